@@ -1,0 +1,49 @@
+//! The library's error type: every variant names the entity that failed.
+
+use std::path::PathBuf;
+
+/// Everything that can go wrong in the library, with the file, key or mesh entity at fault.
+#[derive(Debug, thiserror::Error)]
+pub enum Error {
+    /// A mesh is broken: the message names the vertex, triangle or edge.
+    #[error("mesh: {0}")]
+    Mesh(String),
+    /// A mesh or data file could not be read or parsed.
+    #[error("{path}: {message}")]
+    File {
+        /// The file at fault.
+        path: PathBuf,
+        /// What is wrong with it (with line or section where known).
+        message: String,
+    },
+    /// An expression does not parse or uses an unknown name.
+    #[error("expression `{expr}`: {message}")]
+    Expr {
+        /// The expression text.
+        expr: String,
+        /// What is wrong with it.
+        message: String,
+    },
+    /// Problem data out of range (t ≤ 0, h < 0, NaN, ...): names the quantity.
+    #[error("invalid data: {0}")]
+    Data(String),
+    /// A solver did not converge or met a numerical failure.
+    #[error("solver {solver}: {message}")]
+    Solver {
+        /// The solver's name.
+        solver: String,
+        /// What happened (iterations, residual reached, ...).
+        message: String,
+    },
+    /// An input/output failure while writing results.
+    #[error("{path}: {source}")]
+    Io {
+        /// The file being written or read.
+        path: PathBuf,
+        /// The underlying error.
+        source: std::io::Error,
+    },
+}
+
+/// Shorthand for results of this library.
+pub type Result<T, E = Error> = std::result::Result<T, E>;

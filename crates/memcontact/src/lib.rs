@@ -1,0 +1,23 @@
+//! # memcontact
+//!
+//! Contact between a stretched membrane and an elastic (tensionless Winkler) obstacle,
+//! discretised exactly as in A. Maceri & F. Maceri, "Analysis of a discrete model for the
+//! contact problem between a membrane and an elastic obstacle", Rend. Lincei 80 (1986).
+//!
+//! Data flows one way: [`field`] data and a [`mesh::Mesh`] build a [`model::Model`]
+//! (S, L, D, φₙ of the paper's §2), a [`solve`] method returns a [`solve::Solution`],
+//! and [`results`] derives the physical fields that the [`io`] writers store.
+
+pub mod error;
+pub mod exact;
+pub mod expr;
+pub mod fem;
+pub mod field;
+pub mod io;
+pub mod mesh;
+pub mod model;
+pub mod results;
+pub mod solve;
+pub mod sparse;
+
+pub use error::{Error, Result};

@@ -1,0 +1,1 @@
+//! Built-in mesh generators: rectangle, disc, polygon with holes.

@@ -1,0 +1,464 @@
+//! Triangular meshes: the type, its checks and quality report, the boundary and the map
+//! between vertices and unknowns (SPEC §2: the unknowns are the interior vertices).
+
+pub mod generate;
+pub mod refine;
+
+use crate::{Error, Result};
+use std::collections::{BTreeMap, HashMap};
+
+/// A point of the plane.
+pub type Point = [f64; 2];
+
+/// A conforming triangulation `T_n` of P1 triangles, counter-clockwise after [`Mesh::new`].
+#[derive(Debug, Clone, Default)]
+pub struct Mesh {
+    /// Vertex coordinates.
+    pub points: Vec<Point>,
+    /// Triangles as three vertex indices, counter-clockwise.
+    pub triangles: Vec<[u32; 3]>,
+    /// Region tag of every triangle (a Gmsh physical surface, a polygon part, ...).
+    pub regions: Vec<u32>,
+    /// Names of the region tags that have one.
+    pub region_names: BTreeMap<u32, String>,
+}
+
+/// Geometric quality figures of a mesh (SPEC §2: `l_n`, `s_n`).
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct MeshQuality {
+    /// Number of vertices.
+    pub vertices: usize,
+    /// Number of triangles.
+    pub triangles: usize,
+    /// Number of unknowns: the vertices not on the boundary ∂Ω_n.
+    pub unknowns: usize,
+    /// `l_n`: the largest triangle diameter (longest edge).
+    pub l_n: f64,
+    /// `s_n`: the largest ratio diameter / inscribed-circle diameter.
+    pub s_n: f64,
+    /// The smallest interior angle, in degrees.
+    pub min_angle_deg: f64,
+    /// Total area of Ω_n.
+    pub area: f64,
+}
+
+impl Mesh {
+    /// Builds a mesh and checks it: finite coordinates, valid indices, no degenerate or
+    /// inverted triangle, no duplicate or unused vertex, no non-manifold edge. A mesh whose
+    /// triangles are all clockwise is reoriented; a mix of orientations is an error
+    /// (the minority triangles are inverted). `regions` may be empty (all region 0).
+    pub fn new(
+        points: Vec<Point>,
+        mut triangles: Vec<[u32; 3]>,
+        mut regions: Vec<u32>,
+        region_names: BTreeMap<u32, String>,
+    ) -> Result<Mesh> {
+        if regions.is_empty() {
+            regions = vec![0; triangles.len()];
+        }
+        if regions.len() != triangles.len() {
+            return Err(Error::Mesh(format!(
+                "{} region tags for {} triangles",
+                regions.len(),
+                triangles.len()
+            )));
+        }
+        if triangles.is_empty() {
+            return Err(Error::Mesh("the mesh has no triangle".into()));
+        }
+        for (i, p) in points.iter().enumerate() {
+            if !p[0].is_finite() || !p[1].is_finite() {
+                return Err(Error::Mesh(format!(
+                    "vertex {i} has a non-finite coordinate ({}, {})",
+                    p[0], p[1]
+                )));
+            }
+        }
+        let n = points.len();
+        for (k, t) in triangles.iter().enumerate() {
+            for &v in t {
+                if v as usize >= n {
+                    return Err(Error::Mesh(format!(
+                        "triangle {k} uses vertex {v}, but the mesh has only {n} vertices"
+                    )));
+                }
+            }
+            if t[0] == t[1] || t[1] == t[2] || t[0] == t[2] {
+                return Err(Error::Mesh(format!(
+                    "triangle {k} repeats a vertex: {:?}",
+                    t
+                )));
+            }
+        }
+        // Degenerate and orientation checks.
+        let mut negative = 0usize;
+        for (k, t) in triangles.iter().enumerate() {
+            let a = signed_area(&points, t);
+            let d = diameter(&points, t);
+            if a.abs() <= 1e-12 * d * d {
+                return Err(Error::Mesh(format!(
+                    "triangle {k} (vertices {}, {}, {}) is degenerate: area {a:e}",
+                    t[0], t[1], t[2]
+                )));
+            }
+            if a < 0.0 {
+                negative += 1;
+            }
+        }
+        if negative == triangles.len() {
+            for t in &mut triangles {
+                t.swap(1, 2);
+            }
+        } else if negative > 0 {
+            let k = triangles
+                .iter()
+                .position(|t| signed_area(&points, t) < 0.0)
+                .unwrap_or(0);
+            let t = triangles[k];
+            return Err(Error::Mesh(format!(
+                "triangle {k} (vertices {}, {}, {}) is inverted: its orientation is opposite \
+                 to that of the other triangles ({negative} of {} are inverted)",
+                t[0],
+                t[1],
+                t[2],
+                triangles.len()
+            )));
+        }
+        let mesh = Mesh {
+            points,
+            triangles,
+            regions,
+            region_names,
+        };
+        mesh.check_vertices()?;
+        mesh.check_edges()?;
+        Ok(mesh)
+    }
+
+    /// Unused and duplicate vertices are errors.
+    fn check_vertices(&self) -> Result<()> {
+        let mut used = vec![false; self.points.len()];
+        for t in &self.triangles {
+            for &v in t {
+                used[v as usize] = true;
+            }
+        }
+        if let Some(v) = used.iter().position(|u| !u) {
+            let count = used.iter().filter(|u| !**u).count();
+            return Err(Error::Mesh(format!(
+                "vertex {v} at ({}, {}) is used by no triangle ({count} unused vertices)",
+                self.points[v][0], self.points[v][1]
+            )));
+        }
+        let mut seen: HashMap<(u64, u64), usize> = HashMap::with_capacity(self.points.len());
+        for (i, p) in self.points.iter().enumerate() {
+            // +0.0 normalises -0.0 so that equal coordinates hash equally.
+            let key = ((p[0] + 0.0).to_bits(), (p[1] + 0.0).to_bits());
+            if let Some(j) = seen.insert(key, i) {
+                return Err(Error::Mesh(format!(
+                    "vertices {j} and {i} are duplicates at ({}, {})",
+                    p[0], p[1]
+                )));
+            }
+        }
+        Ok(())
+    }
+
+    /// An edge shared by more than two triangles, or by two triangles that traverse it in
+    /// the same direction (a fold), is an error.
+    fn check_edges(&self) -> Result<()> {
+        for (a, b, uses) in self.edge_uses() {
+            if uses.len() > 2 {
+                return Err(Error::Mesh(format!(
+                    "edge ({a}, {b}) is non-manifold: shared by triangles {:?}",
+                    uses.iter().map(|u| u.0).collect::<Vec<_>>()
+                )));
+            }
+            if uses.len() == 2 && uses[0].1 == uses[1].1 {
+                return Err(Error::Mesh(format!(
+                    "triangles {} and {} overlap across edge ({a}, {b})",
+                    uses[0].0, uses[1].0
+                )));
+            }
+        }
+        Ok(())
+    }
+
+    /// Every edge `(a, b)` with `a < b` and the triangles using it, each with a flag telling
+    /// whether the triangle traverses it from `a` to `b`.
+    fn edge_uses(&self) -> Vec<(u32, u32, Vec<(usize, bool)>)> {
+        let mut map: HashMap<(u32, u32), Vec<(usize, bool)>> =
+            HashMap::with_capacity(self.triangles.len() * 2);
+        for (k, t) in self.triangles.iter().enumerate() {
+            for e in 0..3 {
+                let (a, b) = (t[e], t[(e + 1) % 3]);
+                let key = (a.min(b), a.max(b));
+                map.entry(key).or_default().push((k, a < b));
+            }
+        }
+        let mut v: Vec<_> = map.into_iter().map(|((a, b), u)| (a, b, u)).collect();
+        v.sort_unstable_by_key(|e| (e.0, e.1));
+        v
+    }
+
+    /// Number of vertices.
+    pub fn n_vertices(&self) -> usize {
+        self.points.len()
+    }
+
+    /// Number of triangles.
+    pub fn n_triangles(&self) -> usize {
+        self.triangles.len()
+    }
+
+    /// The boundary edges ∂Ω_n: edges of exactly one triangle, as `(a, b)` in the
+    /// triangle's (counter-clockwise) order.
+    pub fn boundary_edges(&self) -> Vec<[u32; 2]> {
+        // Each interior edge appears once in each direction; sort half-edges to pair them.
+        let mut half: Vec<(u32, u32)> = Vec::with_capacity(self.triangles.len() * 3);
+        for t in &self.triangles {
+            for e in 0..3 {
+                half.push((t[e], t[(e + 1) % 3]));
+            }
+        }
+        let mut keyed: Vec<(u64, u32, u32)> = half
+            .iter()
+            .map(|&(a, b)| (((a.min(b) as u64) << 32) | b.max(a) as u64, a, b))
+            .collect();
+        keyed.sort_unstable_by_key(|k| k.0);
+        let mut out = Vec::new();
+        let mut i = 0;
+        while i < keyed.len() {
+            let mut j = i + 1;
+            while j < keyed.len() && keyed[j].0 == keyed[i].0 {
+                j += 1;
+            }
+            if j - i == 1 {
+                out.push([keyed[i].1, keyed[i].2]);
+            }
+            i = j;
+        }
+        out
+    }
+
+    /// `true` for every vertex on the boundary ∂Ω_n.
+    pub fn boundary_vertices(&self) -> Vec<bool> {
+        let mut on = vec![false; self.points.len()];
+        for [a, b] in self.boundary_edges() {
+            on[a as usize] = true;
+            on[b as usize] = true;
+        }
+        on
+    }
+
+    /// Signed area of triangle `k` (positive: counter-clockwise).
+    pub fn area(&self, k: usize) -> f64 {
+        signed_area(&self.points, &self.triangles[k])
+    }
+
+    /// The three corner coordinates of triangle `k`.
+    pub fn corners(&self, k: usize) -> [Point; 3] {
+        let t = self.triangles[k];
+        [
+            self.points[t[0] as usize],
+            self.points[t[1] as usize],
+            self.points[t[2] as usize],
+        ]
+    }
+
+    /// Total area of Ω_n.
+    pub fn total_area(&self) -> f64 {
+        (0..self.triangles.len()).map(|k| self.area(k)).sum()
+    }
+
+    /// The quality report: counts, `l_n`, `s_n`, smallest angle.
+    pub fn quality(&self) -> MeshQuality {
+        let boundary = self.boundary_vertices();
+        let mut l_n: f64 = 0.0;
+        let mut s_n: f64 = 0.0;
+        let mut min_angle = f64::INFINITY;
+        let mut area = 0.0;
+        for k in 0..self.triangles.len() {
+            let c = self.corners(k);
+            let e = [dist(c[1], c[2]), dist(c[2], c[0]), dist(c[0], c[1])];
+            let a = self.area(k).abs();
+            area += a;
+            let d = e[0].max(e[1]).max(e[2]);
+            l_n = l_n.max(d);
+            // Inscribed circle: radius 2A / perimeter.
+            let r = 2.0 * a / (e[0] + e[1] + e[2]);
+            s_n = s_n.max(d / (2.0 * r));
+            for i in 0..3 {
+                let (opp, b, cc) = (e[i], e[(i + 1) % 3], e[(i + 2) % 3]);
+                let cos = ((b * b + cc * cc - opp * opp) / (2.0 * b * cc)).clamp(-1.0, 1.0);
+                min_angle = min_angle.min(cos.acos().to_degrees());
+            }
+        }
+        MeshQuality {
+            vertices: self.points.len(),
+            triangles: self.triangles.len(),
+            unknowns: boundary.iter().filter(|b| !**b).count(),
+            l_n,
+            s_n,
+            min_angle_deg: min_angle,
+            area,
+        }
+    }
+
+    /// The name of region `tag`, or the tag as text.
+    pub fn region_name(&self, tag: u32) -> String {
+        self.region_names
+            .get(&tag)
+            .cloned()
+            .unwrap_or_else(|| tag.to_string())
+    }
+}
+
+/// The map between mesh vertices and unknowns: the unknowns are the interior vertices
+/// `a_1, ..., a_m` (SPEC §2). Vectors over unknowns and over vertices are different things;
+/// convert only through this type.
+#[derive(Debug, Clone)]
+pub struct DofMap {
+    /// `vertex[i]`: the mesh vertex of unknown `i`.
+    pub vertex: Vec<u32>,
+    /// `dof[v]`: the unknown of vertex `v`, or `None` on the boundary.
+    pub dof: Vec<Option<u32>>,
+}
+
+impl DofMap {
+    /// Numbers the interior vertices of `mesh` in vertex order.
+    pub fn new(mesh: &Mesh) -> DofMap {
+        let boundary = mesh.boundary_vertices();
+        let mut vertex = Vec::with_capacity(boundary.len());
+        let mut dof = vec![None; boundary.len()];
+        for (v, &b) in boundary.iter().enumerate() {
+            if !b {
+                dof[v] = Some(vertex.len() as u32);
+                vertex.push(v as u32);
+            }
+        }
+        DofMap { vertex, dof }
+    }
+
+    /// Number of unknowns `m`.
+    pub fn len(&self) -> usize {
+        self.vertex.len()
+    }
+
+    /// `true` when the mesh has no interior vertex.
+    pub fn is_empty(&self) -> bool {
+        self.vertex.is_empty()
+    }
+
+    /// A vector over unknowns extended to all vertices, with `boundary` on ∂Ω_n.
+    pub fn to_vertices(&self, x: &[f64], boundary: f64) -> Vec<f64> {
+        let mut out = vec![boundary; self.dof.len()];
+        for (i, &v) in self.vertex.iter().enumerate() {
+            out[v as usize] = x[i];
+        }
+        out
+    }
+
+    /// A vector over all vertices restricted to the unknowns.
+    pub fn to_unknowns(&self, x: &[f64]) -> Vec<f64> {
+        self.vertex.iter().map(|&v| x[v as usize]).collect()
+    }
+}
+
+/// Twice-signed area / 2 of a triangle given by vertex indices.
+pub fn signed_area(points: &[Point], t: &[u32; 3]) -> f64 {
+    let [a, b, c] = [
+        points[t[0] as usize],
+        points[t[1] as usize],
+        points[t[2] as usize],
+    ];
+    0.5 * ((b[0] - a[0]) * (c[1] - a[1]) - (c[0] - a[0]) * (b[1] - a[1]))
+}
+
+fn diameter(points: &[Point], t: &[u32; 3]) -> f64 {
+    let p = |i: usize| points[t[i] as usize];
+    dist(p(0), p(1)).max(dist(p(1), p(2))).max(dist(p(2), p(0)))
+}
+
+/// Euclidean distance.
+pub fn dist(a: Point, b: Point) -> f64 {
+    ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2)).sqrt()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn square() -> Mesh {
+        let p = vec![[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0], [0.5, 0.5]];
+        let t = vec![[0, 1, 4], [1, 2, 4], [2, 3, 4], [3, 0, 4]];
+        Mesh::new(p, t, vec![], BTreeMap::new()).unwrap()
+    }
+
+    #[test]
+    fn boundary_and_dofs() {
+        let m = square();
+        assert_eq!(m.boundary_edges().len(), 4);
+        let d = DofMap::new(&m);
+        assert_eq!(d.vertex, vec![4]);
+        let q = m.quality();
+        assert_eq!(q.unknowns, 1);
+        assert!((q.area - 1.0).abs() < 1e-15);
+        assert!((q.min_angle_deg - 45.0).abs() < 1e-12);
+        assert!((q.l_n - 1.0).abs() < 1e-15);
+    }
+
+    #[test]
+    fn clockwise_mesh_is_reoriented() {
+        let p = vec![[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]];
+        let m = Mesh::new(p, vec![[0, 2, 1]], vec![], BTreeMap::new()).unwrap();
+        assert!(m.area(0) > 0.0);
+    }
+
+    #[test]
+    fn broken_meshes_are_errors() {
+        let p = vec![[0.0, 0.0], [1.0, 0.0], [0.0, 1.0], [1.0, 1.0]];
+        let e = Mesh::new(p.clone(), vec![[0, 1, 2]], vec![], BTreeMap::new()).unwrap_err();
+        assert!(e.to_string().contains("vertex 3"), "{e}");
+        let e = Mesh::new(
+            vec![[0.0, 0.0], [1.0, 0.0], [2.0, 0.0]],
+            vec![[0, 1, 2]],
+            vec![],
+            BTreeMap::new(),
+        )
+        .unwrap_err();
+        assert!(e.to_string().contains("degenerate"), "{e}");
+        let e = Mesh::new(
+            p.clone(),
+            vec![[0, 1, 2], [1, 2, 3]],
+            vec![],
+            BTreeMap::new(),
+        )
+        .unwrap_err();
+        assert!(e.to_string().contains("inverted"), "{e}");
+        let mut p2 = p.clone();
+        p2.push([1.0, 0.0]);
+        let e = Mesh::new(p2, vec![[0, 1, 2], [4, 3, 2]], vec![], BTreeMap::new()).unwrap_err();
+        assert!(e.to_string().contains("duplicates"), "{e}");
+        let p3 = vec![[0.0, 0.0], [1.0, 0.0], [0.0, 1.0], [1.0, 1.0], [-1.0, -1.0]];
+        let e = Mesh::new(
+            p3,
+            vec![[0, 1, 2], [1, 3, 2], [0, 4, 1]],
+            vec![],
+            BTreeMap::new(),
+        );
+        assert!(e.is_ok());
+        let p4 = vec![[0.0, 0.0], [1.0, 0.0], [0.5, 1.0], [0.5, -1.0], [0.5, 2.0]];
+        let e = Mesh::new(
+            p4,
+            vec![[0, 1, 2], [0, 3, 1], [0, 1, 4]],
+            vec![],
+            BTreeMap::new(),
+        )
+        .unwrap_err();
+        assert!(
+            e.to_string().contains("non-manifold") || e.to_string().contains("overlap"),
+            "{e}"
+        );
+    }
+}
