@@ -16,6 +16,7 @@ pub mod field;
 pub mod io;
 pub mod mesh;
 pub mod model;
+pub mod quadrature;
 pub mod results;
 pub mod solve;
 pub mod sparse;

@@ -21,6 +21,31 @@ pub struct Mesh {
     pub regions: Vec<u32>,
     /// Names of the region tags that have one.
     pub region_names: BTreeMap<u32, String>,
+    /// The curved boundary the mesh approximates, if any: refinement moves new boundary
+    /// vertices onto it so that Ω_n approaches Ω.
+    pub curve: Option<Circle>,
+}
+
+/// A circle: the boundary of a disc domain.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Circle {
+    /// Centre.
+    pub center: Point,
+    /// Radius.
+    pub radius: f64,
+}
+
+impl Circle {
+    /// The point of the circle closest to `p` (radial projection).
+    pub fn project(&self, p: Point) -> Point {
+        let (dx, dy) = (p[0] - self.center[0], p[1] - self.center[1]);
+        let r = (dx * dx + dy * dy).sqrt();
+        if r == 0.0 {
+            return p;
+        }
+        let s = self.radius / r;
+        [self.center[0] + dx * s, self.center[1] + dy * s]
+    }
 }
 
 /// Geometric quality figures of a mesh (SPEC §2: `l_n`, `s_n`).
@@ -129,6 +154,7 @@ impl Mesh {
             triangles,
             regions,
             region_names,
+            curve: None,
         };
         mesh.check_vertices()?;
         mesh.check_edges()?;
