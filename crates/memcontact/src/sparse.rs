@@ -1,1 +1,320 @@
-//! TODO
+//! Sparse symmetric matrices in compressed-row form with a shared pattern, and a sparse
+//! Cholesky factorisation (faer) that keeps its symbolic analysis between refactorisations.
+
+use crate::{Error, Result};
+use rayon::prelude::*;
+use std::sync::Arc;
+
+/// Below this many rows, matrix-vector products run serially (threads cost more).
+const PAR_ROWS: usize = 20_000;
+
+/// A sparsity pattern: sorted column indices per row. Shared by S, L and the Newton
+/// matrices, so that it is built once (assemble once, keep the pattern).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Pattern {
+    /// Row `i` occupies `col[row_ptr[i]..row_ptr[i + 1]]`.
+    pub row_ptr: Vec<usize>,
+    /// Column indices, sorted within each row.
+    pub col: Vec<u32>,
+}
+
+impl Pattern {
+    /// Number of rows (= columns: the patterns here are square).
+    pub fn n(&self) -> usize {
+        self.row_ptr.len() - 1
+    }
+
+    /// Number of stored entries.
+    pub fn nnz(&self) -> usize {
+        self.col.len()
+    }
+
+    /// The position of entry `(i, j)` in the value array, if stored.
+    pub fn find(&self, i: usize, j: usize) -> Option<usize> {
+        let row = &self.col[self.row_ptr[i]..self.row_ptr[i + 1]];
+        row.binary_search(&(j as u32))
+            .ok()
+            .map(|k| self.row_ptr[i] + k)
+    }
+
+    /// The position of every diagonal entry (all must be stored).
+    pub fn diagonal_positions(&self) -> Vec<usize> {
+        (0..self.n())
+            .map(|i| self.find(i, i).expect("the pattern stores the diagonal"))
+            .collect()
+    }
+}
+
+/// A square sparse matrix in compressed-row form over a shared [`Pattern`].
+#[derive(Debug, Clone)]
+pub struct Csr {
+    /// The sparsity pattern.
+    pub pattern: Arc<Pattern>,
+    /// One value per pattern entry.
+    pub val: Vec<f64>,
+}
+
+impl Csr {
+    /// A matrix of zeros on `pattern`.
+    pub fn zeros(pattern: Arc<Pattern>) -> Csr {
+        let nnz = pattern.nnz();
+        Csr {
+            pattern,
+            val: vec![0.0; nnz],
+        }
+    }
+
+    /// A diagonal matrix stored on its own diagonal pattern.
+    pub fn diagonal(d: &[f64]) -> Csr {
+        Csr {
+            pattern: Arc::new(Pattern {
+                row_ptr: (0..=d.len()).collect(),
+                col: (0..d.len() as u32).collect(),
+            }),
+            val: d.to_vec(),
+        }
+    }
+
+    /// Builds a matrix from `(row, col, value)` triplets (duplicates summed). Meant for
+    /// small matrices (coarse levels, tests).
+    pub fn from_triplets(n: usize, triplets: &[(usize, usize, f64)]) -> Csr {
+        let mut rows: Vec<Vec<(u32, f64)>> = vec![Vec::new(); n];
+        for &(i, j, v) in triplets {
+            rows[i].push((j as u32, v));
+        }
+        let mut row_ptr = vec![0usize];
+        let mut col = Vec::new();
+        let mut val = Vec::new();
+        for mut r in rows {
+            r.sort_unstable_by_key(|e| e.0);
+            let mut k = 0;
+            while k < r.len() {
+                let (j, mut v) = r[k];
+                k += 1;
+                while k < r.len() && r[k].0 == j {
+                    v += r[k].1;
+                    k += 1;
+                }
+                col.push(j);
+                val.push(v);
+            }
+            row_ptr.push(col.len());
+        }
+        Csr {
+            pattern: Arc::new(Pattern { row_ptr, col }),
+            val,
+        }
+    }
+
+    /// Number of rows.
+    pub fn n(&self) -> usize {
+        self.pattern.n()
+    }
+
+    /// Entry `(i, j)` (zero when not stored).
+    pub fn get(&self, i: usize, j: usize) -> f64 {
+        self.pattern.find(i, j).map_or(0.0, |k| self.val[k])
+    }
+
+    /// The diagonal.
+    pub fn diag(&self) -> Vec<f64> {
+        (0..self.n()).map(|i| self.get(i, i)).collect()
+    }
+
+    /// Row `i` as (columns, values).
+    #[inline]
+    pub fn row(&self, i: usize) -> (&[u32], &[f64]) {
+        let r = self.pattern.row_ptr[i]..self.pattern.row_ptr[i + 1];
+        (&self.pattern.col[r.clone()], &self.val[r])
+    }
+
+    /// `(A x)_i`.
+    #[inline]
+    pub fn row_dot(&self, i: usize, x: &[f64]) -> f64 {
+        let (c, v) = self.row(i);
+        c.iter().zip(v).map(|(&j, &a)| a * x[j as usize]).sum()
+    }
+
+    /// `y = A x` (parallel for large matrices; the result does not depend on the thread
+    /// count because every row is summed in the same order).
+    pub fn mul_into(&self, x: &[f64], y: &mut [f64]) {
+        if self.n() >= PAR_ROWS {
+            y.par_iter_mut()
+                .enumerate()
+                .with_min_len(4096)
+                .for_each(|(i, yi)| *yi = self.row_dot(i, x));
+        } else {
+            for (i, yi) in y.iter_mut().enumerate() {
+                *yi = self.row_dot(i, x);
+            }
+        }
+    }
+
+    /// `A x` as a new vector.
+    pub fn mul(&self, x: &[f64]) -> Vec<f64> {
+        let mut y = vec![0.0; self.n()];
+        self.mul_into(x, &mut y);
+        y
+    }
+
+    /// `xᵀ A x`.
+    pub fn quad_form(&self, x: &[f64]) -> f64 {
+        if self.n() >= PAR_ROWS {
+            (0..self.n())
+                .into_par_iter()
+                .with_min_len(4096)
+                .map(|i| x[i] * self.row_dot(i, x))
+                .sum()
+        } else {
+            (0..self.n()).map(|i| x[i] * self.row_dot(i, x)).sum()
+        }
+    }
+
+    /// `true` when every entry is finite.
+    pub fn is_finite(&self) -> bool {
+        self.val.iter().all(|v| v.is_finite())
+    }
+}
+
+/// A sparse LLᵀ factorisation of a symmetric positive definite [`Csr`] (faer's supernodal
+/// Cholesky with AMD ordering). The symbolic analysis is done once per pattern;
+/// [`Cholesky::refactor`] redoes only the numeric part, as an active-set loop needs.
+pub struct Cholesky {
+    n: usize,
+    col_ptr: Vec<usize>,
+    row_idx: Vec<usize>,
+    symbolic: faer::sparse::linalg::solvers::SymbolicLlt<usize>,
+    numeric: Option<faer::sparse::linalg::solvers::Llt<usize, f64>>,
+}
+
+impl Cholesky {
+    /// Analyses the pattern of `a` and factorises it.
+    pub fn new(a: &Csr) -> Result<Cholesky> {
+        use faer::sparse::SymbolicSparseColMatRef;
+        let n = a.n();
+        // A symmetric matrix in CSR is its own CSC: row pointers become column pointers.
+        let col_ptr = a.pattern.row_ptr.clone();
+        let row_idx: Vec<usize> = a.pattern.col.iter().map(|&j| j as usize).collect();
+        let sym = SymbolicSparseColMatRef::new_checked(n, n, &col_ptr, None, &row_idx);
+        let symbolic = faer::sparse::linalg::solvers::SymbolicLlt::try_new(sym, faer::Side::Lower)
+            .map_err(|e| Error::Solver {
+                solver: "cholesky".into(),
+                message: format!("symbolic analysis failed: {e:?}"),
+            })?;
+        let mut c = Cholesky {
+            n,
+            col_ptr,
+            row_idx,
+            symbolic,
+            numeric: None,
+        };
+        c.refactor(a)?;
+        Ok(c)
+    }
+
+    /// Factorises new values on the same pattern.
+    pub fn refactor(&mut self, a: &Csr) -> Result<()> {
+        use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
+        debug_assert_eq!(a.n(), self.n);
+        if !a.is_finite() {
+            return Err(Error::Solver {
+                solver: "cholesky".into(),
+                message: "the matrix has non-finite entries".into(),
+            });
+        }
+        let sym = SymbolicSparseColMatRef::new_checked(
+            self.n,
+            self.n,
+            &self.col_ptr,
+            None,
+            &self.row_idx,
+        );
+        let mat = SparseColMatRef::new(sym, &a.val);
+        let llt = faer::sparse::linalg::solvers::Llt::try_new_with_symbolic(
+            self.symbolic.clone(),
+            mat,
+            faer::Side::Lower,
+        )
+        .map_err(|e| Error::Solver {
+            solver: "cholesky".into(),
+            message: format!("the matrix is not positive definite ({e:?})"),
+        })?;
+        self.numeric = Some(llt);
+        Ok(())
+    }
+
+    /// Solves `A x = b` in place.
+    pub fn solve_in_place(&self, b: &mut [f64]) {
+        use faer::linalg::solvers::Solve;
+        let llt = self.numeric.as_ref().expect("factorised in new()");
+        let rhs = faer::MatMut::from_column_major_slice_mut(b, self.n, 1);
+        llt.solve_in_place(rhs);
+    }
+}
+
+/// Euclidean dot product.
+pub fn dot(a: &[f64], b: &[f64]) -> f64 {
+    a.iter().zip(b).map(|(x, y)| x * y).sum()
+}
+
+/// Maximum norm.
+pub fn norm_inf(a: &[f64]) -> f64 {
+    a.iter().fold(0.0, |m, x| m.max(x.abs()))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The 1-D Laplacian tridiag(-1, 2, -1).
+    fn lap1d(n: usize) -> Csr {
+        let mut t = Vec::new();
+        for i in 0..n {
+            t.push((i, i, 2.0));
+            if i > 0 {
+                t.push((i, i - 1, -1.0));
+                t.push((i - 1, i, -1.0));
+            }
+        }
+        Csr::from_triplets(n, &t)
+    }
+
+    #[test]
+    fn cholesky_solves_and_refactors() {
+        let mut a = lap1d(50);
+        let x: Vec<f64> = (0..50).map(|i| (i as f64 * 0.3).sin()).collect();
+        let mut b = a.mul(&x);
+        let mut c = Cholesky::new(&a).unwrap();
+        c.solve_in_place(&mut b);
+        for (p, q) in b.iter().zip(&x) {
+            assert!((p - q).abs() < 1e-12);
+        }
+        for v in a.val.iter_mut() {
+            *v *= 3.0;
+        }
+        c.refactor(&a).unwrap();
+        let mut b = a.mul(&x);
+        c.solve_in_place(&mut b);
+        for (p, q) in b.iter().zip(&x) {
+            assert!((p - q).abs() < 1e-12);
+        }
+    }
+
+    #[test]
+    fn indefinite_matrix_is_an_error() {
+        let mut a = lap1d(5);
+        for v in a.val.iter_mut() {
+            *v = -*v;
+        }
+        assert!(Cholesky::new(&a).is_err());
+    }
+
+    #[test]
+    fn triplets_sum_duplicates() {
+        let a = Csr::from_triplets(2, &[(0, 0, 1.0), (0, 0, 2.0), (1, 0, 4.0)]);
+        assert_eq!(a.get(0, 0), 3.0);
+        assert_eq!(a.get(1, 0), 4.0);
+        assert_eq!(a.get(0, 1), 0.0);
+        assert_eq!(a.quad_form(&[1.0, 1.0]), 7.0);
+    }
+}

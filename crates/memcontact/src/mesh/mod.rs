@@ -48,6 +48,9 @@ impl Circle {
     }
 }
 
+/// An edge `(a, b)`, `a < b`, with the triangles using it and whether each goes a → b.
+type EdgeUse = (u32, u32, Vec<(usize, bool)>);
+
 /// Geometric quality figures of a mesh (SPEC §2: `l_n`, `s_n`).
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
 pub struct MeshQuality {
@@ -212,7 +215,7 @@ impl Mesh {
 
     /// Every edge `(a, b)` with `a < b` and the triangles using it, each with a flag telling
     /// whether the triangle traverses it from `a` to `b`.
-    fn edge_uses(&self) -> Vec<(u32, u32, Vec<(usize, bool)>)> {
+    fn edge_uses(&self) -> Vec<EdgeUse> {
         let mut map: HashMap<(u32, u32), Vec<(usize, bool)>> =
             HashMap::with_capacity(self.triangles.len() * 2);
         for (k, t) in self.triangles.iter().enumerate() {
