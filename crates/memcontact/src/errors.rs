@@ -103,12 +103,18 @@ pub fn error_norms(
         l2 += a;
         h1 += b;
     }
-    let max_nodal = mesh
-        .points
-        .iter()
-        .zip(u_vertices)
-        .map(|(&p, &u)| (exact.value(p) - u).abs())
-        .fold(0.0, f64::max);
+    let mut max_nodal: f64 = 0.0;
+    for (i, (&p, &u)) in mesh.points.iter().zip(u_vertices).enumerate() {
+        if !exact.contains(p) {
+            return Err(Error::Mesh(format!(
+                "vertex {i} at ({}, {}) lies outside the domain of {}",
+                p[0],
+                p[1],
+                exact.describe()
+            )));
+        }
+        max_nodal = max_nodal.max((exact.value(p) - u).abs());
+    }
     let gap = match exact.disk() {
         Some((c, r)) => disk_gap(mesh, exact, c, r)?,
         None => [0.0; 3],
