@@ -122,30 +122,42 @@ impl Field {
                 fallback = Some(value);
                 continue;
             }
-            let by_name = region_names
+            // A name may label several tags: the value applies to each of them.
+            let by_name: Vec<u32> = region_names
                 .iter()
-                .find(|(_, n)| *n == key)
-                .map(|(&t, _)| t);
-            let tag = match by_name.or_else(|| key.trim().parse::<u32>().ok()) {
-                Some(tag) if present.binary_search(&tag).is_ok() => tag,
-                Some(tag) if by_name.is_some() => {
+                .filter(|(_, n)| n.as_str() == key)
+                .map(|(&t, _)| t)
+                .collect();
+            let is_present = |t: &u32| present.binary_search(t).is_ok();
+            let targets: Vec<u32> = if !by_name.is_empty() {
+                let found: Vec<u32> = by_name.iter().copied().filter(is_present).collect();
+                if found.is_empty() {
+                    let tags: Vec<String> = by_name.iter().map(u32::to_string).collect();
                     return Err(Error::Data(format!(
-                        "{name}: region '{key}' (tag {tag}) has no triangles in the mesh ({})",
+                        "{name}: region '{key}' (tag {}) has no triangles in the mesh ({})",
+                        tags.join(", "),
                         listing()
-                    )))
+                    )));
                 }
-                _ => {
-                    return Err(Error::Data(format!(
-                        "{name}: no region named '{key}' in the mesh ({})",
-                        listing()
-                    )))
+                found
+            } else {
+                match key.trim().parse::<u32>() {
+                    Ok(tag) if is_present(&tag) => vec![tag],
+                    _ => {
+                        return Err(Error::Data(format!(
+                            "{name}: no region named '{key}' in the mesh ({})",
+                            listing()
+                        )))
+                    }
                 }
             };
-            if let Some((other, _)) = given.insert(tag, (key.as_str(), value)) {
-                return Err(Error::Data(format!(
-                    "{name}: region {} is given twice (as '{other}' and as '{key}')",
-                    label(tag)
-                )));
+            for tag in targets {
+                if let Some((other, _)) = given.insert(tag, (key.as_str(), value.clone())) {
+                    return Err(Error::Data(format!(
+                        "{name}: region {} is given twice (as '{other}' and as '{key}')",
+                        label(tag)
+                    )));
+                }
             }
         }
         let mut regions = Vec::with_capacity(present.len());
@@ -705,6 +717,10 @@ mod tests {
             m,
             "load f: no value for region foam and no \"default\" entry (regions: soil, foam)"
         );
+        // A name shared by two tags applies to both.
+        let shared = BTreeMap::from([(1, "soil".to_string()), (5, "soil".to_string())]);
+        let h = json(r#"{"soil": 3}"#).bind("h", &shared, &[1, 5]).unwrap();
+        assert_eq!((h.eval([0.0, 0.0], 1), h.eval([0.0, 0.0], 5)), (3.0, 3.0));
         let m = data_error(json(r#"{"soil": 1, "1": 2}"#).bind("h", &names(), &[1, 2]));
         assert!(m.contains("region soil is given twice"), "{m}");
         let nested = Field::Regions(BTreeMap::from([(
