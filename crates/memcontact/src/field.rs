@@ -873,3 +873,12 @@ mod tests {
         check::<Stiffness>();
     }
 }
+
+impl crate::fem::Coefficient for BoundField {
+    fn at(&self, p: [f64; 2], region: u32) -> f64 {
+        self.eval(p, region)
+    }
+    fn on_region(&self, region: u32) -> Option<f64> {
+        self.region_constant(region)
+    }
+}
