@@ -559,11 +559,7 @@ mod tests {
                         total = k;
                     }
                     let tail = String::from_utf8(raw[total..].to_vec()).unwrap();
-                    assert_eq!(
-                        tail.trim(),
-                        "</AppendedData>\n</VTKFile>",
-                        "tail"
-                    );
+                    assert_eq!(tail.trim(), "</AppendedData>\n</VTKFile>", "tail");
                     (
                         format!(
                             "{head}{}{tail}",
