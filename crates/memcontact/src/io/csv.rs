@@ -14,6 +14,7 @@
 
 use super::vtu::DataArray;
 use crate::{Error, Result};
+use rayon::prelude::*;
 use std::io::Write;
 use std::path::Path;
 
@@ -36,27 +37,48 @@ pub fn write_columns_csv(path: &Path, columns: &[(&str, DataArray)]) -> Result<(
     }
     let names: Vec<&str> = columns.iter().map(|(n, _)| *n).collect();
     crate::io::write_atomic(path, |w| {
-        let mut buf = Vec::with_capacity(CHUNK + 4096);
-        push_header(&mut buf, &names);
-        for i in 0..rows {
-            for (k, (_, data)) in columns.iter().enumerate() {
-                if k > 0 {
-                    buf.push(b',');
-                }
-                match data {
-                    DataArray::F64(v) => push_f64(&mut buf, v[i]),
-                    DataArray::I32(v) => push_int(&mut buf, v[i] as i64),
-                    DataArray::I8(v) => push_int(&mut buf, v[i] as i64),
-                }
-            }
-            buf.push(b'\n');
-            if buf.len() >= CHUNK {
-                w.write_all(&buf)?;
-                buf.clear();
+        let mut head = Vec::new();
+        push_header(&mut head, &names);
+        w.write_all(&head)?;
+        // Blocks of rows are formatted in parallel, a batch at a time, and written in order.
+        let blocks = rows.div_ceil(ROWS_PER_BLOCK);
+        let batch = 4 * rayon::current_num_threads().max(1);
+        for first in (0..blocks).step_by(batch) {
+            let texts: Vec<Vec<u8>> = (first..(first + batch).min(blocks))
+                .into_par_iter()
+                .map(|b| {
+                    let range = b * ROWS_PER_BLOCK..((b + 1) * ROWS_PER_BLOCK).min(rows);
+                    format_rows(columns, range)
+                })
+                .collect();
+            for text in &texts {
+                w.write_all(text)?;
             }
         }
-        w.write_all(&buf)
+        Ok(())
     })
+}
+
+/// Rows per block formatted by one task.
+const ROWS_PER_BLOCK: usize = 4096;
+
+/// Formats rows `range` of `columns` as CSV lines.
+fn format_rows(columns: &[(&str, DataArray)], range: std::ops::Range<usize>) -> Vec<u8> {
+    let mut buf = Vec::with_capacity(range.len() * columns.len() * 20);
+    for i in range {
+        for (k, (_, data)) in columns.iter().enumerate() {
+            if k > 0 {
+                buf.push(b',');
+            }
+            match data {
+                DataArray::F64(v) => push_f64(&mut buf, v[i]),
+                DataArray::I32(v) => push_int(&mut buf, v[i] as i64),
+                DataArray::I8(v) => push_int(&mut buf, v[i] as i64),
+            }
+        }
+        buf.push(b'\n');
+    }
+    buf
 }
 
 /// Writes a small table: the `header` row, then every row of `rows`, each of which must have
@@ -258,6 +280,15 @@ mod tests {
             "CSV 1M rows x 10 f64 columns: {:.3} s, {:.1} MB",
             t.elapsed().as_secs_f64(),
             std::fs::metadata(&path).unwrap().len() as f64 / 1e6
+        );
+        let t = std::time::Instant::now();
+        let bytes: usize = (0..n)
+            .step_by(ROWS_PER_BLOCK)
+            .map(|i| format_rows(&columns, i..(i + ROWS_PER_BLOCK).min(n)).len())
+            .sum();
+        eprintln!(
+            "  of which formatting on one thread: {:.3} s ({bytes} bytes)",
+            t.elapsed().as_secs_f64()
         );
         std::fs::remove_file(&path).unwrap();
     }
