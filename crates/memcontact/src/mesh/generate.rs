@@ -1221,4 +1221,41 @@ mod tests {
         assert!((layer_area - 2.8).abs() < 1e-9, "{layer_area}");
         assert!((m.total_area() - 12.0).abs() < 1e-9);
     }
+    /// Timings for the report: `cargo test --release -p memcontact --lib timings -- --ignored --nocapture`.
+    #[test]
+    #[ignore]
+    fn timings() {
+        for n in [1024, 4096] {
+            let t = std::time::Instant::now();
+            let h = rectangle(&spec(n, n, Diagonal::Right)).unwrap();
+            let dt = t.elapsed();
+            let tri: usize = h.levels.iter().map(|m| m.triangles.len()).sum();
+            eprintln!(
+                "rectangle {n}²: {dt:?}, {} levels, finest {} vertices / {} triangles, all levels {tri} triangles",
+                h.depth(),
+                h.finest().points.len(),
+                h.finest().triangles.len()
+            );
+        }
+        let coarse = rectangle(&spec(512, 512, Diagonal::Alternate))
+            .unwrap()
+            .levels
+            .pop()
+            .unwrap();
+        let t = std::time::Instant::now();
+        let (f, _) = refine_uniform(&coarse);
+        eprintln!(
+            "refine_uniform {} -> {} triangles: {:?}",
+            coarse.triangles.len(),
+            f.triangles.len(),
+            t.elapsed()
+        );
+        let t = std::time::Instant::now();
+        let d = disk([0.0, 0.0], 1.0, 0.005).unwrap();
+        eprintln!(
+            "disk size 0.005: {} triangles in {:?}",
+            d.triangles.len(),
+            t.elapsed()
+        );
+    }
 }
