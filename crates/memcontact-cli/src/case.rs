@@ -407,7 +407,10 @@ impl Case {
             ),
         };
         if m.refine > 12 {
-            bail!("mesh.refine = {} is too large (each refinement multiplies the triangles by 4)", m.refine);
+            bail!(
+                "mesh.refine = {} is too large (each refinement multiplies the triangles by 4)",
+                m.refine
+            );
         }
         if m.refine > 0 {
             hierarchy.refine(m.refine);
@@ -415,4 +418,3 @@ impl Case {
         Ok((hierarchy, warnings))
     }
 }
-
