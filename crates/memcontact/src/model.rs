@@ -572,26 +572,7 @@ fn mollify(mesh: &Mesh, adj: &VertexTriangles, phi: &dyn Coefficient, eps: f64) 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use std::collections::BTreeMap;
-
-    pub(crate) fn square(n: usize) -> Mesh {
-        let mut p = Vec::new();
-        for j in 0..=n {
-            for i in 0..=n {
-                p.push([i as f64 / n as f64, j as f64 / n as f64]);
-            }
-        }
-        let mut t = Vec::new();
-        let w = (n + 1) as u32;
-        for j in 0..n as u32 {
-            for i in 0..n as u32 {
-                let a = j * w + i;
-                t.push([a, a + 1, a + w + 1]);
-                t.push([a, a + w + 1, a + w]);
-            }
-        }
-        Mesh::new(p, t, vec![], BTreeMap::new()).unwrap()
-    }
+    use crate::solve::tests::square;
 
     fn data<'a>(h: &'a f64, foundation: Foundation) -> ProblemData<'a> {
         ProblemData {
