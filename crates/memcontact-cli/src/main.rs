@@ -1,1 +1,86 @@
-fn main() {}
+//! `memcontact`: the command-line tool. Parses arguments, reads the case, runs the library,
+//! prints a summary and writes the outputs. All the numerics live in the library.
+
+mod case;
+mod commands;
+mod examples;
+mod output;
+mod plot;
+
+use clap::{Parser, Subcommand};
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+/// Contact between a stretched membrane and an elastic (Winkler) obstacle: the discrete
+/// model of Maceri & Maceri (1986), solved exactly and certified.
+///
+/// Units are whatever consistent system the case uses: lengths in the mesh's unit,
+/// tension t in force/length, load f and pressures in force/area, stiffness h in
+/// force/length³.
+#[derive(Parser)]
+#[command(name = "memcontact", version, about, long_about)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Solve a case and write solution.vtu, nodes.csv and summary.json.
+    Solve {
+        /// The case file (TOML).
+        case: PathBuf,
+        /// Output directory (created if needed).
+        #[arg(short, long, default_value = "out")]
+        output: PathBuf,
+        /// Override a case key, e.g. --set mesh.nx=128 --set obstacle.foundation=lumped.
+        #[arg(long = "set", value_name = "KEY=VALUE")]
+        sets: Vec<String>,
+        /// Print no progress lines.
+        #[arg(short, long)]
+        quiet: bool,
+    },
+    /// Validate a case and report its mesh, without solving.
+    Check {
+        /// The case file (TOML).
+        case: PathBuf,
+        /// Override a case key.
+        #[arg(long = "set", value_name = "KEY=VALUE")]
+        sets: Vec<String>,
+    },
+    /// List the example cases, or write one (and any mesh it needs) to a directory.
+    Example {
+        /// The example to write; omit to list them.
+        name: Option<String>,
+        /// Directory to write into (created if needed).
+        #[arg(short, long, default_value = "examples")]
+        dir: PathBuf,
+        /// Overwrite existing files.
+        #[arg(long)]
+        force: bool,
+    },
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Command::Solve {
+            case,
+            output,
+            sets,
+            quiet,
+        } => commands::solve(&case, &output, &sets, quiet),
+        Command::Check { case, sets } => commands::check(&case, &sets),
+        Command::Example { name, dir, force } => examples::run(name.as_deref(), &dir, force),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e}");
+            for cause in e.chain().skip(1) {
+                eprintln!("  caused by: {cause}");
+            }
+            ExitCode::FAILURE
+        }
+    }
+}

@@ -1,1 +1,1423 @@
-//! TODO
+//! Gmsh MSH meshes: a reader for versions 2.2 and 4.1, ASCII and binary, and a writer.
+//!
+//! Only 3-node triangles (element type 2) make the mesh; physical surfaces become regions
+//! (`$PhysicalNames` of dimension 2 name them). Every other element type is skipped with a
+//! warning. The format is described in the Gmsh reference manual, section "MSH file format".
+
+use crate::mesh::Mesh;
+use crate::{Error, Result};
+use std::collections::BTreeMap;
+use std::io::Write;
+use std::path::Path;
+
+/// The MSH flavours [`write_msh`] can produce.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum MshVersion {
+    /// MSH 2.2, text.
+    V22Ascii,
+    /// MSH 2.2, binary.
+    V22Binary,
+    /// MSH 4.1, text (Gmsh's default).
+    V41Ascii,
+    /// MSH 4.1, binary.
+    V41Binary,
+}
+
+/// Reads a 2-D triangle mesh from a Gmsh MSH file (2.2 or 4.1, ASCII or binary).
+///
+/// Returns the mesh (vertices: the nodes used by triangles, in file order; regions: the
+/// physical surface of each triangle, 0 if none) and warnings: skipped element types,
+/// dropped nodes, surfaces with several physical tags. Parse failures are
+/// [`Error::File`] with the line (ASCII) or section (binary) and what was expected; a
+/// broken mesh (inverted, duplicate vertices...) is reported by [`Mesh::new`]'s checks.
+pub fn read_msh(path: &Path) -> Result<(Mesh, Vec<String>)> {
+    let file_err = |message: String| Error::File {
+        path: path.to_path_buf(),
+        message,
+    };
+    let bytes = std::fs::read(path).map_err(|e| file_err(format!("cannot read the file: {e}")))?;
+    let raw = parse(&bytes).map_err(file_err)?;
+    raw.into_mesh().map_err(|e| match e {
+        ParseOrMesh::Parse(m) => file_err(m),
+        ParseOrMesh::Mesh(e, warnings) => file_err(format!(
+            "{e} (triangles are numbered from 0 in file order, vertices from 0 in node \
+             order){}",
+            if warnings.is_empty() {
+                String::new()
+            } else {
+                format!("; warnings: {}", warnings.join("; "))
+            }
+        )),
+    })
+}
+
+/// Number of nodes and a name for the Gmsh element types (reference manual, `$Elements`).
+fn element_type(t: i32) -> Option<(usize, &'static str)> {
+    Some(match t {
+        1 => (2, "2-node line"),
+        2 => (3, "3-node triangle"),
+        3 => (4, "4-node quadrangle"),
+        4 => (4, "4-node tetrahedron"),
+        5 => (8, "8-node hexahedron"),
+        6 => (6, "6-node prism"),
+        7 => (5, "5-node pyramid"),
+        8 => (3, "3-node second order line"),
+        9 => (6, "6-node second order triangle"),
+        10 => (9, "9-node second order quadrangle"),
+        11 => (10, "10-node second order tetrahedron"),
+        12 => (27, "27-node second order hexahedron"),
+        13 => (18, "18-node second order prism"),
+        14 => (14, "14-node second order pyramid"),
+        15 => (1, "1-node point"),
+        16 => (8, "8-node second order quadrangle"),
+        17 => (20, "20-node second order hexahedron"),
+        18 => (15, "15-node second order prism"),
+        19 => (13, "13-node second order pyramid"),
+        20 => (9, "9-node third order incomplete triangle"),
+        21 => (10, "10-node third order triangle"),
+        22 => (12, "12-node fourth order incomplete triangle"),
+        23 => (15, "15-node fourth order triangle"),
+        24 => (15, "15-node fifth order incomplete triangle"),
+        25 => (21, "21-node fifth order complete triangle"),
+        26 => (4, "4-node third order edge"),
+        27 => (5, "5-node fourth order edge"),
+        28 => (6, "6-node fifth order edge"),
+        29 => (20, "20-node third order tetrahedron"),
+        30 => (35, "35-node fourth order tetrahedron"),
+        31 => (56, "56-node fifth order tetrahedron"),
+        92 => (64, "64-node third order hexahedron"),
+        93 => (125, "125-node fourth order hexahedron"),
+        _ => return None,
+    })
+}
+
+/// What the file holds, before it becomes a mesh.
+#[derive(Default)]
+struct Raw {
+    /// (node tag, coordinates) in file order.
+    nodes: Vec<(u64, [f64; 3])>,
+    /// (element tag, node tags, physical tag) of every 3-node triangle.
+    triangles: Vec<(u64, [u64; 3], u32)>,
+    /// Physical names of dimension 2.
+    names: BTreeMap<u32, String>,
+    /// Skipped elements per type.
+    skipped: BTreeMap<i32, usize>,
+    warnings: Vec<String>,
+}
+
+enum ParseOrMesh {
+    Parse(String),
+    Mesh(Error, Vec<String>),
+}
+
+impl Raw {
+    /// Resolves node tags, keeps the nodes used by triangles, checks planarity and builds
+    /// the mesh.
+    fn into_mesh(self) -> std::result::Result<(Mesh, Vec<String>), ParseOrMesh> {
+        let Raw {
+            nodes,
+            triangles,
+            names,
+            skipped,
+            mut warnings,
+        } = self;
+        if triangles.is_empty() {
+            let others: usize = skipped.values().sum();
+            return Err(ParseOrMesh::Parse(format!(
+                "no 3-node triangle (element type 2) in $Elements ({others} other elements): \
+                 a 2-D triangle mesh is needed"
+            )));
+        }
+        // Planarity: z must vanish up to round-off relative to the extent of the mesh.
+        let extent = nodes
+            .iter()
+            .map(|(_, p)| p[0].abs().max(p[1].abs()))
+            .fold(1.0, f64::max);
+        for (tag, p) in &nodes {
+            if p[2].is_nan() || p[2].abs() > 1e-12 * extent {
+                return Err(ParseOrMesh::Parse(format!(
+                    "$Nodes: node {tag} at ({}, {}, {}) has z ≠ 0: the mesh must lie in the \
+                     plane z = 0",
+                    p[0], p[1], p[2]
+                )));
+            }
+        }
+        // Tag → file index by sorting (node tags may be sparse and unordered).
+        let mut by_tag: Vec<(u64, u32)> = nodes
+            .iter()
+            .enumerate()
+            .map(|(i, (t, _))| (*t, i as u32))
+            .collect();
+        by_tag.sort_unstable();
+        if let Some(w) = by_tag.windows(2).find(|w| w[0].0 == w[1].0) {
+            return Err(ParseOrMesh::Parse(format!(
+                "$Nodes: node tag {} appears twice",
+                w[0].0
+            )));
+        }
+        let find = |tag: u64| {
+            by_tag
+                .binary_search_by_key(&tag, |e| e.0)
+                .ok()
+                .map(|k| by_tag[k].1)
+        };
+        let mut new_index = vec![u32::MAX; nodes.len()];
+        let mut tris = Vec::with_capacity(triangles.len());
+        let mut regions = Vec::with_capacity(triangles.len());
+        for (etag, t, region) in &triangles {
+            let mut out = [0u32; 3];
+            for (o, &n) in out.iter_mut().zip(t) {
+                *o = find(n).ok_or_else(|| {
+                    ParseOrMesh::Parse(format!(
+                        "$Elements: triangle {etag} references node {n}, which is not in $Nodes"
+                    ))
+                })?;
+            }
+            tris.push(out);
+            regions.push(*region);
+        }
+        // Keep the used nodes, in file order.
+        for t in &tris {
+            for &v in t {
+                new_index[v as usize] = 0;
+            }
+        }
+        let mut points = Vec::new();
+        for (i, slot) in new_index.iter_mut().enumerate() {
+            if *slot == 0 {
+                *slot = points.len() as u32;
+                points.push([nodes[i].1[0], nodes[i].1[1]]);
+            }
+        }
+        for t in &mut tris {
+            for v in t.iter_mut() {
+                *v = new_index[*v as usize];
+            }
+        }
+        for (&t, &count) in &skipped {
+            let name = element_type(t).map_or("unknown type", |e| e.1);
+            warnings.push(format!("skipped {count} elements of type {t} ({name})"));
+        }
+        let dropped = nodes.len() - points.len();
+        if dropped > 0 {
+            warnings.push(format!(
+                "dropped {dropped} of {} nodes that no triangle uses",
+                nodes.len()
+            ));
+        }
+        match Mesh::new(points, tris, regions, names) {
+            Ok(mesh) => Ok((mesh, warnings)),
+            Err(e) => Err(ParseOrMesh::Mesh(e, warnings)),
+        }
+    }
+}
+
+/// A cursor over the file: whitespace-separated tokens for the text parts, little- or
+/// big-endian numbers for the binary ones.
+struct Cursor<'a> {
+    buf: &'a [u8],
+    pos: usize,
+    /// Binary numbers are byte-swapped (the file was written on the other endianness).
+    swap: bool,
+    /// Size of `size_t` in 4.1 binary files.
+    size_t: usize,
+    /// The section being read, for messages.
+    section: &'static str,
+}
+
+type Parse<T> = std::result::Result<T, String>;
+
+impl<'a> Cursor<'a> {
+    fn line(&self, pos: usize) -> usize {
+        1 + self.buf[..pos.min(self.buf.len())]
+            .iter()
+            .filter(|&&b| b == b'\n')
+            .count()
+    }
+
+    /// The next whitespace-separated token and the line it is on.
+    fn token(&mut self) -> Option<(&'a str, usize)> {
+        while self.pos < self.buf.len() && self.buf[self.pos].is_ascii_whitespace() {
+            self.pos += 1;
+        }
+        if self.pos >= self.buf.len() {
+            return None;
+        }
+        let start = self.pos;
+        while self.pos < self.buf.len() && !self.buf[self.pos].is_ascii_whitespace() {
+            self.pos += 1;
+        }
+        let text = std::str::from_utf8(&self.buf[start..self.pos]).unwrap_or("<not text>");
+        Some((text, start))
+    }
+
+    /// The next token parsed as `T`, `what` naming it in the error.
+    fn parse<T: std::str::FromStr>(&mut self, what: &str) -> Parse<T> {
+        match self.token() {
+            Some((text, start)) => text.parse().map_err(|_| {
+                format!(
+                    "line {} ({}): expected {what}, found `{}`",
+                    self.line(start),
+                    self.section,
+                    text.chars().take(40).collect::<String>()
+                )
+            }),
+            None => Err(format!(
+                "unexpected end of file in {}: expected {what}",
+                self.section
+            )),
+        }
+    }
+
+    /// Requires the token `word` (a section end, ...).
+    fn expect(&mut self, word: &str) -> Parse<()> {
+        match self.token() {
+            Some((t, _)) if t == word => Ok(()),
+            Some((t, start)) => Err(format!(
+                "line {}: expected `{word}`, found `{}`",
+                self.line(start),
+                t.chars().take(40).collect::<String>()
+            )),
+            None => Err(format!("unexpected end of file: expected `{word}`")),
+        }
+    }
+
+    /// Skips the rest of the current line, its newline included (binary data follows).
+    fn end_line(&mut self) {
+        while self.pos < self.buf.len() && self.buf[self.pos] != b'\n' {
+            self.pos += 1;
+        }
+        self.pos = (self.pos + 1).min(self.buf.len());
+    }
+
+    fn bytes<const N: usize>(&mut self, what: &str) -> Parse<[u8; N]> {
+        let end = self.pos + N;
+        if end > self.buf.len() {
+            return Err(format!(
+                "unexpected end of file in the binary data of {} (byte {}): expected {what}",
+                self.section, self.pos
+            ));
+        }
+        let mut b: [u8; N] = self.buf[self.pos..end].try_into().expect("length N");
+        if self.swap {
+            b.reverse();
+        }
+        self.pos = end;
+        Ok(b)
+    }
+
+    fn int(&mut self, what: &str) -> Parse<i32> {
+        Ok(i32::from_ne_bytes(self.bytes::<4>(what)?))
+    }
+
+    fn double(&mut self, what: &str) -> Parse<f64> {
+        Ok(f64::from_ne_bytes(self.bytes::<8>(what)?))
+    }
+
+    fn size(&mut self, what: &str) -> Parse<u64> {
+        if self.size_t == 4 {
+            Ok(u32::from_ne_bytes(self.bytes::<4>(what)?) as u64)
+        } else {
+            Ok(u64::from_ne_bytes(self.bytes::<8>(what)?))
+        }
+    }
+
+    /// A count that must fit in memory: no more than one item per remaining byte.
+    fn check_count(&self, n: u64, what: &str) -> Parse<usize> {
+        if n > (self.buf.len() - self.pos.min(self.buf.len())) as u64 + 1 {
+            return Err(format!(
+                "{}: {what} = {n} is more than the file can hold (truncated or corrupt file?)",
+                self.section
+            ));
+        }
+        Ok(n as usize)
+    }
+}
+
+/// The MSH flavour named by `$MeshFormat`.
+#[derive(Clone, Copy, PartialEq)]
+enum Flavour {
+    V2,
+    V4,
+}
+
+fn parse(buf: &[u8]) -> Parse<Raw> {
+    let mut c = Cursor {
+        buf,
+        pos: 0,
+        swap: false,
+        size_t: 8,
+        section: "$MeshFormat",
+    };
+    match c.token() {
+        Some(("$MeshFormat", _)) => {}
+        Some((t, _)) => {
+            return Err(format!(
+                "line 1: expected `$MeshFormat`, found `{}`: not a Gmsh MSH file",
+                t.chars().take(40).collect::<String>()
+            ))
+        }
+        None => return Err("the file is empty: expected `$MeshFormat`".into()),
+    }
+    let (version, vpos) = c
+        .token()
+        .ok_or("unexpected end of file in $MeshFormat: expected the version")?;
+    let flavour = match version {
+        "2.2" | "2.1" | "2" | "2.0" => Flavour::V2,
+        "4.1" => Flavour::V4,
+        v => {
+            return Err(format!(
+                "line {}: MSH version {v} is not supported (2.2 and 4.1 are)",
+                c.line(vpos)
+            ))
+        }
+    };
+    let file_type: i32 = c.parse("the file type (0 ASCII, 1 binary)")?;
+    let data_size: usize = c.parse("the data size")?;
+    let binary = match file_type {
+        0 => false,
+        1 => true,
+        t => {
+            return Err(format!(
+                "$MeshFormat: file type {t} is neither 0 (ASCII) nor 1 (binary)"
+            ))
+        }
+    };
+    if binary {
+        if flavour == Flavour::V4 && data_size != 4 && data_size != 8 {
+            return Err(format!(
+                "$MeshFormat: data size {data_size} is not supported (4 or 8)"
+            ));
+        }
+        c.size_t = data_size;
+        c.end_line();
+        let one = c.bytes::<4>("the endianness check (int 1)")?;
+        if i32::from_ne_bytes(one) == 1 {
+            c.swap = false;
+        } else if i32::from_ne_bytes(one).swap_bytes() == 1 {
+            c.swap = true;
+        } else {
+            return Err(
+                "$MeshFormat: the binary endianness check is not the integer 1".to_string(),
+            );
+        }
+    }
+    c.expect("$EndMeshFormat")?;
+
+    let mut raw = Raw::default();
+    let mut entities: BTreeMap<i32, Vec<i32>> = BTreeMap::new();
+    let mut saw_nodes = false;
+    let mut saw_elements = false;
+    while let Some((tok, start)) = c.token() {
+        match tok {
+            "$PhysicalNames" => {
+                c.section = "$PhysicalNames";
+                read_physical_names(&mut c, &mut raw)?;
+            }
+            "$Entities" if flavour == Flavour::V4 => {
+                c.section = "$Entities";
+                if binary {
+                    c.end_line();
+                }
+                entities = read_entities(&mut c, binary, &mut raw.warnings)?;
+                c.expect("$EndEntities")?;
+            }
+            "$Nodes" => {
+                c.section = "$Nodes";
+                match flavour {
+                    Flavour::V2 => read_nodes_v2(&mut c, binary, &mut raw)?,
+                    Flavour::V4 => {
+                        if binary {
+                            c.end_line();
+                        }
+                        read_nodes_v4(&mut c, binary, &mut raw)?
+                    }
+                }
+                c.expect("$EndNodes")?;
+                saw_nodes = true;
+            }
+            "$Elements" => {
+                c.section = "$Elements";
+                match flavour {
+                    Flavour::V2 => read_elements_v2(&mut c, binary, &mut raw)?,
+                    Flavour::V4 => {
+                        if binary {
+                            c.end_line();
+                        }
+                        read_elements_v4(&mut c, binary, &entities, &mut raw)?
+                    }
+                }
+                c.expect("$EndElements")?;
+                saw_elements = true;
+            }
+            t if t.starts_with('$') && !t.starts_with("$End") => {
+                // An unknown or unused section ($Periodic, $NodeData, ...): skip it.
+                let end = format!("$End{}", &t[1..]);
+                let rest = &buf[c.pos..];
+                match find(rest, end.as_bytes()) {
+                    Some(k) => c.pos += k + end.len(),
+                    None => {
+                        return Err(format!(
+                            "line {}: section {t} has no `{end}`",
+                            c.line(start)
+                        ))
+                    }
+                }
+            }
+            t => {
+                return Err(format!(
+                    "line {}: expected a section header such as `$Nodes`, found `{}`",
+                    c.line(start),
+                    t.chars().take(40).collect::<String>()
+                ))
+            }
+        }
+    }
+    if !saw_nodes {
+        return Err("the file has no $Nodes section".into());
+    }
+    if !saw_elements {
+        return Err("the file has no $Elements section".into());
+    }
+    Ok(raw)
+}
+
+fn find(hay: &[u8], needle: &[u8]) -> Option<usize> {
+    hay.windows(needle.len()).position(|w| w == needle)
+}
+
+fn read_physical_names(c: &mut Cursor, raw: &mut Raw) -> Parse<()> {
+    let n: usize = c.parse("the number of physical names")?;
+    for _ in 0..n {
+        let dim: i32 = c.parse("a physical dimension")?;
+        let tag: i64 = c.parse("a physical tag")?;
+        // The name: a quoted string, possibly with spaces.
+        while c.pos < c.buf.len() && (c.buf[c.pos] == b' ' || c.buf[c.pos] == b'\t') {
+            c.pos += 1;
+        }
+        let line = c.line(c.pos);
+        if c.buf.get(c.pos) != Some(&b'"') {
+            return Err(format!(
+                "line {line} ($PhysicalNames): expected a quoted name after `{dim} {tag}`"
+            ));
+        }
+        let start = c.pos + 1;
+        let len = c.buf[start..]
+            .iter()
+            .position(|&b| b == b'"' || b == b'\n')
+            .filter(|&k| c.buf[start + k] == b'"')
+            .ok_or_else(|| format!("line {line} ($PhysicalNames): unterminated name"))?;
+        let name = String::from_utf8_lossy(&c.buf[start..start + len]).into_owned();
+        c.pos = start + len + 1;
+        if dim == 2 {
+            let tag = u32::try_from(tag)
+                .map_err(|_| format!("line {line} ($PhysicalNames): bad physical tag {tag}"))?;
+            raw.names.insert(tag, name);
+        }
+    }
+    c.expect("$EndPhysicalNames")
+}
+
+/// `$Entities` (4.1): the physical tags of every surface.
+fn read_entities(
+    c: &mut Cursor,
+    binary: bool,
+    warnings: &mut Vec<String>,
+) -> Parse<BTreeMap<i32, Vec<i32>>> {
+    let mut counts = [0usize; 4];
+    for (k, what) in ["points", "curves", "surfaces", "volumes"]
+        .iter()
+        .enumerate()
+    {
+        let n = if binary {
+            c.size(&format!("the number of {what}"))?
+        } else {
+            c.parse(&format!("the number of {what}"))?
+        };
+        counts[k] = c.check_count(n, &format!("the number of {what}"))?;
+    }
+    let mut surfaces = BTreeMap::new();
+    for (dim, &count) in counts.iter().enumerate() {
+        for _ in 0..count {
+            let tag: i32 = if binary {
+                c.int("an entity tag")?
+            } else {
+                c.parse("an entity tag")?
+            };
+            let n_coords = if dim == 0 { 3 } else { 6 };
+            for _ in 0..n_coords {
+                if binary {
+                    c.double("an entity bounding box coordinate")?;
+                } else {
+                    c.parse::<f64>("an entity bounding box coordinate")?;
+                }
+            }
+            let n_phys = if binary {
+                c.size("the number of physical tags")?
+            } else {
+                c.parse("the number of physical tags")?
+            };
+            let n_phys = c.check_count(n_phys, "the number of physical tags")?;
+            let mut phys = Vec::with_capacity(n_phys);
+            for _ in 0..n_phys {
+                phys.push(if binary {
+                    c.int("a physical tag")?
+                } else {
+                    c.parse("a physical tag")?
+                });
+            }
+            if dim > 0 {
+                let n_bound = if binary {
+                    c.size("the number of bounding entities")?
+                } else {
+                    c.parse("the number of bounding entities")?
+                };
+                let n_bound = c.check_count(n_bound, "the number of bounding entities")?;
+                for _ in 0..n_bound {
+                    if binary {
+                        c.int("a bounding entity tag")?;
+                    } else {
+                        c.parse::<i32>("a bounding entity tag")?;
+                    }
+                }
+            }
+            if dim == 2 {
+                if phys.len() > 1 {
+                    warnings.push(format!(
+                        "surface {tag} has {} physical tags; its triangles get the first ({})",
+                        phys.len(),
+                        phys[0]
+                    ));
+                }
+                surfaces.insert(tag, phys);
+            }
+        }
+    }
+    Ok(surfaces)
+}
+
+fn read_nodes_v2(c: &mut Cursor, binary: bool, raw: &mut Raw) -> Parse<()> {
+    let n: u64 = c.parse("the number of nodes")?;
+    let n = c.check_count(n, "the number of nodes")?;
+    raw.nodes.reserve(n);
+    if binary {
+        c.end_line();
+    }
+    for _ in 0..n {
+        if binary {
+            let tag = c.int("a node tag")?;
+            let p = [c.double("x")?, c.double("y")?, c.double("z")?];
+            let tag = u64::try_from(tag).map_err(|_| format!("$Nodes: bad node tag {tag}"))?;
+            raw.nodes.push((tag, p));
+        } else {
+            let tag: u64 = c.parse("a node tag")?;
+            let p = [c.parse("x")?, c.parse("y")?, c.parse("z")?];
+            raw.nodes.push((tag, p));
+        }
+    }
+    Ok(())
+}
+
+fn read_nodes_v4(c: &mut Cursor, binary: bool, raw: &mut Raw) -> Parse<()> {
+    let mut head = [0u64; 4];
+    for (h, what) in head.iter_mut().zip([
+        "the number of node blocks",
+        "the number of nodes",
+        "the smallest node tag",
+        "the largest node tag",
+    ]) {
+        *h = if binary {
+            c.size(what)?
+        } else {
+            c.parse(what)?
+        };
+    }
+    let blocks = c.check_count(head[0], "the number of node blocks")?;
+    let total = c.check_count(head[1], "the number of nodes")?;
+    raw.nodes.reserve(total);
+    for _ in 0..blocks {
+        let (dim, parametric, n) = if binary {
+            let dim = c.int("an entity dimension")?;
+            c.int("an entity tag")?;
+            let parametric = c.int("the parametric flag")?;
+            (dim, parametric, c.size("the number of nodes in the block")?)
+        } else {
+            let dim: i32 = c.parse("an entity dimension")?;
+            c.parse::<i32>("an entity tag")?;
+            let parametric: i32 = c.parse("the parametric flag")?;
+            (
+                dim,
+                parametric,
+                c.parse("the number of nodes in the block")?,
+            )
+        };
+        let n = c.check_count(n, "the number of nodes in the block")?;
+        let params = if parametric != 0 {
+            dim.max(0) as usize
+        } else {
+            0
+        };
+        let first = raw.nodes.len();
+        for _ in 0..n {
+            let tag = if binary {
+                c.size("a node tag")?
+            } else {
+                c.parse("a node tag")?
+            };
+            raw.nodes.push((tag, [0.0; 3]));
+        }
+        for k in 0..n {
+            let mut p = [0.0; 3];
+            for x in &mut p {
+                *x = if binary {
+                    c.double("a node coordinate")?
+                } else {
+                    c.parse("a node coordinate")?
+                };
+            }
+            for _ in 0..params {
+                if binary {
+                    c.double("a parametric coordinate")?;
+                } else {
+                    c.parse::<f64>("a parametric coordinate")?;
+                }
+            }
+            raw.nodes[first + k].1 = p;
+        }
+    }
+    if raw.nodes.len() != total {
+        return Err(format!(
+            "$Nodes: the header announces {total} nodes but the blocks hold {}",
+            raw.nodes.len()
+        ));
+    }
+    Ok(())
+}
+
+fn read_elements_v2(c: &mut Cursor, binary: bool, raw: &mut Raw) -> Parse<()> {
+    let n: u64 = c.parse("the number of elements")?;
+    let n = c.check_count(n, "the number of elements")?;
+    if binary {
+        c.end_line();
+        let mut done = 0;
+        while done < n {
+            let ty = c.int("an element type")?;
+            let count = c.int("the number of elements that follow")?;
+            let n_tags = c.int("the number of tags")?;
+            let (nodes, _) = element_type(ty).ok_or_else(|| {
+                format!("$Elements: unknown element type {ty}: cannot skip it in binary data")
+            })?;
+            let count = usize::try_from(count)
+                .ok()
+                .filter(|&k| k <= n - done)
+                .ok_or_else(|| format!("$Elements: bad block size {count}"))?;
+            let n_tags = usize::try_from(n_tags)
+                .map_err(|_| format!("$Elements: bad number of tags {n_tags}"))?;
+            for _ in 0..count {
+                let tag = c.int("an element tag")?;
+                let mut phys = 0;
+                for k in 0..n_tags {
+                    let t = c.int("an element tag")?;
+                    if k == 0 {
+                        phys = t;
+                    }
+                }
+                let mut v = [0u64; 3];
+                for k in 0..nodes {
+                    let node = c.int("an element node")?;
+                    if let Some(slot) = v.get_mut(k) {
+                        *slot = u64::try_from(node)
+                            .map_err(|_| format!("$Elements: element {tag}: bad node {node}"))?;
+                    }
+                }
+                add_element(raw, ty, tag as i64, v, phys as i64)?;
+            }
+            done += count;
+        }
+        return Ok(());
+    }
+    for _ in 0..n {
+        let (tag_text, start) = c
+            .token()
+            .ok_or("unexpected end of file in $Elements: expected an element")?;
+        let line = c.line(start);
+        let tag: i64 = tag_text.parse().map_err(|_| {
+            format!("line {line} ($Elements): expected an element tag, found `{tag_text}`")
+        })?;
+        let ty: i32 = c.parse("an element type")?;
+        let n_tags: usize = c.parse("the number of tags")?;
+        let mut phys = 0;
+        for k in 0..n_tags {
+            let t: i64 = c.parse("an element tag")?;
+            if k == 0 {
+                phys = t;
+            }
+        }
+        match element_type(ty) {
+            Some((nodes, _)) => {
+                let mut v = [0u64; 3];
+                for k in 0..nodes {
+                    let node: u64 = c.parse("a node tag")?;
+                    if let Some(slot) = v.get_mut(k) {
+                        *slot = node;
+                    }
+                }
+                add_element(raw, ty, tag, v, phys)?;
+            }
+            None => {
+                // Unknown type: the element is the rest of its line.
+                c.end_line();
+                *raw.skipped.entry(ty).or_default() += 1;
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Records a triangle or counts a skipped element.
+fn add_element(raw: &mut Raw, ty: i32, tag: i64, v: [u64; 3], phys: i64) -> Parse<()> {
+    if ty != 2 {
+        *raw.skipped.entry(ty).or_default() += 1;
+        return Ok(());
+    }
+    let phys = u32::try_from(phys)
+        .map_err(|_| format!("$Elements: triangle {tag}: bad physical tag {phys}"))?;
+    raw.triangles.push((tag as u64, v, phys));
+    Ok(())
+}
+
+fn read_elements_v4(
+    c: &mut Cursor,
+    binary: bool,
+    entities: &BTreeMap<i32, Vec<i32>>,
+    raw: &mut Raw,
+) -> Parse<()> {
+    let mut head = [0u64; 4];
+    for (h, what) in head.iter_mut().zip([
+        "the number of element blocks",
+        "the number of elements",
+        "the smallest element tag",
+        "the largest element tag",
+    ]) {
+        *h = if binary {
+            c.size(what)?
+        } else {
+            c.parse(what)?
+        };
+    }
+    let blocks = c.check_count(head[0], "the number of element blocks")?;
+    for _ in 0..blocks {
+        let (dim, entity, ty, n) = if binary {
+            (
+                c.int("an entity dimension")?,
+                c.int("an entity tag")?,
+                c.int("an element type")?,
+                c.size("the number of elements in the block")?,
+            )
+        } else {
+            (
+                c.parse::<i32>("an entity dimension")?,
+                c.parse::<i32>("an entity tag")?,
+                c.parse::<i32>("an element type")?,
+                c.parse::<u64>("the number of elements in the block")?,
+            )
+        };
+        let n = c.check_count(n, "the number of elements in the block")?;
+        let phys = if dim == 2 {
+            entities
+                .get(&entity)
+                .and_then(|p| p.first())
+                .copied()
+                .unwrap_or(0)
+        } else {
+            0
+        };
+        let known = element_type(ty);
+        if known.is_none() {
+            if binary {
+                return Err(format!(
+                    "$Elements: unknown element type {ty}: cannot skip it in binary data"
+                ));
+            }
+            for _ in 0..n {
+                c.token();
+                c.end_line();
+            }
+            *raw.skipped.entry(ty).or_default() += n;
+            continue;
+        }
+        let nodes = known.map_or(0, |k| k.0);
+        for _ in 0..n {
+            let tag = if binary {
+                c.size("an element tag")?
+            } else {
+                c.parse("an element tag")?
+            };
+            let mut v = [0u64; 3];
+            for k in 0..nodes {
+                let node = if binary {
+                    c.size("an element node")?
+                } else {
+                    c.parse("an element node")?
+                };
+                if let Some(slot) = v.get_mut(k) {
+                    *slot = node;
+                }
+            }
+            add_element(raw, ty, tag as i64, v, phys as i64)?;
+        }
+    }
+    Ok(())
+}
+
+/// Writes `mesh` as a Gmsh MSH file: region tags become physical surfaces (one
+/// elementary surface per region), with `region_names` as `$PhysicalNames`. Useful to
+/// convert meshes and to look at them in Gmsh. Written atomically.
+pub fn write_msh(path: &Path, mesh: &Mesh, version: MshVersion) -> Result<()> {
+    crate::io::write_atomic(path, |w| match version {
+        MshVersion::V22Ascii => write_v22(w, mesh, false),
+        MshVersion::V22Binary => write_v22(w, mesh, true),
+        MshVersion::V41Ascii => write_v41(w, mesh, false),
+        MshVersion::V41Binary => write_v41(w, mesh, true),
+    })
+}
+
+fn write_header(
+    w: &mut dyn Write,
+    version: &str,
+    binary: bool,
+    mesh: &Mesh,
+) -> std::io::Result<()> {
+    writeln!(w, "$MeshFormat")?;
+    writeln!(w, "{version} {} 8", binary as u8)?;
+    if binary {
+        w.write_all(&1i32.to_ne_bytes())?;
+        writeln!(w)?;
+    }
+    writeln!(w, "$EndMeshFormat")?;
+    if !mesh.region_names.is_empty() {
+        writeln!(w, "$PhysicalNames")?;
+        writeln!(w, "{}", mesh.region_names.len())?;
+        for (tag, name) in &mesh.region_names {
+            writeln!(w, "2 {tag} \"{}\"", name.replace(['"', '\n'], "'"))?;
+        }
+        writeln!(w, "$EndPhysicalNames")?;
+    }
+    Ok(())
+}
+
+fn write_v22(w: &mut dyn Write, mesh: &Mesh, binary: bool) -> std::io::Result<()> {
+    write_header(w, "2.2", binary, mesh)?;
+    writeln!(w, "$Nodes")?;
+    writeln!(w, "{}", mesh.points.len())?;
+    for (i, p) in mesh.points.iter().enumerate() {
+        if binary {
+            w.write_all(&(i as i32 + 1).to_ne_bytes())?;
+            for x in [p[0], p[1], 0.0] {
+                w.write_all(&x.to_ne_bytes())?;
+            }
+        } else {
+            writeln!(w, "{} {} {} 0", i + 1, p[0], p[1])?;
+        }
+    }
+    if binary {
+        writeln!(w)?;
+    }
+    writeln!(w, "$EndNodes")?;
+    writeln!(w, "$Elements")?;
+    writeln!(w, "{}", mesh.triangles.len())?;
+    if binary {
+        for x in [2i32, mesh.triangles.len() as i32, 2] {
+            w.write_all(&x.to_ne_bytes())?;
+        }
+    }
+    for (k, t) in mesh.triangles.iter().enumerate() {
+        let r = mesh.regions.get(k).copied().unwrap_or(0);
+        // tags: physical = region, elementary = region + 1 (elementary tags are positive)
+        let row = [k as u32 + 1, r, r + 1, t[0] + 1, t[1] + 1, t[2] + 1];
+        if binary {
+            for x in row {
+                w.write_all(&(x as i32).to_ne_bytes())?;
+            }
+        } else {
+            writeln!(
+                w,
+                "{} 2 2 {} {} {} {} {}",
+                row[0], row[1], row[2], row[3], row[4], row[5]
+            )?;
+        }
+    }
+    if binary {
+        writeln!(w)?;
+    }
+    writeln!(w, "$EndElements")
+}
+
+fn write_v41(w: &mut dyn Write, mesh: &Mesh, binary: bool) -> std::io::Result<()> {
+    write_header(w, "4.1", binary, mesh)?;
+    let size = |w: &mut dyn Write, x: usize| w.write_all(&(x as u64).to_ne_bytes());
+    let int = |w: &mut dyn Write, x: i32| w.write_all(&x.to_ne_bytes());
+    let dbl = |w: &mut dyn Write, x: f64| w.write_all(&x.to_ne_bytes());
+    // One surface per region tag, numbered 1, 2, ... in tag order.
+    let mut per_region: BTreeMap<u32, Vec<usize>> = BTreeMap::new();
+    for k in 0..mesh.triangles.len() {
+        per_region
+            .entry(mesh.regions.get(k).copied().unwrap_or(0))
+            .or_default()
+            .push(k);
+    }
+    let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+    for p in &mesh.points {
+        for d in 0..2 {
+            lo[d] = lo[d].min(p[d]);
+            hi[d] = hi[d].max(p[d]);
+        }
+    }
+    writeln!(w, "$Entities")?;
+    if binary {
+        for x in [0, 0, per_region.len(), 0] {
+            size(w, x)?;
+        }
+    } else {
+        writeln!(w, "0 0 {} 0", per_region.len())?;
+    }
+    for (s, &r) in per_region.keys().enumerate() {
+        let phys: &[i32] = if r == 0 { &[] } else { &[r as i32] };
+        if binary {
+            int(w, s as i32 + 1)?;
+            for x in [lo[0], lo[1], 0.0, hi[0], hi[1], 0.0] {
+                dbl(w, x)?;
+            }
+            size(w, phys.len())?;
+            for &p in phys {
+                int(w, p)?;
+            }
+            size(w, 0)?;
+        } else {
+            write!(
+                w,
+                "{} {} {} 0 {} {} 0 {}",
+                s + 1,
+                lo[0],
+                lo[1],
+                hi[0],
+                hi[1],
+                phys.len()
+            )?;
+            for p in phys {
+                write!(w, " {p}")?;
+            }
+            writeln!(w, " 0")?;
+        }
+    }
+    if binary {
+        writeln!(w)?;
+    }
+    writeln!(w, "$EndEntities")?;
+    let n = mesh.points.len();
+    writeln!(w, "$Nodes")?;
+    if binary {
+        for x in [1, n, 1, n] {
+            size(w, x)?;
+        }
+        int(w, 2)?;
+        int(w, 1)?;
+        int(w, 0)?;
+        size(w, n)?;
+        for i in 0..n {
+            size(w, i + 1)?;
+        }
+        for p in &mesh.points {
+            for x in [p[0], p[1], 0.0] {
+                dbl(w, x)?;
+            }
+        }
+        writeln!(w)?;
+    } else {
+        writeln!(w, "1 {n} 1 {n}")?;
+        writeln!(w, "2 1 0 {n}")?;
+        for i in 0..n {
+            writeln!(w, "{}", i + 1)?;
+        }
+        for p in &mesh.points {
+            writeln!(w, "{} {} 0", p[0], p[1])?;
+        }
+    }
+    writeln!(w, "$EndNodes")?;
+    let nt = mesh.triangles.len();
+    writeln!(w, "$Elements")?;
+    if binary {
+        for x in [per_region.len(), nt, 1, nt] {
+            size(w, x)?;
+        }
+    } else {
+        writeln!(w, "{} {nt} 1 {nt}", per_region.len())?;
+    }
+    let mut tag = 1;
+    for (s, list) in per_region.values().enumerate() {
+        if binary {
+            int(w, 2)?;
+            int(w, s as i32 + 1)?;
+            int(w, 2)?;
+            size(w, list.len())?;
+        } else {
+            writeln!(w, "2 {} 2 {}", s + 1, list.len())?;
+        }
+        for &k in list {
+            let t = mesh.triangles[k];
+            if binary {
+                for x in [tag, t[0] as usize + 1, t[1] as usize + 1, t[2] as usize + 1] {
+                    size(w, x)?;
+                }
+            } else {
+                writeln!(w, "{tag} {} {} {}", t[0] + 1, t[1] + 1, t[2] + 1)?;
+            }
+            tag += 1;
+        }
+    }
+    if binary {
+        writeln!(w)?;
+    }
+    writeln!(w, "$EndElements")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mesh::Point;
+    use std::path::PathBuf;
+
+    fn data(name: &str) -> PathBuf {
+        Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("tests/data")
+            .join(name)
+    }
+
+    fn temp(name: &str) -> PathBuf {
+        let dir = std::env::temp_dir().join(format!("mc-gmsh-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        dir.join(name)
+    }
+
+    /// The triangles as sorted triples of corner coordinates (bit patterns) with their
+    /// region: a description independent of the vertex and triangle numbering.
+    fn canonical(m: &Mesh) -> Vec<([[u64; 2]; 3], u32)> {
+        let key = |p: Point| [p[0].to_bits(), p[1].to_bits()];
+        let mut v: Vec<_> = (0..m.triangles.len())
+            .map(|k| {
+                let mut c = m.corners(k).map(key);
+                c.sort();
+                (c, m.regions[k])
+            })
+            .collect();
+        v.sort();
+        v
+    }
+
+    #[test]
+    fn gmsh_fixtures_agree_in_all_four_flavours() {
+        let names = [
+            "disk_v22_ascii.msh",
+            "disk_v22_binary.msh",
+            "disk_v41_ascii.msh",
+            "disk_v41_binary.msh",
+        ];
+        let meshes: Vec<(Mesh, Vec<String>)> =
+            names.iter().map(|n| read_msh(&data(n)).unwrap()).collect();
+        let (first, warnings) = &meshes[0];
+        // Region names: dimension 2 only ("rim" is a curve).
+        let expect: BTreeMap<u32, String> =
+            BTreeMap::from([(1, "foam".into()), (2, "soil".into())]);
+        assert_eq!(first.region_names, expect);
+        assert!(
+            warnings
+                .iter()
+                .any(|w| w.contains("of type 1 (2-node line)")),
+            "{warnings:?}"
+        );
+        // Geometry: the disc of radius 1 (inscribed polygon), the foam disc of radius 0.5.
+        let pi = std::f64::consts::PI;
+        let area = first.total_area();
+        assert!(area < pi && area > pi - 0.02, "{area}");
+        let foam: f64 = (0..first.triangles.len())
+            .filter(|&k| first.regions[k] == 1)
+            .map(|k| first.area(k))
+            .sum();
+        assert!(foam < pi / 4.0 && foam > pi / 4.0 - 0.01, "{foam}");
+        assert!(first.regions.iter().all(|&r| r == 1 || r == 2));
+        assert!(first.triangles.len() > 250 && first.triangles.len() < 600);
+        for (p, v) in first.points.iter().zip(first.boundary_vertices()) {
+            if v {
+                assert!((p[0].hypot(p[1]) - 1.0).abs() < 1e-12);
+            }
+        }
+        for (name, (m, w)) in names.iter().zip(&meshes).skip(1) {
+            assert_eq!(m.points.len(), first.points.len(), "{name}");
+            assert!(same_mesh(m, first, 1e-14), "{name}: not the same triangles");
+            assert_eq!(m.region_names, first.region_names, "{name}");
+            assert_eq!(w, warnings, "{name}");
+        }
+    }
+
+    /// Whether two meshes have the same vertices (within `tol`; text files round the
+    /// coordinates to 16 digits, binary ones do not) and the same triangles with the same
+    /// regions, whatever the numbering.
+    fn same_mesh(a: &Mesh, b: &Mesh, tol: f64) -> bool {
+        if a.points.len() != b.points.len() || a.triangles.len() != b.triangles.len() {
+            return false;
+        }
+        let order = |m: &Mesh| {
+            let key = |p: Point| ((p[0] * 1e9).round() as i64, (p[1] * 1e9).round() as i64);
+            let mut o: Vec<usize> = (0..m.points.len()).collect();
+            o.sort_by_key(|&i| key(m.points[i]));
+            o
+        };
+        let (oa, ob) = (order(a), order(b));
+        // rank[v]: the position of vertex v in the sorted order, common to both meshes.
+        let mut rank_a = vec![0u32; oa.len()];
+        let mut rank_b = vec![0u32; ob.len()];
+        for (r, (&i, &j)) in oa.iter().zip(&ob).enumerate() {
+            let (p, q) = (a.points[i], b.points[j]);
+            if (p[0] - q[0]).abs() > tol || (p[1] - q[1]).abs() > tol {
+                return false;
+            }
+            rank_a[i] = r as u32;
+            rank_b[j] = r as u32;
+        }
+        let tris = |m: &Mesh, rank: &[u32]| {
+            let mut v: Vec<([u32; 3], u32)> = m
+                .triangles
+                .iter()
+                .zip(&m.regions)
+                .map(|(t, &r)| {
+                    let mut k = t.map(|v| rank[v as usize]);
+                    k.sort();
+                    (k, r)
+                })
+                .collect();
+            v.sort();
+            v
+        };
+        tris(a, &rank_a) == tris(b, &rank_b)
+    }
+
+    /// A unit square of 4 triangles around a centre node written by hand from the format
+    /// documentation: sparse node tags, a point element and line elements to skip, two
+    /// physical surfaces, a name with a space.
+    const SQUARE_22: &str = "$MeshFormat
+2.2 0 8
+$EndMeshFormat
+$PhysicalNames
+3
+1 7 \"edge\"
+2 5 \"left half\"
+2 6 \"right\"
+$EndPhysicalNames
+$Nodes
+5
+10 0 0 0
+20 1 0 0
+30 1 1 0
+40 0 1 0
+99 0.5 0.5 0
+$EndNodes
+$Elements
+7
+1 15 2 0 1 10
+2 1 2 7 1 10 20
+3 1 2 7 1 20 30
+11 2 2 5 1 10 20 99
+12 2 2 6 1 20 30 99
+13 2 2 6 2 30 40 99
+14 2 2 5 2 40 10 99
+$EndElements
+";
+
+    const SQUARE_41: &str = "$MeshFormat
+4.1 0 8
+$EndMeshFormat
+$PhysicalNames
+2
+2 5 \"left half\"
+2 6 \"right\"
+$EndPhysicalNames
+$Entities
+0 1 2 0
+3 0 0 0 1 0 0 1 7 0
+1 0 0 0 1 1 0 1 5 0
+2 0 0 0 1 1 0 1 6 0
+$EndEntities
+$Nodes
+2 5 10 99
+2 1 0 3
+10
+20
+99
+0 0 0
+1 0 0
+0.5 0.5 0
+2 2 0 2
+30
+40
+1 1 0
+0 1 0
+$EndNodes
+$Elements
+3 6 1 14
+1 3 1 1
+2 10 20
+2 1 2 2
+11 10 20 99
+14 40 10 99
+2 2 2 3
+12 20 30 99
+13 30 40 99
+15 30 99 10
+$EndElements
+";
+
+    fn write_text(name: &str, text: &str) -> PathBuf {
+        let p = temp(name);
+        std::fs::write(&p, text).unwrap();
+        p
+    }
+
+    #[test]
+    fn hand_written_files_read_independently_of_the_writer() {
+        let (m2, w2) = read_msh(&write_text("sq22.msh", SQUARE_22)).unwrap();
+        assert_eq!(m2.points.len(), 5);
+        assert_eq!(m2.points[4], [0.5, 0.5]);
+        assert_eq!(m2.triangles.len(), 4);
+        assert_eq!(m2.regions, vec![5, 6, 6, 5]);
+        assert_eq!(m2.region_name(5), "left half");
+        assert_eq!(m2.region_name(6), "right");
+        assert!(!m2.region_names.contains_key(&7));
+        assert!((m2.total_area() - 1.0).abs() < 1e-15);
+        assert_eq!(w2.len(), 2, "{w2:?}");
+        assert!(w2.contains(&"skipped 1 elements of type 15 (1-node point)".to_string()));
+        assert!(w2.contains(&"skipped 2 elements of type 1 (2-node line)".to_string()));
+
+        // 4.1: the third triangle block element 15 would overlap; drop it for the good case.
+        let good41 = SQUARE_41
+            .replace("3 6 1 14", "3 5 1 14")
+            .replace("2 2 2 3\n", "2 2 2 2\n")
+            .replace("15 30 99 10\n", "");
+        let (m4, w4) = read_msh(&write_text("sq41.msh", &good41)).unwrap();
+        assert_eq!(m4.points.len(), 5);
+        assert_eq!(canonical(&m4), canonical(&m2));
+        assert_eq!(m4.region_names, m2.region_names);
+        assert_eq!(
+            w4,
+            vec!["skipped 1 elements of type 1 (2-node line)".to_string()]
+        );
+        // The overlapping extra triangle is caught by the mesh checks.
+        let e = read_msh(&write_text("sq41bad.msh", SQUARE_41)).unwrap_err();
+        assert!(e.to_string().contains("sq41bad.msh"), "{e}");
+    }
+
+    #[test]
+    fn writer_round_trips_in_all_flavours() {
+        let (mesh, _) = read_msh(&data("disk_v41_ascii.msh")).unwrap();
+        let mut mesh = mesh;
+        mesh.region_names.insert(0, "default".into());
+        mesh.regions[0] = 0;
+        for (v, name) in [
+            (MshVersion::V22Ascii, "w22a.msh"),
+            (MshVersion::V22Binary, "w22b.msh"),
+            (MshVersion::V41Ascii, "w41a.msh"),
+            (MshVersion::V41Binary, "w41b.msh"),
+        ] {
+            let p = temp(name);
+            write_msh(&p, &mesh, v).unwrap();
+            let (back, warnings) = read_msh(&p).unwrap();
+            assert!(warnings.is_empty(), "{warnings:?}");
+            assert_eq!(back.points, mesh.points, "{name}");
+            assert_eq!(canonical(&back), canonical(&mesh), "{name}");
+            assert_eq!(back.region_names, mesh.region_names, "{name}");
+        }
+    }
+
+    #[test]
+    fn byte_swapped_binary_is_read() {
+        // Write a 2.2 binary file, then swap every binary number by hand.
+        let (mesh, _) = read_msh(&write_text("sw.msh", SQUARE_22)).unwrap();
+        let p = temp("sw22b.msh");
+        write_msh(&p, &mesh, MshVersion::V22Binary).unwrap();
+        let bytes = std::fs::read(&p).unwrap();
+        let text_end = |tag: &[u8], from: usize| find(&bytes[from..], tag).unwrap() + from;
+        let mut out = bytes.clone();
+        let swap = |out: &mut Vec<u8>, from: usize, to: usize, widths: &[usize]| {
+            let mut pos = from;
+            let mut k = 0;
+            while pos < to {
+                let w = widths[k % widths.len()];
+                out[pos..pos + w].reverse();
+                pos += w;
+                k += 1;
+            }
+        };
+        let one = text_end(b"2.2 1 8\n", 0) + 8;
+        swap(&mut out, one, one + 4, &[4]);
+        let nodes = text_end(b"$Nodes\n5\n", 0) + 9;
+        swap(&mut out, nodes, nodes + 5 * 28, &[4, 8, 8, 8]);
+        let elems = text_end(b"$Elements\n4\n", 0) + 12;
+        swap(&mut out, elems, elems + 12 + 4 * 24, &[4]);
+        let q = temp("sw22b_swapped.msh");
+        std::fs::write(&q, out).unwrap();
+        let (back, _) = read_msh(&q).unwrap();
+        assert_eq!(canonical(&back), canonical(&mesh));
+    }
+
+    #[test]
+    fn bad_files_are_clear_errors() {
+        let err =
+            |name: &str, text: &str| read_msh(&write_text(name, text)).unwrap_err().to_string();
+        // truncated in the middle of $Elements
+        let cut = &SQUARE_22[..SQUARE_22.find("13 2 2").unwrap()];
+        let e = err("trunc.msh", cut);
+        assert!(e.contains("trunc.msh") && e.contains("end of file"), "{e}");
+        // truncated binary
+        let (mesh, _) = read_msh(&write_text("ok.msh", SQUARE_22)).unwrap();
+        let p = temp("truncb.msh");
+        write_msh(&p, &mesh, MshVersion::V41Binary).unwrap();
+        let b = std::fs::read(&p).unwrap();
+        std::fs::write(&p, &b[..b.len() - 40]).unwrap();
+        let e = read_msh(&p).unwrap_err().to_string();
+        assert!(e.contains("$Elements") && e.contains("end of file"), "{e}");
+        // bad header
+        let e = err("hdr.msh", "$MeshFormt\n2.2 0 8\n$EndMeshFormat\n");
+        assert!(e.contains("line 1") && e.contains("$MeshFormat"), "{e}");
+        let e = err("ver.msh", "$MeshFormat\n3.0 0 8\n$EndMeshFormat\n");
+        assert!(e.contains("version 3.0"), "{e}");
+        let e = err("num.msh", &SQUARE_22.replace("20 1 0 0", "20 1 zero 0"));
+        assert!(e.contains("line 13") && e.contains("zero"), "{e}");
+        // missing node
+        let e = err(
+            "miss.msh",
+            &SQUARE_22.replace("12 2 2 6 1 20 30 99", "12 2 2 6 1 20 31 99"),
+        );
+        assert!(e.contains("triangle 12") && e.contains("node 31"), "{e}");
+        // non-planar
+        let e = err("z.msh", &SQUARE_22.replace("30 1 1 0", "30 1 1 0.25"));
+        assert!(e.contains("node 30") && e.contains("plane"), "{e}");
+        // no triangles
+        let lines_only = "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n2\n1 0 0 0\n2 1 0 0\n\
+                          $EndNodes\n$Elements\n1\n1 1 2 0 1 1 2\n$EndElements\n";
+        let e = err("lines.msh", lines_only);
+        assert!(e.contains("no 3-node triangle"), "{e}");
+        // duplicate node tags
+        let e = err(
+            "dup.msh",
+            &SQUARE_22.replace("99 0.5 0.5 0", "40 0.5 0.5 0"),
+        );
+        assert!(e.contains("node tag 40 appears twice"), "{e}");
+        // no such file
+        let e = read_msh(Path::new("/nonexistent/x.msh"))
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("cannot read"), "{e}");
+        // an inverted triangle: reported by the mesh checks, with the file name
+        let e = err("inv.msh", &SQUARE_22.replace("20 30 99", "30 20 99"));
+        assert!(e.contains("inv.msh") && e.contains("inverted"), "{e}");
+    }
+}

@@ -1,0 +1,78 @@
+//! `memcontact example`: ready-to-run case files, embedded in the binary.
+
+use anyhow::{bail, Context, Result};
+use std::path::Path;
+
+/// An example: name, one-line description, and its files (name, contents).
+struct Example {
+    name: &'static str,
+    about: &'static str,
+    files: &'static [(&'static str, &'static str)],
+}
+
+const EXAMPLES: &[Example] = &[
+    Example {
+        name: "disk",
+        about: "the axisymmetric disc of SPEC §4 on a flat elastic foundation (exact solution known)",
+        files: &[("disk.toml", include_str!("../../../examples/disk.toml"))],
+    },
+    Example {
+        name: "roof",
+        about: "a roof membrane with a skylight opening over an irregular foam cushion (polygon with a hole, two soils)",
+        files: &[("roof.toml", include_str!("../../../examples/roof.toml"))],
+    },
+    Example {
+        name: "bench-square",
+        about: "the standard benchmark of issue 4 on the unit square (N × N structured mesh)",
+        files: &[(
+            "bench-square.toml",
+            include_str!("../../../examples/bench-square.toml"),
+        )],
+    },
+    Example {
+        name: "rigid-square",
+        about: "the classical rigid obstacle problem u ≤ φ on the unit square",
+        files: &[(
+            "rigid-square.toml",
+            include_str!("../../../examples/rigid-square.toml"),
+        )],
+    },
+    Example {
+        name: "gmsh-disk",
+        about: "a Gmsh mesh with two physical surfaces (foam, soil) of different stiffness",
+        files: &[
+            ("gmsh-disk.toml", include_str!("../../../examples/gmsh-disk.toml")),
+            ("disk.msh", include_str!("../../../examples/disk.msh")),
+        ],
+    },
+];
+
+/// Lists the examples, or writes example `name` into `dir`.
+pub fn run(name: Option<&str>, dir: &Path, force: bool) -> Result<()> {
+    let Some(name) = name else {
+        println!("examples (write one with `memcontact example NAME [--dir DIR]`):");
+        for e in EXAMPLES {
+            println!("  {:<14} {}", e.name, e.about);
+        }
+        return Ok(());
+    };
+    let Some(example) = EXAMPLES.iter().find(|e| e.name == name) else {
+        let names: Vec<&str> = EXAMPLES.iter().map(|e| e.name).collect();
+        bail!("no example named \"{name}\" (examples: {})", names.join(", "));
+    };
+    std::fs::create_dir_all(dir)
+        .with_context(|| format!("cannot create directory {}", dir.display()))?;
+    for (file, text) in example.files {
+        let path = dir.join(file);
+        if path.exists() && !force {
+            bail!("{} exists (use --force to overwrite)", path.display());
+        }
+        memcontact::io::write_atomic(&path, |w| w.write_all(text.as_bytes()))?;
+        println!("wrote {}", path.display());
+    }
+    println!(
+        "run it with: memcontact solve {} -o out",
+        dir.join(example.files[0].0).display()
+    );
+    Ok(())
+}

@@ -1,0 +1,230 @@
+//! End-to-end tests: the `memcontact` binary on real case files, checking the files it
+//! writes and the errors it reports.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn bin() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_memcontact"))
+}
+
+fn examples() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples")
+}
+
+fn run(args: &[&str]) -> Output {
+    bin().args(args).output().expect("the binary runs")
+}
+
+fn text(o: &Output) -> String {
+    format!(
+        "{}{}",
+        String::from_utf8_lossy(&o.stdout),
+        String::from_utf8_lossy(&o.stderr)
+    )
+}
+
+fn tmp(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("memcontact-e2e-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+fn summary(dir: &Path) -> serde_json::Value {
+    serde_json::from_str(&std::fs::read_to_string(dir.join("summary.json")).unwrap()).unwrap()
+}
+
+#[test]
+fn solves_the_disk_example_and_writes_consistent_files() {
+    let out = tmp("disk");
+    let case = examples().join("disk.toml");
+    let o = run(&["solve", case.to_str().unwrap(), "-o", out.to_str().unwrap(), "-q"]);
+    assert!(o.status.success(), "{}", text(&o));
+    assert!(text(&o).contains("certificate"));
+    let s = summary(&out);
+    for key in [
+        "vertices",
+        "triangles",
+        "unknowns",
+        "solver",
+        "foundation",
+        "iterations",
+        "energy",
+        "kkt_residual",
+        "contact_area",
+        "total_load",
+        "total_contact_force",
+        "max_deflection",
+        "time_total_s",
+    ] {
+        assert!(s.get(key).is_some(), "summary.json lacks {key}");
+    }
+    assert!(s["kkt_residual"].as_f64().unwrap() <= 1e-9);
+    assert_eq!(s["foundation"], "consistent");
+    // Load = f × area of Ω_n (the disc's inscribed polygon, within 2% of π).
+    let load = s["total_load"].as_f64().unwrap();
+    assert!((load / 8.0 - std::f64::consts::PI).abs() < 0.02 * std::f64::consts::PI);
+    // The obstacle carries part of the load: 0 < Σ X₁ < ∫ f.
+    let force = s["total_contact_force"].as_f64().unwrap();
+    assert!(force > 0.0 && force < load);
+
+    let csv = std::fs::read_to_string(out.join("nodes.csv")).unwrap();
+    let mut lines = csv.lines();
+    let header = lines.next().unwrap();
+    assert!(header.starts_with("x,y,u,phi,penetration,pressure,contact_force,state"));
+    let rows: Vec<Vec<f64>> = lines
+        .map(|l| l.split(',').map(|v| v.parse::<f64>().unwrap()).collect())
+        .collect();
+    assert_eq!(rows.len() as u64, s["vertices"].as_u64().unwrap());
+    // Boundary vertices (on the unit circle) have u = 0; penetration = (u - φ)⁺;
+    // pressure = h × penetration; states match the sign of u - φ.
+    for r in &rows {
+        let (x, y, u, phi, pen, p, _x1, st) = (r[0], r[1], r[2], r[3], r[4], r[5], r[6], r[7]);
+        if (x * x + y * y).sqrt() > 1.0 - 1e-9 {
+            assert_eq!(u, 0.0);
+        }
+        assert!((pen - (u - phi).max(0.0)).abs() <= 1e-15);
+        assert!((p - 100.0 * pen).abs() <= 1e-12);
+        if st == 1.0 {
+            assert!(u > phi);
+        }
+    }
+    assert!(rows.iter().any(|r| r[7] == 1.0) && rows.iter().any(|r| r[7] == -1.0));
+    let vtu = std::fs::read_to_string(out.join("solution.vtu"))
+        .or_else(|_| std::fs::read(out.join("solution.vtu")).map(|b| String::from_utf8_lossy(&b).into_owned()))
+        .unwrap();
+    for name in ["\"u\"", "\"phi\"", "\"penetration\"", "\"pressure\"", "\"contact_force\"", "\"state\"", "\"region\""] {
+        assert!(vtu.contains(name), "solution.vtu lacks {name}");
+    }
+}
+
+#[test]
+fn set_overrides_keys_and_lumped_differs_from_consistent() {
+    let case = examples().join("bench-square.toml");
+    let mut energies = Vec::new();
+    for f in ["consistent", "lumped"] {
+        let out = tmp(&format!("bench-{f}"));
+        let o = run(&[
+            "solve",
+            case.to_str().unwrap(),
+            "-o",
+            out.to_str().unwrap(),
+            "-q",
+            "--set",
+            "mesh.nx=16",
+            "--set",
+            "mesh.ny=16",
+            "--set",
+            &format!("obstacle.foundation={f}"),
+        ]);
+        assert!(o.status.success(), "{}", text(&o));
+        let s = summary(&out);
+        assert_eq!(s["vertices"].as_u64().unwrap(), 17 * 17);
+        assert_eq!(s["foundation"], f);
+        energies.push(s["energy"].as_f64().unwrap());
+    }
+    assert!((energies[0] - energies[1]).abs() > 1e-6 * energies[0].abs());
+}
+
+#[test]
+fn check_reports_the_mesh() {
+    let case = examples().join("roof.toml");
+    let o = run(&["check", case.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", text(&o));
+    let t = text(&o);
+    assert!(t.contains("valid") && t.contains("vertices") && t.contains("l_n"));
+    assert!(t.contains("block"), "{t}");
+}
+
+#[test]
+fn example_lists_and_writes() {
+    let o = run(&["example"]);
+    assert!(o.status.success());
+    for n in ["disk", "roof", "bench-square", "rigid-square", "gmsh-disk"] {
+        assert!(text(&o).contains(n));
+    }
+    let d = tmp("example");
+    let o = run(&["example", "gmsh-disk", "--dir", d.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", text(&o));
+    assert!(d.join("gmsh-disk.toml").exists() && d.join("disk.msh").exists());
+    // The written example runs where it was written (paths are relative to the case).
+    let out = d.join("out");
+    let o = run(&["solve", d.join("gmsh-disk.toml").to_str().unwrap(), "-o", out.to_str().unwrap(), "-q"]);
+    assert!(o.status.success(), "{}", text(&o));
+    assert!(out.join("summary.json").exists());
+    let o = run(&["example", "nope"]);
+    assert!(!o.status.success());
+}
+
+/// Writes a case with `body` and returns its path.
+fn case_file(dir: &Path, body: &str) -> PathBuf {
+    let p = dir.join("case.toml");
+    std::fs::write(&p, body).unwrap();
+    p
+}
+
+const GOOD: &str = r#"
+[mesh]
+generator = "rectangle"
+nx = 8
+[membrane]
+tension = 1.0
+load = "8"
+[obstacle]
+shape = "0.1"
+stiffness = 100.0
+"#;
+
+/// Runs `solve` on a case and asserts it fails with `needle` in the message and writes
+/// nothing.
+fn fails_with(name: &str, body: &str, needle: &str) {
+    let d = tmp(name);
+    let p = case_file(&d, body);
+    let out = d.join("out");
+    let o = run(&["solve", p.to_str().unwrap(), "-o", out.to_str().unwrap(), "-q"]);
+    assert!(!o.status.success(), "{name}: expected a failure");
+    let t = text(&o);
+    assert!(t.contains(needle), "{name}: message lacks \"{needle}\": {t}");
+    assert!(!t.contains("panicked"), "{name}: {t}");
+    assert!(!out.join("summary.json").exists() && !out.join("nodes.csv").exists());
+}
+
+#[test]
+fn good_case_solves() {
+    let d = tmp("good");
+    let p = case_file(&d, GOOD);
+    let o = run(&["solve", p.to_str().unwrap(), "-o", d.join("out").to_str().unwrap(), "-q"]);
+    assert!(o.status.success(), "{}", text(&o));
+}
+
+#[test]
+fn bad_inputs_are_clear_errors() {
+    fails_with("toml", "[mesh\ngenerator = 1", "malformed TOML");
+    fails_with("unknown-key", &GOOD.replace("nx = 8", "nx = 8\nnz = 3"), "nz");
+    fails_with("tension", &GOOD.replace("tension = 1.0", "tension = -2.0"), "tension");
+    fails_with("zero-tension", &GOOD.replace("tension = 1.0", "tension = 0"), "tension");
+    fails_with("negative-h", &GOOD.replace("stiffness = 100.0", "stiffness = -5.0"), "negative");
+    fails_with("nan", &GOOD.replace("load = \"8\"", "load = \"sqrt(x - 2)\""), "NaN");
+    fails_with("inf", &GOOD.replace("load = \"8\"", "load = \"1/(x-x)\""), "load");
+    fails_with("parse", &GOOD.replace("load = \"8\"", "load = \"8 * (x\""), "load");
+    fails_with("variable", &GOOD.replace("load = \"8\"", "load = \"8 * z\""), "z");
+    fails_with("method", &format!("{GOOD}[solver]\nmethod = \"magic\""), "magic");
+    fails_with(
+        "mesh-file",
+        &GOOD.replace("generator = \"rectangle\"\nnx = 8", "file = \"missing.msh\""),
+        "missing.msh",
+    );
+    let d = tmp("broken-msh");
+    std::fs::write(d.join("broken.msh"), "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n3\n1 0 0 0\n").unwrap();
+    let body = GOOD.replace("generator = \"rectangle\"\nnx = 8", "file = \"broken.msh\"");
+    let p = case_file(&d, &body);
+    let o = run(&["solve", p.to_str().unwrap(), "-o", d.join("out").to_str().unwrap()]);
+    assert!(!o.status.success());
+    assert!(text(&o).contains("broken.msh"), "{}", text(&o));
+    fails_with(
+        "non-convergence",
+        &format!("{GOOD}[solver]\nmethod = \"coordinate\"\nmax_iterations = 2"),
+        "coordinate",
+    );
+}
