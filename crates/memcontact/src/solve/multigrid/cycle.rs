@@ -16,8 +16,8 @@
 //!   replaced by the identity.
 
 use super::transfer::{galerkin_patterns, par_rows, Transfer};
-use crate::mesh::refine::Hierarchy;
-use crate::mesh::DofMap;
+use crate::mesh::refine::{Hierarchy, Refinement};
+use crate::mesh::{DofMap, Mesh};
 use crate::sparse::{Cholesky, Csr, Pattern};
 use crate::{Error, Result};
 use std::sync::Arc;
@@ -57,16 +57,19 @@ impl Levels {
                 finest.dof.len()
             )));
         }
-        let mut dofs: Vec<DofMap> = hierarchy.levels[..nl - 1].iter().map(DofMap::new).collect();
-        let check = DofMap::new(last);
-        if check.vertex != finest.vertex {
-            return Err(Error::Mesh(
-                "the finest level of the hierarchy does not have the model's unknowns: the \
-                 hierarchy must end with the mesh the model was assembled on"
-                    .into(),
-            ));
+        check_pattern(last, finest, &pattern)?;
+        // The unknowns of the coarser levels, from the finer ones: a coarse vertex is
+        // interior exactly when the fine vertex sitting on it is (nested meshes).
+        let mut dofs = vec![finest.clone()];
+        for k in (0..nl - 1).rev() {
+            let coarse = coarse_dofs(
+                &hierarchy.refinements[k],
+                hierarchy.levels[k].n_vertices(),
+                dofs.last().expect("the finer level"),
+            )?;
+            dofs.push(coarse);
         }
-        dofs.push(check);
+        dofs.reverse();
         // Levels without unknowns cannot carry a correction: start above them.
         let first = dofs.iter().position(|d| !d.is_empty()).unwrap_or(nl - 1);
         let mut transfers = Vec::with_capacity(nl - 1 - first);
@@ -96,6 +99,79 @@ impl Levels {
     /// Number of unknowns of level `k`.
     pub fn n(&self, k: usize) -> usize {
         self.dofs[k].len()
+    }
+}
+
+/// The unknowns of a coarse level of `n_vertices` vertices, given those of the level
+/// refined from it: coarse vertex `c` is interior iff the fine vertex on it (parents
+/// `[c, c]`) is. A coarse vertex without such a fine vertex is an error.
+fn coarse_dofs(refinement: &Refinement, n_vertices: usize, fine: &DofMap) -> Result<DofMap> {
+    if refinement.parents.len() != fine.dof.len() {
+        return Err(Error::Mesh(format!(
+            "the refinement relation names parents for {} vertices, but the finer level has \
+             {} vertices",
+            refinement.parents.len(),
+            fine.dof.len()
+        )));
+    }
+    let mut interior: Vec<Option<bool>> = vec![None; n_vertices];
+    for (v, &[a, b]) in refinement.parents.iter().enumerate() {
+        if a as usize >= n_vertices || b as usize >= n_vertices {
+            return Err(Error::Mesh(format!(
+                "vertex {v} of the finer level has parent vertices ({a}, {b}), but the \
+                 coarser level has only {n_vertices} vertices"
+            )));
+        }
+        if a == b {
+            interior[a as usize] = Some(fine.dof[v].is_some());
+        }
+    }
+    let mut vertex = Vec::new();
+    let mut dof = vec![None; n_vertices];
+    for (c, i) in interior.iter().enumerate() {
+        match i {
+            None => {
+                return Err(Error::Mesh(format!(
+                    "the refinement relation keeps no vertex on vertex {c} of the coarser level"
+                )))
+            }
+            Some(true) => {
+                dof[c] = Some(vertex.len() as u32);
+                vertex.push(c as u32);
+            }
+            Some(false) => {}
+        }
+    }
+    Ok(DofMap { vertex, dof })
+}
+
+/// Checks that the operator pattern couples the unknowns of the triangles of `mesh` (every
+/// triangle of small meshes, every 8th of large ones): a cheap test that the model was
+/// assembled on this mesh.
+fn check_pattern(mesh: &Mesh, dofs: &DofMap, pattern: &Pattern) -> Result<()> {
+    use rayon::prelude::*;
+    let step = if mesh.n_triangles() > 100_000 { 8 } else { 1 };
+    let bad = mesh
+        .triangles
+        .par_iter()
+        .enumerate()
+        .with_min_len(4096)
+        .filter(|(k, _)| k % step == 0)
+        .find_any(|(_, t)| {
+            t.iter().any(|&a| {
+                t.iter().any(|&b| match (dofs.dof[a as usize], dofs.dof[b as usize]) {
+                    (Some(i), Some(j)) => pattern.find(i as usize, j as usize).is_none(),
+                    _ => false,
+                })
+            })
+        });
+    match bad {
+        Some((k, _)) => Err(Error::Mesh(format!(
+            "triangle {k} of the finest level of the hierarchy couples unknowns that the \
+             model's matrices do not: the hierarchy must end with the mesh the model was \
+             assembled on"
+        ))),
+        None => Ok(()),
     }
 }
 
@@ -352,6 +428,8 @@ pub struct LinearSolve {
     pub cycles: usize,
     /// `‖b − A x‖∞ / ‖b‖∞` at the end.
     pub relative_residual: f64,
+    /// Wall-clock seconds per phase (setup, coarse operators, cycles).
+    pub phases: Vec<(String, f64)>,
 }
 
 /// Solves the linear system `S x = rhs` (S on the finest level of `hierarchy`, over the
@@ -366,8 +444,12 @@ pub fn poisson_solve(
     tol: f64,
     max_cycles: usize,
 ) -> Result<LinearSolve> {
+    let t0 = std::time::Instant::now();
     let levels = Levels::new(hierarchy, dofs, s.pattern.clone())?;
-    linear_solve(s, rhs, &levels, tol, max_cycles)
+    let setup = t0.elapsed().as_secs_f64();
+    let mut out = linear_solve(s, rhs, &levels, tol, max_cycles)?;
+    out.phases.insert(0, ("setup".into(), setup));
+    Ok(out)
 }
 
 /// [`poisson_solve`] on prebuilt [`Levels`].
@@ -384,8 +466,10 @@ pub fn linear_solve(
             message: "right-hand side, matrix and hierarchy sizes differ".into(),
         });
     }
+    let mut timer = crate::solve::PhaseTimer::default();
     let mut mg = Multigrid::new(levels, levels.len() - 1);
-    mg.update(a, None)?;
+    timer.time("coarse operators", || mg.update(a, None))?;
+    let t0 = std::time::Instant::now();
     let norm_b = crate::sparse::norm_inf(rhs);
     let mut x = vec![0.0; a.n()];
     let mut r = vec![0.0; a.n()];
@@ -408,9 +492,11 @@ pub fn linear_solve(
             ),
         });
     }
+    timer.add("v-cycles", t0.elapsed().as_secs_f64());
     Ok(LinearSolve {
         x,
         cycles,
         relative_residual: rel,
+        phases: timer.into_phases(),
     })
 }

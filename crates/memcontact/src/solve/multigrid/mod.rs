@@ -35,15 +35,15 @@ mod tests;
 pub use cycle::{linear_solve, poisson_solve, Levels, LinearSolve, Multigrid};
 pub use transfer::Transfer;
 
-use super::active_set::{
-    feasible_start, fill_truncated_hessian, line_step, piece_gradient, NewtonStates,
-};
+#[cfg(doc)]
+use super::active_set::{fill_truncated_hessian, piece_gradient};
+use super::active_set::{feasible_start, line_step, NewtonStates};
 use super::local::sweep_forward;
 use super::{IterationRecord, Method, Observer, PhaseTimer, Settings, Solution};
 use crate::mesh::refine::Hierarchy;
-use crate::model::{FoundationMatrix, Model};
+use crate::model::{Certificate, FoundationMatrix, Model};
 use crate::sparse::{Csr, Pattern};
-use crate::{Error, Result};
+use crate::Result;
 use rayon::prelude::*;
 use std::time::Instant;
 
@@ -145,6 +145,7 @@ pub fn solve_with(
             models.reverse();
         });
     }
+    let mut final_certificate = None;
     let mut v = feasible_start(if first < top { &models[0] } else { model });
     for k in first..=top {
         let m = models.get(k).unwrap_or(model);
@@ -188,6 +189,7 @@ pub fn solve_with(
             confirm: k == top,
         })?;
         let seconds = t0.elapsed().as_secs_f64();
+        final_certificate = out.2;
         if k < top {
             timer.add("nested iteration", seconds);
         }
@@ -199,7 +201,10 @@ pub fn solve_with(
         });
     }
     drop(models);
-    let certificate = timer.time("certificate", || model.certificate(&v));
+    let certificate = match final_certificate {
+        Some(c) => c,
+        None => timer.time("certificate", || model.certificate(&v)),
+    };
     let iterations = report.levels.last().map_or(0, |l| l.iterations);
     Ok((
         Solution {
@@ -276,8 +281,9 @@ struct LevelSolve<'a, 'b> {
     confirm: bool,
 }
 
-/// TNNMG on one level; returns (iterations, scaled KKT residual reached).
-fn level_solve(ls: LevelSolve) -> Result<(usize, f64)> {
+/// TNNMG on one level; returns the iterations, the scaled KKT residual reached and, when
+/// convergence was confirmed, the model's certificate at the final iterate.
+fn level_solve(ls: LevelSolve) -> Result<(usize, f64, Option<Certificate>)> {
     let LevelSolve {
         model,
         levels,
@@ -293,18 +299,21 @@ fn level_solve(ls: LevelSolve) -> Result<(usize, f64)> {
     } = ls;
     let n = model.n();
     let pattern = model.s.pattern.clone();
-    let diag = diagonal_positions(&pattern)?;
     let scale = model.force_scale();
     let mut a = Csr::zeros(pattern.clone());
     let mut mg = Multigrid::new(levels, top);
     mg.smoothing = options.smoothing;
     let mut delta = vec![0.0; n];
+    let mut g = vec![0.0; n];
+    let mut r = vec![0.0; n];
+    let mut before = vec![0.0; n];
     let mut prev: Option<NewtonStates> = None;
     let mut changed = vec![false; n];
     let mut dirty = vec![false; n];
     let mut iterations = 0;
     let mut stalled = 0;
     let mut kkt;
+    let mut certificate = None;
     loop {
         let (k, energy) = timer.time("certificate", || fast_kkt(model, v, scale));
         kkt = k;
@@ -324,9 +333,10 @@ fn level_solve(ls: LevelSolve) -> Result<(usize, f64)> {
                 break;
             }
             // The authoritative certificate (the same formula, assembled by the model).
-            let c = timer.time("certificate", || model.certificate(v)).kkt();
-            if c <= tolerance {
-                kkt = c;
+            let c = timer.time("certificate", || model.certificate(v));
+            if c.kkt() <= tolerance {
+                kkt = c.kkt();
+                certificate = Some(c);
                 break;
             }
         }
@@ -334,38 +344,29 @@ fn level_solve(ls: LevelSolve) -> Result<(usize, f64)> {
             break;
         }
         iterations += 1;
-        let before = timer.time("smoothing", || {
-            let before = v.clone();
+        timer.time("smoothing", || {
+            before.copy_from_slice(v);
             for _ in 0..options.presmoothing {
                 sweep_forward(model, v);
             }
-            before
         });
         // The truncated Newton system at the smoothed iterate.
         let st = NewtonStates::of(model, v);
-        let (mut rhs, r) = timer.time("newton system", || {
-            fill_truncated_hessian(model, &st, &mut a);
-            for (i, &p) in diag.iter().enumerate() {
-                if st.truncated[i] {
-                    a.val[p] = 0.0;
-                }
-            }
-            piece_gradient(model, v, &st)
+        let rows = prev
+            .as_ref()
+            .map(|p| mark_dirty(&pattern, p, &st, &mut changed, &mut dirty));
+        let rows = rows.map(|_| dirty.as_slice());
+        timer.time("newton system", || {
+            newton_system(model, v, &st, &mut a, rows, &mut g, &mut r)
         });
-        let dirty_rows = timer.time("coarse operators", || {
-            let d = prev
-                .as_ref()
-                .map(|p| mark_dirty(&pattern, p, &st, &mut changed, &mut dirty));
-            mg.update(&a, d.map(|_| dirty.as_slice()))
-        });
-        dirty_rows?;
+        timer.time("coarse operators", || mg.update(&a, rows))?;
         timer.time("v-cycle", || {
-            for g in rhs.iter_mut() {
-                *g = -*g;
+            for x in g.iter_mut() {
+                *x = -*x;
             }
             delta.iter_mut().for_each(|d| *d = 0.0);
             for _ in 0..options.cycles {
-                mg.v_cycle(&a, &mut delta, &rhs);
+                mg.v_cycle(&a, &mut delta, &g);
             }
             for (i, d) in delta.iter_mut().enumerate() {
                 if st.truncated[i] || !d.is_finite() {
@@ -384,7 +385,100 @@ fn level_solve(ls: LevelSolve) -> Result<(usize, f64)> {
             stalled = 0;
         }
     }
-    Ok((iterations, kkt))
+    Ok((iterations, kkt, certificate))
+}
+
+/// The truncated Newton system of TNNMG at V for the states `st`: the Hessian of the
+/// smooth piece, `S + E_P L E_P`, with the rows and columns of the truncated vertices
+/// *zero* (they are decoupled, and the multigrid leaves zero rows alone), and the gradient
+/// of the piece `g = SV − D + E_P L p`, zero on truncated vertices; also `r = SV − D`.
+///
+/// This is the system of [`fill_truncated_hessian`] and [`piece_gradient`] (a test checks
+/// that they agree), in one pass without allocation, refilling only the matrix rows
+/// flagged in `rows` (those whose states or whose neighbours' states changed).
+fn newton_system(
+    model: &Model,
+    v: &[f64],
+    st: &NewtonStates,
+    a: &mut Csr,
+    rows: Option<&[bool]>,
+    g: &mut [f64],
+    r: &mut [f64],
+) {
+    const CHUNK: usize = 1024;
+    let pat = model.s.pattern.clone();
+    let sval = &model.s.val;
+    let pen = |j: usize| {
+        if model.can_touch[j] {
+            (v[j] - model.phi[j]).max(0.0)
+        } else {
+            0.0
+        }
+    };
+    let row = |i: usize, arow: &mut [f64], gi: &mut f64, ri: &mut f64| {
+        let (s, e) = (pat.row_ptr[i], pat.row_ptr[i + 1]);
+        let cols = &pat.col[s..e];
+        let mut sv = 0.0;
+        for (&j, &sij) in cols.iter().zip(&sval[s..e]) {
+            sv += sij * v[j as usize];
+        }
+        *ri = sv - model.d[i];
+        *gi = if st.truncated[i] {
+            0.0
+        } else if st.penetrating[i] {
+            *ri + match &model.l {
+                FoundationMatrix::Consistent(l) => {
+                    let mut lp = 0.0;
+                    for (&j, &lij) in cols.iter().zip(&l.val[s..e]) {
+                        lp += lij * pen(j as usize);
+                    }
+                    lp
+                }
+                FoundationMatrix::Lumped(d) => d[i] * pen(i),
+                FoundationMatrix::Rigid => 0.0,
+            }
+        } else {
+            *ri
+        };
+        if !rows.is_none_or(|d| d[i]) {
+            return;
+        }
+        for (k, &j) in cols.iter().enumerate() {
+            let j = j as usize;
+            arow[k] = if st.truncated[i] || st.truncated[j] {
+                0.0
+            } else if st.penetrating[i] && st.penetrating[j] {
+                match &model.l {
+                    FoundationMatrix::Consistent(l) => sval[s + k] + l.val[s + k],
+                    FoundationMatrix::Lumped(d) if i == j => sval[s + k] + d[i],
+                    _ => sval[s + k],
+                }
+            } else {
+                sval[s + k]
+            };
+        }
+    };
+    let blocks = transfer::row_chunks(&pat, &mut a.val, CHUNK);
+    let work = |((start, vals), (gc, rc)): ((usize, &mut [f64]), (&mut [f64], &mut [f64]))| {
+        let mut off = 0;
+        for (k, (gi, ri)) in gc.iter_mut().zip(rc.iter_mut()).enumerate() {
+            let i = start + k;
+            let len = pat.row_ptr[i + 1] - pat.row_ptr[i];
+            row(i, &mut vals[off..off + len], gi, ri);
+            off += len;
+        }
+    };
+    if v.len() >= transfer::PAR_ROWS {
+        blocks
+            .into_par_iter()
+            .zip(g.par_chunks_mut(CHUNK).zip(r.par_chunks_mut(CHUNK)))
+            .for_each(work);
+    } else {
+        blocks
+            .into_iter()
+            .zip(g.chunks_mut(CHUNK).zip(r.chunks_mut(CHUNK)))
+            .for_each(work);
+    }
 }
 
 /// Flags the rows of the truncated Hessian that differ between two state sets: a row
@@ -406,18 +500,6 @@ fn mark_dirty(
             .any(|&j| changed[j as usize]);
     });
     dirty.iter().filter(|&&d| d).count()
-}
-
-/// The position of every diagonal entry of `pattern`; a missing one is an error.
-fn diagonal_positions(pattern: &Pattern) -> Result<Vec<usize>> {
-    (0..pattern.n())
-        .map(|i| {
-            pattern.find(i, i).ok_or_else(|| Error::Solver {
-                solver: "multigrid".into(),
-                message: format!("the matrix pattern does not store the diagonal entry {i}"),
-            })
-        })
-        .collect()
 }
 
 /// Rows per block of the deterministic reductions.

@@ -407,3 +407,43 @@ fn print_options() {
         }
     }
 }
+
+#[test]
+fn fused_newton_system_is_the_active_set_system() {
+    use crate::solve::active_set::{fill_truncated_hessian, piece_gradient};
+    let hier = square_hierarchy(4, 3);
+    for (h, f) in [
+        (Some(1000.0), Foundation::Consistent),
+        (Some(1000.0), Foundation::Lumped),
+        (None, Foundation::Lumped),
+    ] {
+        let model = bench_model(hier.finest(), h, f);
+        // An iterate with clear, touching and penetrating vertices.
+        let mut v: Vec<f64> = (0..model.n())
+            .map(|i| model.phi[i] + 0.05 * ((i as f64) * 0.7).sin())
+            .collect();
+        for i in (0..model.n()).step_by(5) {
+            v[i] = model.phi[i];
+        }
+        if h.is_none() {
+            for (x, p) in v.iter_mut().zip(&model.phi) {
+                *x = x.min(*p);
+            }
+        }
+        let st = NewtonStates::of(&model, &v);
+        let mut reference = Csr::zeros(model.s.pattern.clone());
+        fill_truncated_hessian(&model, &st, &mut reference);
+        let (g_ref, r_ref) = piece_gradient(&model, &v, &st);
+        let mut a = Csr::zeros(model.s.pattern.clone());
+        let (mut g, mut r) = (vec![0.0; model.n()], vec![0.0; model.n()]);
+        newton_system(&model, &v, &st, &mut a, None, &mut g, &mut r);
+        for i in 0..model.n() {
+            assert!((g[i] - g_ref[i]).abs() < 1e-14 && (r[i] - r_ref[i]).abs() < 1e-14);
+            for j in 0..model.n() {
+                // The same matrix, except that truncated rows are zero instead of identity.
+                let expect = if st.truncated[i] { 0.0 } else { reference.get(i, j) };
+                assert_eq!(a.get(i, j), expect, "{f:?} ({i}, {j})");
+            }
+        }
+    }
+}

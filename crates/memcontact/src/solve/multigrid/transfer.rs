@@ -178,27 +178,31 @@ impl Transfer {
     /// The sparsity pattern of `Pᵀ A P` for A on `fine` (the symbolic Galerkin product,
     /// computed once per hierarchy). The diagonal is always stored.
     pub fn galerkin_pattern(&self, fine: &Pattern) -> Pattern {
-        let rows: Vec<Vec<u32>> = (0..self.n_coarse)
-            .into_par_iter()
-            .with_min_len(1024)
-            .map(|i| {
-                let mut r: Vec<u32> = Vec::with_capacity(32);
-                r.push(i as u32);
-                for &v in &self.children[self.child_ptr[i]..self.child_ptr[i + 1]] {
-                    let v = v as usize;
-                    for &w in &fine.col[fine.row_ptr[v]..fine.row_ptr[v + 1]] {
-                        let (p, wt) = (self.parents[w as usize], self.weights[w as usize]);
-                        for s in 0..2 {
-                            if wt[s] != 0.0 {
-                                r.push(p[s]);
-                            }
+        let n_coarse = self.n_coarse;
+        // `seen[j] == i` marks column j as already in row i (no sort of duplicates).
+        let row = |seen: &mut Vec<u32>, i: usize| {
+            let mut r: Vec<u32> = Vec::with_capacity(16);
+            r.push(i as u32);
+            seen[i] = i as u32;
+            for &v in &self.children[self.child_ptr[i]..self.child_ptr[i + 1]] {
+                let v = v as usize;
+                for &w in &fine.col[fine.row_ptr[v]..fine.row_ptr[v + 1]] {
+                    let (p, wt) = (self.parents[w as usize], self.weights[w as usize]);
+                    for s in 0..2 {
+                        if wt[s] != 0.0 && seen[p[s] as usize] != i as u32 {
+                            seen[p[s] as usize] = i as u32;
+                            r.push(p[s]);
                         }
                     }
                 }
-                r.sort_unstable();
-                r.dedup();
-                r
-            })
+            }
+            r.sort_unstable();
+            r
+        };
+        let rows: Vec<Vec<u32>> = (0..n_coarse)
+            .into_par_iter()
+            .with_min_len(1024)
+            .map_init(|| vec![u32::MAX; n_coarse], row)
             .collect();
         let mut row_ptr = Vec::with_capacity(rows.len() + 1);
         row_ptr.push(0);
