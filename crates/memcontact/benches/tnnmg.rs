@@ -1,0 +1,58 @@
+//! `cargo bench -p memcontact --bench tnnmg [-- N1 N2 ...] [-- --lumped|--consistent]`:
+//! the standard benchmark table of issue 4 (see `memcontact::bench`). Sizes default to
+//! 128 … 2048 cells per side.
+
+use memcontact::bench::{run_bench, BenchRow};
+use memcontact::model::Foundation;
+
+fn main() {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let mut sizes: Vec<usize> = args.iter().filter_map(|a| a.parse().ok()).collect();
+    if sizes.is_empty() {
+        sizes = vec![128, 256, 512, 1024, 2048];
+    }
+    let foundations: Vec<Foundation> = if args.iter().any(|a| a == "--lumped") {
+        vec![Foundation::Lumped]
+    } else if args.iter().any(|a| a == "--consistent") {
+        vec![Foundation::Consistent]
+    } else {
+        vec![Foundation::Lumped, Foundation::Consistent]
+    };
+    println!(
+        "{:>5} {:>9} {:>10} {:>5} {:>22} {:>7} {:>7} {:>7} {:>8} {:>9} {:>7} {:>4}",
+        "N", "unknowns", "foundation", "its", "per level", "mesh s", "asm s", "solve s",
+        "peak MB", "KKT", "poisson", "cyc"
+    );
+    let mut print = |r: &BenchRow| {
+        let levels: Vec<String> = r.level_iterations.iter().map(|i| i.to_string()).collect();
+        println!(
+            "{:>5} {:>9} {:>10} {:>5} {:>22} {:>7.3} {:>7.3} {:>7.3} {:>8.0} {:>9.2e} {:>7.3} {:>4}",
+            r.n,
+            r.unknowns,
+            r.foundation.name(),
+            r.iterations,
+            levels.join(","),
+            r.time_mesh,
+            r.time_assembly,
+            r.time_solve,
+            r.peak_memory.map_or(f64::NAN, |b| b as f64 / 1048576.0),
+            r.certificate,
+            r.time_poisson,
+            r.poisson_cycles
+        );
+        if std::env::var_os("MEMCONTACT_PHASES").is_some() {
+            let f = |p: &[(String, f64)]| {
+                p.iter()
+                    .map(|(n, t)| format!("{n} {t:.3}"))
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            };
+            println!("      tnnmg: {}", f(&r.phases));
+            println!("      poisson: {}", f(&r.poisson_phases));
+        }
+    };
+    if let Err(e) = run_bench(&sizes, &foundations, &mut print) {
+        eprintln!("benchmark failed: {e}");
+        std::process::exit(1);
+    }
+}
