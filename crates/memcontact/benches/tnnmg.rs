@@ -20,8 +20,18 @@ fn main() {
     };
     println!(
         "{:>5} {:>9} {:>10} {:>5} {:>22} {:>7} {:>7} {:>7} {:>8} {:>9} {:>7} {:>4}",
-        "N", "unknowns", "foundation", "its", "per level", "mesh s", "asm s", "solve s",
-        "peak MB", "KKT", "poisson", "cyc"
+        "N",
+        "unknowns",
+        "foundation",
+        "its",
+        "per level",
+        "mesh s",
+        "asm s",
+        "solve s",
+        "peak MB",
+        "KKT",
+        "poisson",
+        "cyc"
     );
     let mut print = |r: &BenchRow| {
         let levels: Vec<String> = r.level_iterations.iter().map(|i| i.to_string()).collect();

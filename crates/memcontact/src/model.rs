@@ -4,7 +4,7 @@
 //! certificates of Problems 2e and 2f.
 
 use crate::fem::{
-    assemble_matrices, assemble_matrix, assemble_vector, unknowns_pattern, Coefficient, Element,
+    assemble_stiffness_and_mass, assemble_vector, unknowns_pattern, Coefficient, Element,
     VertexTriangles,
 };
 use crate::mesh::{DofMap, Mesh};
@@ -196,27 +196,20 @@ impl Model {
             }
         };
         let pattern = Arc::new(unknowns_pattern(mesh, &dofs, &adj));
-        let stiffness = |e: &Element, _: u32, a: usize, b: usize| t * e.stiffness(a, b);
-        let (s, l) = match (data.stiffness, data.foundation) {
-            (Stiffness::Elastic(h), Foundation::Consistent) => {
-                let mass = |e: &Element, r: u32, a: usize, b: usize| e.weighted_mass(h, r, a, b);
-                let mut m = assemble_matrices(mesh, &dofs, &adj, &pattern, &[&stiffness, &mass]);
-                let l = m.pop().expect("two matrices");
-                (
-                    m.pop().expect("two matrices"),
-                    FoundationMatrix::Consistent(l),
-                )
-            }
-            (Stiffness::Elastic(h), Foundation::Lumped) => (
-                assemble_matrix(mesh, &dofs, &adj, &pattern, &stiffness),
+        let consistent_h = match (data.stiffness, data.foundation) {
+            (Stiffness::Elastic(h), Foundation::Consistent) => Some(h),
+            _ => None,
+        };
+        let (s, l_consistent) =
+            assemble_stiffness_and_mass(mesh, &dofs, &adj, &pattern, t, consistent_h);
+        let l = match (data.stiffness, l_consistent) {
+            (Stiffness::Rigid, _) => FoundationMatrix::Rigid,
+            (_, Some(l)) => FoundationMatrix::Consistent(l),
+            (Stiffness::Elastic(h), None) => {
                 FoundationMatrix::Lumped(assemble_vector(mesh, &dofs, &adj, &|e, r, a| {
                     e.weighted_load(h, r, a)
-                })),
-            ),
-            (Stiffness::Rigid, _) => (
-                assemble_matrix(mesh, &dofs, &adj, &pattern, &stiffness),
-                FoundationMatrix::Rigid,
-            ),
+                }))
+            }
         };
         let load = data.load;
         let d = assemble_vector(mesh, &dofs, &adj, &|e, r, a| e.weighted_load(load, r, a));

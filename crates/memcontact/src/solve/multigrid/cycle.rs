@@ -159,10 +159,11 @@ fn check_pattern(mesh: &Mesh, dofs: &DofMap, pattern: &Pattern) -> Result<()> {
         .filter(|(k, _)| k % step == 0)
         .find_any(|(_, t)| {
             t.iter().any(|&a| {
-                t.iter().any(|&b| match (dofs.dof[a as usize], dofs.dof[b as usize]) {
-                    (Some(i), Some(j)) => pattern.find(i as usize, j as usize).is_none(),
-                    _ => false,
-                })
+                t.iter()
+                    .any(|&b| match (dofs.dof[a as usize], dofs.dof[b as usize]) {
+                        (Some(i), Some(j)) => pattern.find(i as usize, j as usize).is_none(),
+                        _ => false,
+                    })
             })
         });
     match bad {

@@ -35,9 +35,9 @@ mod tests;
 pub use cycle::{linear_solve, poisson_solve, Levels, LinearSolve, Multigrid};
 pub use transfer::Transfer;
 
+use super::active_set::{feasible_start, line_step, NewtonStates};
 #[cfg(doc)]
 use super::active_set::{fill_truncated_hessian, piece_gradient};
-use super::active_set::{feasible_start, line_step, NewtonStates};
 use super::local::sweep_forward;
 use super::{IterationRecord, Method, Observer, PhaseTimer, Settings, Solution};
 use crate::mesh::refine::Hierarchy;

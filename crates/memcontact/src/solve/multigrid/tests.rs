@@ -441,7 +441,11 @@ fn fused_newton_system_is_the_active_set_system() {
             assert!((g[i] - g_ref[i]).abs() < 1e-14 && (r[i] - r_ref[i]).abs() < 1e-14);
             for j in 0..model.n() {
                 // The same matrix, except that truncated rows are zero instead of identity.
-                let expect = if st.truncated[i] { 0.0 } else { reference.get(i, j) };
+                let expect = if st.truncated[i] {
+                    0.0
+                } else {
+                    reference.get(i, j)
+                };
                 assert_eq!(a.get(i, j), expect, "{f:?} ({i}, {j})");
             }
         }
