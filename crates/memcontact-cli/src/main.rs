@@ -4,6 +4,7 @@
 mod case;
 mod commands;
 mod examples;
+mod help;
 mod output;
 mod plot;
 
@@ -27,6 +28,7 @@ struct Cli {
 #[derive(Subcommand)]
 enum Command {
     /// Solve a case and write solution.vtu, nodes.csv and summary.json.
+    #[command(after_long_help = help::CASE_KEYS)]
     Solve {
         /// The case file (TOML).
         case: PathBuf,
@@ -41,6 +43,7 @@ enum Command {
         quiet: bool,
     },
     /// Validate a case and report its mesh, without solving.
+    #[command(after_long_help = help::CASE_KEYS)]
     Check {
         /// The case file (TOML).
         case: PathBuf,
