@@ -3,6 +3,7 @@
 
 mod case;
 mod commands;
+mod convergence;
 mod examples;
 mod help;
 mod output;
@@ -51,6 +52,10 @@ enum Command {
         #[arg(long = "set", value_name = "KEY=VALUE")]
         sets: Vec<String>,
     },
+    /// Measure the convergence of the discrete solution under uniform refinement: errors
+    /// against the case's [exact] solution, rates, convergence.csv and convergence.png
+    /// (or, with --h-sweep, the distance to the rigid limit).
+    Convergence(convergence::Args),
     /// List the example cases, or write one (and any mesh it needs) to a directory.
     Example {
         /// The example to write; omit to list them.
@@ -74,6 +79,7 @@ fn main() -> ExitCode {
             quiet,
         } => commands::solve(&case, &output, &sets, quiet),
         Command::Check { case, sets } => commands::check(&case, &sets),
+        Command::Convergence(args) => convergence::run(&args),
         Command::Example { name, dir, force } => examples::run(name.as_deref(), &dir, force),
     };
     match result {
