@@ -1,9 +1,12 @@
 //! `cargo bench -p memcontact --bench tnnmg [-- N1 N2 ...] [-- --lumped|--consistent]`:
 //! the standard benchmark table of issue 4 (see `memcontact::bench`). Sizes default to
-//! 128 … 2048 cells per side.
+//! 128 … 2048 cells per side. Environment: `MEMCONTACT_PHASES=1` prints the phases,
+//! `MEMCONTACT_NESTED_TOL`, `MEMCONTACT_CYCLES`, `MEMCONTACT_SMOOTHING`,
+//! `MEMCONTACT_NO_NESTED` override the TNNMG options.
 
 use memcontact::bench::{run_bench, BenchRow};
 use memcontact::model::Foundation;
+use memcontact::solve::multigrid::Options;
 
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
@@ -20,8 +23,18 @@ fn main() {
     };
     println!(
         "{:>5} {:>9} {:>10} {:>5} {:>22} {:>7} {:>7} {:>7} {:>8} {:>9} {:>7} {:>4}",
-        "N", "unknowns", "foundation", "its", "per level", "mesh s", "asm s", "solve s",
-        "peak MB", "KKT", "poisson", "cyc"
+        "N",
+        "unknowns",
+        "foundation",
+        "its",
+        "per level",
+        "mesh s",
+        "asm s",
+        "solve s",
+        "peak MB",
+        "KKT",
+        "poisson",
+        "cyc"
     );
     let mut print = |r: &BenchRow| {
         let levels: Vec<String> = r.level_iterations.iter().map(|i| i.to_string()).collect();
@@ -51,7 +64,29 @@ fn main() {
             println!("      poisson: {}", f(&r.poisson_phases));
         }
     };
-    if let Err(e) = run_bench(&sizes, &foundations, &mut print) {
+    let mut options = Options::default();
+    if let Some(t) = std::env::var("MEMCONTACT_NESTED_TOL")
+        .ok()
+        .and_then(|t| t.parse().ok())
+    {
+        options.nested_tolerance = t;
+    }
+    if let Some(c) = std::env::var("MEMCONTACT_CYCLES")
+        .ok()
+        .and_then(|t| t.parse().ok())
+    {
+        options.cycles = c;
+    }
+    if let Some(c) = std::env::var("MEMCONTACT_SMOOTHING")
+        .ok()
+        .and_then(|t| t.parse().ok())
+    {
+        options.smoothing = (c, c);
+    }
+    if std::env::var_os("MEMCONTACT_NO_NESTED").is_some() {
+        options.nested = false;
+    }
+    if let Err(e) = run_bench(&sizes, &foundations, &options, &mut print) {
         eprintln!("benchmark failed: {e}");
         std::process::exit(1);
     }

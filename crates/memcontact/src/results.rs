@@ -92,7 +92,10 @@ pub fn derive(mesh: &Mesh, model: &Model, solution: &Solution) -> (NodalFields, 
         })
         .collect();
     let count = |s: i8| states.iter().filter(|&&x| x == s).count();
-    let contact_area = (0..nv).filter(|&v| state[v] >= 0).map(|v| nodal_area[v]).sum();
+    let contact_area = (0..nv)
+        .filter(|&v| state[v] >= 0)
+        .map(|v| nodal_area[v])
+        .sum();
     let max_u = u.iter().cloned().fold(f64::NEG_INFINITY, f64::max);
     let min_u = u.iter().cloned().fold(f64::INFINITY, f64::min);
     let totals = Totals {
