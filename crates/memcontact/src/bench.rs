@@ -96,12 +96,14 @@ pub fn model(mesh: &crate::mesh::Mesh, foundation: Foundation) -> Result<Model> 
 }
 
 /// Runs the benchmark for every size in `sizes` (cells per side; powers of two give the
-/// deepest hierarchies) and every foundation, calling `observer` with each row as soon as
+/// deepest hierarchies) and every foundation, with the TNNMG `options` (the defaults are
+/// the standard), calling `observer` with each row as soon as
 /// it is measured, and returns the table. Sizes should be given in increasing order: the
 /// peak memory is reset before each row where the kernel allows it.
 pub fn run_bench(
     sizes: &[usize],
     foundations: &[Foundation],
+    options: &Options,
     observer: &mut dyn FnMut(&BenchRow),
 ) -> Result<Vec<BenchRow>> {
     let mut rows = Vec::new();
@@ -121,13 +123,8 @@ pub fn run_bench(
             let model = model(hierarchy.finest(), foundation)?;
             let time_assembly = t0.elapsed().as_secs_f64();
             let t0 = Instant::now();
-            let (solution, report) = multigrid::solve_with(
-                &model,
-                &hierarchy,
-                &settings,
-                &Options::default(),
-                &mut Silent,
-            )?;
+            let (solution, report) =
+                multigrid::solve_with(&model, &hierarchy, &settings, options, &mut Silent)?;
             let time_solve = t0.elapsed().as_secs_f64();
             let (time_poisson, poisson_cycles, poisson_phases) = match &poisson {
                 Some(p) => p.clone(),
@@ -139,6 +136,7 @@ pub fn run_bench(
                         &hierarchy,
                         &model.dofs,
                         TOLERANCE,
+                        Some(model.force_scale()),
                         200,
                     )?;
                     let p = (t0.elapsed().as_secs_f64(), out.cycles, out.phases);
@@ -195,6 +193,7 @@ mod tests {
         let rows = run_bench(
             &[16, 32],
             &[Foundation::Lumped, Foundation::Consistent],
+            &Options::default(),
             &mut |_| seen += 1,
         )
         .unwrap();

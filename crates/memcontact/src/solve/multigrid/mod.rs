@@ -14,7 +14,8 @@
 //!    solved *approximately* by one linear multigrid V-cycle ([`cycle`]) on the truncated
 //!    hierarchy: Galerkin coarse operators `PᵀAP` of the truncated matrix, recomputed every
 //!    iteration in the rows whose states changed;
-//! 3. an **exact line search** on J along δ ([`super::line_search`]), which keeps J
+//! 3. an **exact line search** on J along δ ([`line`], the search of
+//!    [`super::line_search`] with one pass per Newton step), which keeps J
 //!    monotone and snaps vertices onto φ where the minimiser is a kink (for the rigid
 //!    obstacle, δ is first projected so that `V + δ ≤ φ`);
 //! 4. the certificates of 2e and 2f; stop at `settings.tolerance`.
@@ -27,6 +28,7 @@
 //! coarse vertices), and each solution prolongated as the start of the next level.
 
 pub mod cycle;
+pub mod line;
 pub mod transfer;
 
 #[cfg(test)]
@@ -35,9 +37,10 @@ mod tests;
 pub use cycle::{linear_solve, poisson_solve, Levels, LinearSolve, Multigrid};
 pub use transfer::Transfer;
 
-use super::active_set::{feasible_start, line_step, NewtonStates};
+use super::active_set::{feasible_start, NewtonStates};
 #[cfg(doc)]
 use super::active_set::{fill_truncated_hessian, piece_gradient};
+use super::line_search::apply_step;
 use super::local::sweep_forward;
 use super::{IterationRecord, Method, Observer, PhaseTimer, Settings, Solution};
 use crate::mesh::refine::Hierarchy;
@@ -377,7 +380,12 @@ fn level_solve(ls: LevelSolve) -> Result<(usize, f64, Option<Certificate>)> {
                 }
             }
         });
-        timer.time("line search", || line_step(model, v, &delta, &r));
+        timer.time("line search", || {
+            let (g0, s2) = line::line_data(model, &delta, &r);
+            if let Some(alpha) = line::exact_step(model, v, &delta, g0, s2) {
+                apply_step(model, v, &delta, alpha);
+            }
+        });
         prev = Some(st);
         if *v == before {
             stalled += 1;

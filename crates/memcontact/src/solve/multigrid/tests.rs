@@ -42,7 +42,7 @@ pub(crate) fn square_hierarchy(n0: usize, levels: usize) -> Hierarchy {
 
 /// The benchmark's data (t = 1, f = 20, h = 1000, φ = 0.5 + 0.1 sin 2πx cos 2πy) on `mesh`;
 /// `h = None` is the rigid obstacle.
-fn bench_model(mesh: &Mesh, h: Option<f64>, foundation: Foundation) -> Model {
+pub(crate) fn bench_model(mesh: &Mesh, h: Option<f64>, foundation: Foundation) -> Model {
     use std::f64::consts::PI;
     let phi =
         FnCoefficient(|p: [f64; 2]| 0.5 + 0.1 * (2.0 * PI * p[0]).sin() * (2.0 * PI * p[1]).cos());
@@ -144,7 +144,7 @@ fn poisson_v_cycles_converge_independently_of_the_mesh() {
     for levels in 2..=5 {
         let h = square_hierarchy(4, levels);
         let model = bench_model(h.finest(), Some(0.0), Foundation::Lumped);
-        let out = poisson_solve(&model.s, &model.d, &h, &model.dofs, 1e-10, 50).unwrap();
+        let out = poisson_solve(&model.s, &model.d, &h, &model.dofs, 1e-10, None, 50).unwrap();
         let mut exact = model.d.clone();
         Cholesky::new(&model.s).unwrap().solve_in_place(&mut exact);
         assert!(
@@ -154,6 +154,11 @@ fn poisson_v_cycles_converge_independently_of_the_mesh() {
         );
         counts.push(out.cycles);
     }
+    // Below the rounding floor: an error, after a few stagnating cycles, not a hang.
+    let h = square_hierarchy(4, 3);
+    let model = bench_model(h.finest(), Some(0.0), Foundation::Lumped);
+    let e = poisson_solve(&model.s, &model.d, &h, &model.dofs, 1e-30, None, 10_000).unwrap_err();
+    assert!(e.to_string().contains("V-cycles"), "{e}");
     // The asymptotic rate of a V(1,1)-cycle is about 0.27 in the maximum norm.
     let (lo, hi) = (counts.iter().min().unwrap(), counts.iter().max().unwrap());
     assert!(hi - lo <= 4 && *hi <= 24, "{counts:?}");
@@ -450,4 +455,71 @@ fn fused_newton_system_is_the_active_set_system() {
             }
         }
     }
+}
+
+#[test]
+fn block_gauss_seidel_keeps_the_rate_and_ignores_the_thread_count() {
+    // 255² > GS_BLOCK unknowns: the fine level is smoothed block-parallel.
+    let h = square_hierarchy(4, 7);
+    let model = bench_model(h.finest(), Some(0.0), Foundation::Lumped);
+    assert!(model.n() > cycle::GS_BLOCK);
+    let run = |threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        pool.install(|| {
+            poisson_solve(&model.s, &model.d, &h, &model.dofs, 1e-10, None, 50).unwrap()
+        })
+    };
+    let one = run(1);
+    let two = run(3);
+    assert_eq!(one.x, two.x);
+    assert!(one.cycles <= 24, "{}", one.cycles);
+}
+
+#[test]
+#[ignore]
+fn print_big_poisson() {
+    for levels in [10] {
+        let h = if levels == 9 {
+            square_hierarchy(4, levels)
+        } else {
+            crate::bench::mesh(1024).unwrap()
+        };
+        let model = bench_model(h.finest(), Some(0.0), Foundation::Lumped);
+        let lv = Levels::new(&h, &model.dofs, model.s.pattern.clone()).unwrap();
+        let mut mg = Multigrid::new(&lv, lv.len() - 1);
+        mg.update(&model.s, None).unwrap();
+        let mut x = vec![0.0; model.n()];
+        let mut r = vec![0.0; model.n()];
+        let mut rates = vec![];
+        let mut last = norm_inf(&model.d);
+        for _ in 0..40 {
+            mg.v_cycle(&model.s, &mut x, &model.d);
+            cycle::residual(&model.s, &x, &model.d, &mut r);
+            let n = norm_inf(&r);
+            rates.push(format!("{:.3}({:.0e})", n / last, n / norm_inf(&model.d)));
+            last = n;
+        }
+        println!("{levels}: {}", rates.join(" "));
+    }
+}
+
+#[test]
+#[ignore]
+fn print_bench_poisson() {
+    let h = crate::bench::mesh(1024).unwrap();
+    let model = crate::bench::model(h.finest(), Foundation::Lumped).unwrap();
+    let out = poisson_solve(
+        &model.s,
+        &model.d,
+        &h,
+        &model.dofs,
+        1e-10,
+        Some(model.force_scale()),
+        200,
+    )
+    .unwrap();
+    println!("cycles {}", out.cycles);
 }
