@@ -210,6 +210,14 @@ fn human(case: &Case, run: &Run, t: &Totals, t_write: f64, total: f64, out: &Pat
         t_write,
         total
     );
+    if !s.phases.is_empty() {
+        let phases: Vec<String> = s
+            .phases
+            .iter()
+            .map(|(k, v)| format!("{k} {v:.3} s"))
+            .collect();
+        let _ = writeln!(o, "  solver time  {}", phases.join(", "));
+    }
     let _ = writeln!(
         o,
         "  wrote        {}/{{solution.vtu, nodes.csv, summary.json}}",

@@ -24,27 +24,42 @@ fn micro(n: usize) {
     for _ in 0..reps {
         m.s.mul_into(&x, &mut y);
     }
-    println!("matvec      {:.2} ms", t0.elapsed().as_secs_f64() * 1e3 / reps as f64);
+    println!(
+        "matvec      {:.2} ms",
+        t0.elapsed().as_secs_f64() * 1e3 / reps as f64
+    );
     let t0 = Instant::now();
     for _ in 0..reps {
         mg.v_cycle(&m.s, &mut x, &m.d);
     }
-    println!("V(1,1)      {:.2} ms", t0.elapsed().as_secs_f64() * 1e3 / reps as f64);
+    println!(
+        "V(1,1)      {:.2} ms",
+        t0.elapsed().as_secs_f64() * 1e3 / reps as f64
+    );
     let t0 = Instant::now();
     for _ in 0..reps {
         mg.update(&m.s, None).unwrap();
     }
-    println!("galerkin    {:.2} ms", t0.elapsed().as_secs_f64() * 1e3 / reps as f64);
+    println!(
+        "galerkin    {:.2} ms",
+        t0.elapsed().as_secs_f64() * 1e3 / reps as f64
+    );
     let t0 = Instant::now();
     for _ in 0..reps {
         memcontact::solve::local::sweep_forward(&m, &mut x);
     }
-    println!("nonsmooth   {:.2} ms", t0.elapsed().as_secs_f64() * 1e3 / reps as f64);
+    println!(
+        "nonsmooth   {:.2} ms",
+        t0.elapsed().as_secs_f64() * 1e3 / reps as f64
+    );
     let t0 = Instant::now();
     for _ in 0..reps {
         std::hint::black_box(m.certificate(&x));
     }
-    println!("certificate {:.2} ms", t0.elapsed().as_secs_f64() * 1e3 / reps as f64);
+    println!(
+        "certificate {:.2} ms",
+        t0.elapsed().as_secs_f64() * 1e3 / reps as f64
+    );
 }
 
 fn main() {
