@@ -314,3 +314,41 @@ fn bad_inputs_are_clear_errors() {
         "coordinate",
     );
 }
+
+#[test]
+fn every_example_case_solves_with_a_certificate() {
+    let mut n = 0;
+    for entry in std::fs::read_dir(examples()).unwrap() {
+        let path = entry.unwrap().path();
+        if path.extension().and_then(|e| e.to_str()) != Some("toml") {
+            continue;
+        }
+        n += 1;
+        let name = path.file_stem().unwrap().to_str().unwrap().to_string();
+        let out = tmp(&format!("all-{name}"));
+        let mut args = vec![
+            "solve",
+            path.to_str().unwrap(),
+            "-o",
+            out.to_str().unwrap(),
+            "-q",
+        ];
+        if name == "bench-square" {
+            args.extend(["--set", "mesh.nx=64", "--set", "mesh.ny=64"]);
+        }
+        let o = run(&args);
+        assert!(o.status.success(), "{name}: {}", text(&o));
+        let s = summary(&out);
+        assert!(s["kkt_residual"].as_f64().unwrap() <= 1e-9, "{name}");
+        // Equilibrium: the obstacle never carries more than the load.
+        let (load, force) = (
+            s["total_load"].as_f64().unwrap(),
+            s["total_contact_force"].as_f64().unwrap(),
+        );
+        assert!(
+            force >= -1e-12 && force <= load * (1.0 + 1e-12),
+            "{name}: {force} vs {load}"
+        );
+    }
+    assert!(n >= 5);
+}
