@@ -66,7 +66,12 @@ fn column(header: &[String], rows: &[Vec<f64>], name: &str) -> Vec<f64> {
 
 fn assert_png(path: &Path) {
     let bytes = std::fs::read(path).unwrap();
-    assert_eq!(&bytes[..8], b"\x89PNG\r\n\x1a\n", "{} is not a PNG", path.display());
+    assert_eq!(
+        &bytes[..8],
+        b"\x89PNG\r\n\x1a\n",
+        "{} is not a PNG",
+        path.display()
+    );
 }
 
 #[test]
@@ -257,8 +262,16 @@ fn bad_exact_sections_are_errors() {
             "[exact]\nkind = \"disk\"",
             "constant obstacle.stiffness",
         ),
-        (SQUARE, "[exact]\nkind = \"manufactured\"\ndomain = \"rectangle\"", "amplitude"),
-        (SQUARE, "[exact]\nkind = \"manufactured\"\namplitude = 1", "domain"),
+        (
+            SQUARE,
+            "[exact]\nkind = \"manufactured\"\ndomain = \"rectangle\"",
+            "amplitude",
+        ),
+        (
+            SQUARE,
+            "[exact]\nkind = \"manufactured\"\namplitude = 1",
+            "domain",
+        ),
         (
             SQUARE,
             "[exact]\nkind = \"manufactured\"\ndomain = \"disk\"\namplitude = 1",
@@ -310,9 +323,17 @@ fn bad_exact_sections_are_errors() {
     // --levels 0 without --h-sweep, and a missing --levels.
     let case = case_file(&dir, &format!("{DISC}\n[exact]\nkind = \"disk\"\n"));
     let o = run(&["convergence", case.to_str().unwrap(), "--levels", "0"]);
-    assert!(!o.status.success() && text(&o).contains("at least 1"), "{}", text(&o));
+    assert!(
+        !o.status.success() && text(&o).contains("at least 1"),
+        "{}",
+        text(&o)
+    );
     let o = run(&["convergence", case.to_str().unwrap()]);
-    assert!(!o.status.success() && text(&o).contains("--levels"), "{}", text(&o));
+    assert!(
+        !o.status.success() && text(&o).contains("--levels"),
+        "{}",
+        text(&o)
+    );
     // Nothing was written by the failing runs.
     assert!(!out.join("convergence.csv").exists());
 }
