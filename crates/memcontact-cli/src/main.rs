@@ -5,6 +5,7 @@ mod case;
 mod commands;
 mod convergence;
 mod examples;
+mod help;
 mod output;
 mod plot;
 
@@ -28,6 +29,7 @@ struct Cli {
 #[derive(Subcommand)]
 enum Command {
     /// Solve a case and write solution.vtu, nodes.csv and summary.json.
+    #[command(after_long_help = help::CASE_KEYS)]
     Solve {
         /// The case file (TOML).
         case: PathBuf,
@@ -42,6 +44,7 @@ enum Command {
         quiet: bool,
     },
     /// Validate a case and report its mesh, without solving.
+    #[command(after_long_help = help::CASE_KEYS)]
     Check {
         /// The case file (TOML).
         case: PathBuf,

@@ -182,81 +182,61 @@ pub fn unknowns_pattern(mesh: &Mesh, dofs: &DofMap, adj: &VertexTriangles) -> Pa
     pattern
 }
 
-/// A local matrix rule: `(element, region, a, b) ↦ ∫_T ...` for local indices `a`, `b`.
-pub type LocalMatrix<'a> = &'a (dyn Fn(&Element, u32, usize, usize) -> f64 + Sync);
-
-/// Fills the values of one or more matrices on `pattern` in one pass: entry `(i, j)` of
-/// matrix `m` is the sum over the triangles around `a_i` of `locals[m](element, region, a,
-/// b)`, where `a`, `b` are the local indices of `a_i`, `a_j`. Rows are assembled in
-/// parallel; element geometry is computed once per (row, triangle) for all matrices.
-pub fn assemble_matrices(
+/// Assembles the stiffness matrix `S_ij = t ∫ ∇g_i·∇g_j` and, when `h` is given, the
+/// consistent foundation matrix `L_ij = ∫ h g_i g_j` on `pattern`, in one pass over the rows
+/// (SPEC §2). Entry `(i, j)` sums the element integrals of the triangles around `a_i`; rows
+/// are assembled in parallel and element geometry is computed once per (row, triangle).
+pub fn assemble_stiffness_and_mass(
     mesh: &Mesh,
     dofs: &DofMap,
     adj: &VertexTriangles,
     pattern: &Arc<Pattern>,
-    locals: &[LocalMatrix],
-) -> Vec<Csr> {
-    let nm = locals.len();
-    let nnz = pattern.nnz();
-    // Interleaved values: entry e of matrix m at e * nm + m.
-    let mut vals = vec![0.0; nnz * nm];
-    let mut rows: Vec<&mut [f64]> = Vec::with_capacity(pattern.n());
-    {
-        let mut rest: &mut [f64] = &mut vals;
-        for i in 0..pattern.n() {
-            let (head, tail) =
-                rest.split_at_mut((pattern.row_ptr[i + 1] - pattern.row_ptr[i]) * nm);
-            rows.push(head);
-            rest = tail;
-        }
-    }
-    rows.par_iter_mut()
+    t: f64,
+    h: Option<&dyn Coefficient>,
+) -> (Csr, Option<Csr>) {
+    let mut s = Csr::zeros(pattern.clone());
+    let mut l = h.map(|_| Csr::zeros(pattern.clone()));
+    let s_rows = split_rows(pattern, &mut s.val);
+    let l_rows: Vec<Option<&mut [f64]>> = match &mut l {
+        Some(l) => split_rows(pattern, &mut l.val)
+            .into_iter()
+            .map(Some)
+            .collect(),
+        None => (0..pattern.n()).map(|_| None).collect(),
+    };
+    s_rows
+        .into_par_iter()
+        .zip(l_rows)
         .enumerate()
         .with_min_len(1024)
-        .for_each(|(i, row)| {
+        .for_each(|(i, (srow, mut lrow))| {
             let v = dofs.vertex[i] as usize;
             let cols = &pattern.col[pattern.row_ptr[i]..pattern.row_ptr[i + 1]];
             for &k in adj.of(v) {
-                let t = mesh.triangles[k as usize];
+                let tri = mesh.triangles[k as usize];
                 let e = Element::of(mesh, k as usize);
                 let region = mesh.regions[k as usize];
-                let a = t
+                let a = tri
                     .iter()
                     .position(|&w| w as usize == v)
                     .expect("v in triangle");
-                for (b, &w) in t.iter().enumerate() {
-                    if let Some(j) = dofs.dof[w as usize] {
-                        let pos = cols.binary_search(&j).expect("pattern covers the patch");
-                        for (m, local) in locals.iter().enumerate() {
-                            row[pos * nm + m] += local(&e, region, a, b);
-                        }
+                let h_const = h.and_then(|h| h.on_region(region));
+                for (b, &w) in tri.iter().enumerate() {
+                    let Some(j) = dofs.dof[w as usize] else {
+                        continue;
+                    };
+                    let pos = cols.binary_search(&j).expect("pattern covers the patch");
+                    srow[pos] += t * e.stiffness(a, b);
+                    if let (Some(lrow), Some(h)) = (lrow.as_deref_mut(), h) {
+                        lrow[pos] += match h_const {
+                            Some(c) => c * e.area * if a == b { 1.0 / 6.0 } else { 1.0 / 12.0 },
+                            None => e.weighted_mass(h, region, a, b),
+                        };
                     }
                 }
             }
         });
-    (0..nm)
-        .map(|m| Csr {
-            pattern: pattern.clone(),
-            val: if nm == 1 {
-                std::mem::take(&mut vals)
-            } else {
-                vals.par_iter().skip(m).step_by(nm).copied().collect()
-            },
-        })
-        .collect()
-}
-
-/// [`assemble_matrices`] for a single matrix.
-pub fn assemble_matrix(
-    mesh: &Mesh,
-    dofs: &DofMap,
-    adj: &VertexTriangles,
-    pattern: &Arc<Pattern>,
-    local: LocalMatrix,
-) -> Csr {
-    assemble_matrices(mesh, dofs, adj, pattern, &[local])
-        .pop()
-        .expect("one matrix")
+    (s, l)
 }
 
 /// Fills a vector over unknowns: entry `i` sums `local(element, region, a)` over the
@@ -350,7 +330,9 @@ mod tests {
         let dofs = DofMap::new(&m);
         let adj = VertexTriangles::new(&m);
         let pat = Arc::new(unknowns_pattern(&m, &dofs, &adj));
-        let s = assemble_matrix(&m, &dofs, &adj, &pat, &|e, _, a, b| e.stiffness(a, b));
+        let (s, l) = assemble_stiffness_and_mass(&m, &dofs, &adj, &pat, 1.0, Some(&2.0));
+        // ∫ h g² over the patch = h × 6 × (area/6) with area 1/8 per triangle.
+        assert!((l.unwrap().get(0, 0) - 2.0 * 6.0 * (1.0 / 8.0) / 6.0).abs() < 1e-15);
         // P1 on right triangles gives the 5-point stencil: diagonal 4.
         assert_eq!(s.n(), 1);
         assert!((s.get(0, 0) - 4.0).abs() < 1e-14);

@@ -4,10 +4,11 @@
 //! certificates of Problems 2e and 2f.
 
 use crate::fem::{
-    assemble_matrices, assemble_matrix, assemble_vector, unknowns_pattern, Coefficient, Element,
+    assemble_stiffness_and_mass, assemble_vector, unknowns_pattern, Coefficient, Element,
     VertexTriangles,
 };
 use crate::mesh::{DofMap, Mesh};
+use crate::quadrature::gauss_legendre;
 use crate::sparse::{norm_inf, Csr};
 use crate::{Error, Result};
 use rayon::prelude::*;
@@ -195,27 +196,20 @@ impl Model {
             }
         };
         let pattern = Arc::new(unknowns_pattern(mesh, &dofs, &adj));
-        let stiffness = |e: &Element, _: u32, a: usize, b: usize| t * e.stiffness(a, b);
-        let (s, l) = match (data.stiffness, data.foundation) {
-            (Stiffness::Elastic(h), Foundation::Consistent) => {
-                let mass = |e: &Element, r: u32, a: usize, b: usize| e.weighted_mass(h, r, a, b);
-                let mut m = assemble_matrices(mesh, &dofs, &adj, &pattern, &[&stiffness, &mass]);
-                let l = m.pop().expect("two matrices");
-                (
-                    m.pop().expect("two matrices"),
-                    FoundationMatrix::Consistent(l),
-                )
-            }
-            (Stiffness::Elastic(h), Foundation::Lumped) => (
-                assemble_matrix(mesh, &dofs, &adj, &pattern, &stiffness),
+        let consistent_h = match (data.stiffness, data.foundation) {
+            (Stiffness::Elastic(h), Foundation::Consistent) => Some(h),
+            _ => None,
+        };
+        let (s, l_consistent) =
+            assemble_stiffness_and_mass(mesh, &dofs, &adj, &pattern, t, consistent_h);
+        let l = match (data.stiffness, l_consistent) {
+            (Stiffness::Rigid, _) => FoundationMatrix::Rigid,
+            (_, Some(l)) => FoundationMatrix::Consistent(l),
+            (Stiffness::Elastic(h), None) => {
                 FoundationMatrix::Lumped(assemble_vector(mesh, &dofs, &adj, &|e, r, a| {
                     e.weighted_load(h, r, a)
-                })),
-            ),
-            (Stiffness::Rigid, _) => (
-                assemble_matrix(mesh, &dofs, &adj, &pattern, &stiffness),
-                FoundationMatrix::Rigid,
-            ),
+                }))
+            }
         };
         let load = data.load;
         let d = assemble_vector(mesh, &dofs, &adj, &|e, r, a| e.weighted_load(load, r, a));
@@ -568,62 +562,10 @@ fn mollify(mesh: &Mesh, adj: &VertexTriangles, phi: &dyn Coefficient, eps: f64) 
         .collect()
 }
 
-/// Gauss-Legendre nodes and weights on (−1, 1) (Newton on the Legendre recurrence).
-pub fn gauss_legendre(n: usize) -> (Vec<f64>, Vec<f64>) {
-    let mut x = vec![0.0; n];
-    let mut w = vec![0.0; n];
-    for i in 0..n {
-        let mut z = (std::f64::consts::PI * (i as f64 + 0.75) / (n as f64 + 0.5)).cos();
-        for _ in 0..100 {
-            let (mut p0, mut p1) = (1.0, z);
-            for k in 2..=n {
-                let p2 = ((2 * k - 1) as f64 * z * p1 - (k - 1) as f64 * p0) / k as f64;
-                p0 = p1;
-                p1 = p2;
-            }
-            let dp = n as f64 * (z * p1 - p0) / (z * z - 1.0);
-            let dz = p1 / dp;
-            z -= dz;
-            if dz.abs() < 1e-16 {
-                let (mut p0, mut p1) = (1.0, z);
-                for k in 2..=n {
-                    let p2 = ((2 * k - 1) as f64 * z * p1 - (k - 1) as f64 * p0) / k as f64;
-                    p0 = p1;
-                    p1 = p2;
-                }
-                let dp = n as f64 * (z * p1 - p0) / (z * z - 1.0);
-                x[i] = z;
-                w[i] = 2.0 / ((1.0 - z * z) * dp * dp);
-                break;
-            }
-        }
-    }
-    (x, w)
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
-    use std::collections::BTreeMap;
-
-    pub(crate) fn square(n: usize) -> Mesh {
-        let mut p = Vec::new();
-        for j in 0..=n {
-            for i in 0..=n {
-                p.push([i as f64 / n as f64, j as f64 / n as f64]);
-            }
-        }
-        let mut t = Vec::new();
-        let w = (n + 1) as u32;
-        for j in 0..n as u32 {
-            for i in 0..n as u32 {
-                let a = j * w + i;
-                t.push([a, a + 1, a + w + 1]);
-                t.push([a, a + w + 1, a + w]);
-            }
-        }
-        Mesh::new(p, t, vec![], BTreeMap::new()).unwrap()
-    }
+    use crate::solve::tests::square;
 
     fn data<'a>(h: &'a f64, foundation: Foundation) -> ProblemData<'a> {
         ProblemData {

@@ -1,0 +1,577 @@
+//! Linear geometric multigrid on a [`Hierarchy`]: the V-cycle that computes the truncated
+//! Newton correction of TNNMG, and, on the untruncated stiffness matrix S, the linear
+//! Poisson solve used as the benchmark's yardstick.
+//!
+//! * Levels: the unknowns (interior vertices) of every mesh of the hierarchy that has
+//!   any; prolongations [`Transfer`] between consecutive ones.
+//! * Operators: the finest one is given by the caller (S, or the truncated Hessian of
+//!   TNNMG, whose truncated rows and columns are zero); the coarser ones are the Galerkin
+//!   products `A_{k-1} = Pₖᵀ A_k Pₖ` on patterns computed once ([`Levels`]), refilled
+//!   value by value, and only in the rows that changed when the caller says which.
+//! * Smoother: Gauss-Seidel, forward before and backward after the coarse correction (the
+//!   V-cycle is then a symmetric operator). Rows whose diagonal is zero (truncated
+//!   vertices, or coarse vertices all of whose children are truncated) are left alone: in
+//!   a positive semidefinite matrix they are zero rows, decoupled from the rest.
+//! * Coarsest level: sparse Cholesky ([`Cholesky`], symbolic analysis once), zero rows
+//!   replaced by the identity.
+
+use super::transfer::{galerkin_patterns, par_rows, Transfer};
+use crate::mesh::refine::{Hierarchy, Refinement};
+use crate::mesh::{DofMap, Mesh};
+use crate::sparse::{Cholesky, Csr, Pattern};
+use crate::{Error, Result};
+use std::sync::Arc;
+
+/// The static structure of a multigrid hierarchy over unknowns: per level its dof map and
+/// operator pattern, and the prolongations. Built once per hierarchy.
+#[derive(Debug, Clone)]
+pub struct Levels {
+    /// Unknowns of every level, coarsest first (levels without unknowns are left out).
+    pub dofs: Vec<DofMap>,
+    /// Operator patterns, coarsest first; the finest is the pattern of S.
+    pub patterns: Vec<Arc<Pattern>>,
+    /// `transfers[k]` prolongates level `k` to level `k + 1`.
+    pub transfers: Vec<Transfer>,
+}
+
+impl Levels {
+    /// Checks that `hierarchy` ends with the mesh of the unknowns `finest` (whose operator
+    /// pattern is `pattern`) and builds the transfers and Galerkin patterns. A hierarchy
+    /// that does not fit is an error.
+    pub fn new(hierarchy: &Hierarchy, finest: &DofMap, pattern: Arc<Pattern>) -> Result<Levels> {
+        let nl = hierarchy.levels.len();
+        if nl == 0 || hierarchy.refinements.len() + 1 != nl {
+            return Err(Error::Mesh(format!(
+                "a hierarchy of {nl} levels needs {} refinement relations, it has {}",
+                nl.saturating_sub(1),
+                hierarchy.refinements.len()
+            )));
+        }
+        let last = hierarchy.finest();
+        if last.n_vertices() != finest.dof.len() || pattern.n() != finest.len() {
+            return Err(Error::Mesh(format!(
+                "the finest level of the hierarchy has {} vertices, but the model was \
+                 assembled on a mesh of {} vertices: the hierarchy must end with the model's \
+                 mesh",
+                last.n_vertices(),
+                finest.dof.len()
+            )));
+        }
+        check_pattern(last, finest, &pattern)?;
+        // The unknowns of the coarser levels, from the finer ones: a coarse vertex is
+        // interior exactly when the fine vertex sitting on it is (nested meshes).
+        let mut dofs = vec![finest.clone()];
+        for k in (0..nl - 1).rev() {
+            let coarse = coarse_dofs(
+                &hierarchy.refinements[k],
+                hierarchy.levels[k].n_vertices(),
+                dofs.last().expect("the finer level"),
+            )?;
+            dofs.push(coarse);
+        }
+        dofs.reverse();
+        // Levels without unknowns cannot carry a correction: start above them.
+        let first = dofs.iter().position(|d| !d.is_empty()).unwrap_or(nl - 1);
+        let mut transfers = Vec::with_capacity(nl - 1 - first);
+        for k in first..nl - 1 {
+            let t = Transfer::new(&hierarchy.refinements[k], &dofs[k], &dofs[k + 1])?;
+            transfers.push(t);
+        }
+        let dofs: Vec<DofMap> = dofs.into_iter().skip(first).collect();
+        let patterns = galerkin_patterns(&transfers, pattern);
+        Ok(Levels {
+            dofs,
+            patterns,
+            transfers,
+        })
+    }
+
+    /// Number of levels.
+    pub fn len(&self) -> usize {
+        self.dofs.len()
+    }
+
+    /// `true` when there is no level (never, after [`Levels::new`]).
+    pub fn is_empty(&self) -> bool {
+        self.dofs.is_empty()
+    }
+
+    /// Number of unknowns of level `k`.
+    pub fn n(&self, k: usize) -> usize {
+        self.dofs[k].len()
+    }
+}
+
+/// The unknowns of a coarse level of `n_vertices` vertices, given those of the level
+/// refined from it: coarse vertex `c` is interior iff the fine vertex on it (parents
+/// `[c, c]`) is. A coarse vertex without such a fine vertex is an error.
+fn coarse_dofs(refinement: &Refinement, n_vertices: usize, fine: &DofMap) -> Result<DofMap> {
+    if refinement.parents.len() != fine.dof.len() {
+        return Err(Error::Mesh(format!(
+            "the refinement relation names parents for {} vertices, but the finer level has \
+             {} vertices",
+            refinement.parents.len(),
+            fine.dof.len()
+        )));
+    }
+    let mut interior: Vec<Option<bool>> = vec![None; n_vertices];
+    for (v, &[a, b]) in refinement.parents.iter().enumerate() {
+        if a as usize >= n_vertices || b as usize >= n_vertices {
+            return Err(Error::Mesh(format!(
+                "vertex {v} of the finer level has parent vertices ({a}, {b}), but the \
+                 coarser level has only {n_vertices} vertices"
+            )));
+        }
+        if a == b {
+            interior[a as usize] = Some(fine.dof[v].is_some());
+        }
+    }
+    let mut vertex = Vec::new();
+    let mut dof = vec![None; n_vertices];
+    for (c, i) in interior.iter().enumerate() {
+        match i {
+            None => {
+                return Err(Error::Mesh(format!(
+                    "the refinement relation keeps no vertex on vertex {c} of the coarser level"
+                )))
+            }
+            Some(true) => {
+                dof[c] = Some(vertex.len() as u32);
+                vertex.push(c as u32);
+            }
+            Some(false) => {}
+        }
+    }
+    Ok(DofMap { vertex, dof })
+}
+
+/// Checks that the operator pattern couples the unknowns of the triangles of `mesh` (every
+/// triangle of small meshes, every 8th of large ones): a cheap test that the model was
+/// assembled on this mesh.
+fn check_pattern(mesh: &Mesh, dofs: &DofMap, pattern: &Pattern) -> Result<()> {
+    use rayon::prelude::*;
+    let step = if mesh.n_triangles() > 100_000 { 8 } else { 1 };
+    let bad = mesh
+        .triangles
+        .par_iter()
+        .enumerate()
+        .with_min_len(4096)
+        .filter(|(k, _)| k % step == 0)
+        .find_any(|(_, t)| {
+            t.iter().any(|&a| {
+                t.iter()
+                    .any(|&b| match (dofs.dof[a as usize], dofs.dof[b as usize]) {
+                        (Some(i), Some(j)) => pattern.find(i as usize, j as usize).is_none(),
+                        _ => false,
+                    })
+            })
+        });
+    match bad {
+        Some((k, _)) => Err(Error::Mesh(format!(
+            "triangle {k} of the finest level of the hierarchy couples unknowns that the \
+             model's matrices do not: the hierarchy must end with the mesh the model was \
+             assembled on"
+        ))),
+        None => Ok(()),
+    }
+}
+
+/// Gauss-Seidel smoothing steps and operators of a linear multigrid on levels `0..=top` of
+/// a [`Levels`], with the work arrays of a V-cycle (allocated once).
+pub struct Multigrid<'a> {
+    levels: &'a Levels,
+    top: usize,
+    /// Operators of levels `0..top` (the finest is the caller's).
+    coarse: Vec<Csr>,
+    /// `1 / A_ii`, or 0 on zero rows, for levels `0..=top`.
+    inv_diag: Vec<Vec<f64>>,
+    /// Iterate, right-hand side and residual per level `0..top`, and the residual on top.
+    x: Vec<Vec<f64>>,
+    b: Vec<Vec<f64>>,
+    r: Vec<Vec<f64>>,
+    /// The block smoother's copy of the iterate, per level (empty for small levels).
+    snap: Vec<Vec<f64>>,
+    dirty: Vec<Vec<bool>>,
+    /// Level 0's operator with zero rows replaced by the identity, and its factor.
+    coarsest: Csr,
+    chol: Option<Cholesky>,
+    /// Pre- and post-smoothing steps per level.
+    pub smoothing: (usize, usize),
+}
+
+impl<'a> Multigrid<'a> {
+    /// A multigrid on levels `0..=top` (`top` is the level of the caller's operator).
+    pub fn new(levels: &'a Levels, top: usize) -> Multigrid<'a> {
+        let coarse: Vec<Csr> = (0..top)
+            .map(|k| Csr::zeros(levels.patterns[k].clone()))
+            .collect();
+        let zeros = |k: usize| vec![0.0; levels.n(k)];
+        Multigrid {
+            levels,
+            top,
+            coarse,
+            inv_diag: (0..=top).map(zeros).collect(),
+            x: (0..top).map(zeros).collect(),
+            b: (0..top).map(zeros).collect(),
+            r: (0..=top).map(zeros).collect(),
+            snap: (0..=top)
+                .map(|k| {
+                    if levels.n(k) > GS_BLOCK {
+                        zeros(k)
+                    } else {
+                        Vec::new()
+                    }
+                })
+                .collect(),
+            dirty: (0..top).map(|k| vec![true; levels.n(k)]).collect(),
+            coarsest: Csr::zeros(levels.patterns[0].clone()),
+            chol: None,
+            smoothing: (1, 1),
+        }
+    }
+
+    /// Number of levels used.
+    pub fn depth(&self) -> usize {
+        self.top + 1
+    }
+
+    /// Recomputes the coarse operators from the finest one, `fine` (on the pattern of the
+    /// top level). With `dirty_fine`, only the coarse rows that depend on the flagged fine
+    /// rows are recomputed (the caller guarantees the other fine rows did not change since
+    /// the last update).
+    pub fn update(&mut self, fine: &Csr, dirty_fine: Option<&[bool]>) -> Result<()> {
+        let top = self.top;
+        if fine.n() != self.levels.n(top) {
+            return Err(Error::Solver {
+                solver: "multigrid".into(),
+                message: format!(
+                    "operator of {} rows for a level of {} unknowns",
+                    fine.n(),
+                    self.levels.n(top)
+                ),
+            });
+        }
+        fill_inv_diag(fine, &mut self.inv_diag[top]);
+        let first = self.chol.is_none();
+        for k in (0..top).rev() {
+            let t = &self.levels.transfers[k];
+            let (lower, upper) = self.coarse.split_at_mut(k + 1);
+            let finer: &Csr = if k + 1 == top { fine } else { &upper[0] };
+            let (dl, du) = self.dirty.split_at_mut(k + 1);
+            let dirty_here = &mut dl[k];
+            let use_dirty = match (k + 1 == top, dirty_fine) {
+                (_, _) if first => false,
+                (true, Some(d)) => {
+                    t.coarse_dirty(d, dirty_here);
+                    true
+                }
+                (false, Some(_)) => {
+                    t.coarse_dirty(&du[0], dirty_here);
+                    true
+                }
+                (_, None) => false,
+            };
+            if !use_dirty {
+                dirty_here.iter_mut().for_each(|d| *d = true);
+            }
+            t.galerkin_values(finer, &mut lower[k], Some(dirty_here));
+            fill_inv_diag(&lower[k], &mut self.inv_diag[k]);
+        }
+        // The coarsest level: refactor when anything changed there.
+        let changed = first || top == 0 || self.dirty[0].iter().any(|&d| d);
+        if changed {
+            let a0 = if top == 0 { fine } else { &self.coarse[0] };
+            self.coarsest.val.copy_from_slice(&a0.val);
+            let pat = self.coarsest.pattern.clone();
+            for i in 0..pat.n() {
+                if self.inv_diag[0][i] == 0.0 {
+                    for k in pat.row_ptr[i]..pat.row_ptr[i + 1] {
+                        self.coarsest.val[k] = if pat.col[k] as usize == i { 1.0 } else { 0.0 };
+                    }
+                }
+            }
+            match &mut self.chol {
+                Some(c) => c.refactor(&self.coarsest)?,
+                None => self.chol = Some(Cholesky::new(&self.coarsest)?),
+            }
+        }
+        Ok(())
+    }
+
+    /// One V-cycle for `A x = b` on the top level (`fine` = its operator, as given to the
+    /// last [`Multigrid::update`]), improving `x` in place. Zero rows of A leave their x
+    /// unchanged (the caller may zero them afterwards).
+    pub fn v_cycle(&mut self, fine: &Csr, x: &mut [f64], b: &[f64]) {
+        let top = self.top;
+        let (nu1, nu2) = self.smoothing;
+        if top == 0 {
+            // One level: the direct solve, on the residual equation.
+            let r = &mut self.r[0];
+            residual(fine, x, b, r);
+            self.solve_coarsest_in_place(None);
+            let r = &self.r[0];
+            for (i, xi) in x.iter_mut().enumerate() {
+                if self.inv_diag[0][i] != 0.0 {
+                    *xi += r[i];
+                }
+            }
+            return;
+        }
+        // Down: smooth, restrict the residual.
+        for _ in 0..nu1 {
+            gauss_seidel(fine, &self.inv_diag[top], x, b, &mut self.snap[top], false);
+        }
+        residual(fine, x, b, &mut self.r[top]);
+        self.levels.transfers[top - 1].restrict(&self.r[top], &mut self.b[top - 1]);
+        for k in (1..top).rev() {
+            let (a, inv) = (&self.coarse[k], &self.inv_diag[k]);
+            let (xk, bk) = (&mut self.x[k], &self.b[k]);
+            xk.iter_mut().for_each(|v| *v = 0.0);
+            for _ in 0..nu1 {
+                gauss_seidel(a, inv, xk, bk, &mut self.snap[k], false);
+            }
+            residual(a, xk, bk, &mut self.r[k]);
+            let (bl, _) = self.b.split_at_mut(k);
+            self.levels.transfers[k - 1].restrict(&self.r[k], &mut bl[k - 1]);
+        }
+        // Bottom: the direct solve.
+        self.solve_coarsest_in_place(Some(0));
+        // Up: prolongate the correction, smooth.
+        for k in 1..top {
+            let (xl, xu) = self.x.split_at_mut(k);
+            self.levels.transfers[k - 1].prolongate_add(&xl[k - 1], &mut xu[0]);
+            for _ in 0..nu2 {
+                gauss_seidel(
+                    &self.coarse[k],
+                    &self.inv_diag[k],
+                    &mut xu[0],
+                    &self.b[k],
+                    &mut self.snap[k],
+                    true,
+                );
+            }
+        }
+        self.levels.transfers[top - 1].prolongate_add(&self.x[top - 1], x);
+        for _ in 0..nu2 {
+            gauss_seidel(fine, &self.inv_diag[top], x, b, &mut self.snap[top], true);
+        }
+    }
+
+    /// Level 0: `x₀ = A₀⁻¹ b₀` (into `self.x[0]` when `into = Some(0)`, else in place in
+    /// `self.r[0]`), zero on the zero rows.
+    fn solve_coarsest_in_place(&mut self, into: Option<usize>) {
+        let inv = &self.inv_diag[0];
+        let target: &mut Vec<f64> = match into {
+            Some(_) => {
+                self.x[0].copy_from_slice(&self.b[0]);
+                &mut self.x[0]
+            }
+            None => &mut self.r[0],
+        };
+        for (t, &d) in target.iter_mut().zip(inv) {
+            if d == 0.0 {
+                *t = 0.0;
+            }
+        }
+        if let Some(c) = &self.chol {
+            c.solve_in_place(target);
+        }
+        for (t, &d) in target.iter_mut().zip(inv) {
+            if d == 0.0 {
+                *t = 0.0;
+            }
+        }
+    }
+}
+
+/// `1 / A_ii`, or 0 where `A_ii ≤ 0` (zero rows).
+fn fill_inv_diag(a: &Csr, inv: &mut [f64]) {
+    let pat = &a.pattern;
+    par_rows(inv, |i, d| {
+        let (s, e) = (pat.row_ptr[i], pat.row_ptr[i + 1]);
+        let k = pat.col[s..e].partition_point(|&j| (j as usize) < i);
+        let aii = if s + k < e && pat.col[s + k] as usize == i {
+            a.val[s + k]
+        } else {
+            0.0
+        };
+        *d = if aii > 0.0 { 1.0 / aii } else { 0.0 };
+    });
+}
+
+/// `r = b − A x`.
+pub(crate) fn residual(a: &Csr, x: &[f64], b: &[f64], r: &mut [f64]) {
+    let pat = &a.pattern;
+    par_rows(r, |i, ri| {
+        let (s, e) = (pat.row_ptr[i], pat.row_ptr[i + 1]);
+        *ri = b[i] - row_sum(&pat.col[s..e], &a.val[s..e], |j| x[j]);
+    });
+}
+
+/// Rows per block of the block Gauss-Seidel smoother. The blocks are fixed by the matrix
+/// size alone, so the result does not depend on the number of threads.
+pub(crate) const GS_BLOCK: usize = 32_768;
+
+/// `Σ_k vals[k] x(cols[k])` with two partial sums (a shorter dependency chain).
+#[inline(always)]
+fn row_sum(cols: &[u32], vals: &[f64], x: impl Fn(usize) -> f64) -> f64 {
+    let (mut s0, mut s1) = (0.0, 0.0);
+    let mut pairs = cols.chunks_exact(2).zip(vals.chunks_exact(2));
+    for (c, v) in &mut pairs {
+        s0 += v[0] * x(c[0] as usize);
+        s1 += v[1] * x(c[1] as usize);
+    }
+    if cols.len() % 2 == 1 {
+        let k = cols.len() - 1;
+        s0 += vals[k] * x(cols[k] as usize);
+    }
+    s0 + s1
+}
+
+/// One Gauss-Seidel sweep for `A x = b` (rows with `inv_diag = 0` skipped), forward or
+/// backward. Up to [`GS_BLOCK`] unknowns it is the classical sweep; beyond, the rows are cut
+/// into blocks of [`GS_BLOCK`] that are swept in parallel, each by Gauss-Seidel inside the
+/// block and with the values of the other blocks from before the sweep (hybrid
+/// Gauss-Seidel, kept in `snapshot`).
+pub(crate) fn gauss_seidel(
+    a: &Csr,
+    inv: &[f64],
+    x: &mut [f64],
+    b: &[f64],
+    snapshot: &mut [f64],
+    backward: bool,
+) {
+    use rayon::prelude::*;
+    let pat = &a.pattern;
+    let n = x.len();
+    let sweep = |lo: usize, xs: &mut [f64], outside: &[f64]| {
+        let hi = lo + xs.len();
+        let mut relax = |i: usize| {
+            let d = inv[i];
+            if d == 0.0 {
+                return;
+            }
+            let (s, e) = (pat.row_ptr[i], pat.row_ptr[i + 1]);
+            let ax = row_sum(&pat.col[s..e], &a.val[s..e], |j| {
+                if j >= lo && j < hi {
+                    xs[j - lo]
+                } else {
+                    outside[j]
+                }
+            });
+            xs[i - lo] += (b[i] - ax) * d;
+        };
+        if backward {
+            (lo..hi).rev().for_each(&mut relax);
+        } else {
+            (lo..hi).for_each(&mut relax);
+        }
+    };
+    if n <= GS_BLOCK {
+        sweep(0, x, &[]);
+        return;
+    }
+    snapshot.copy_from_slice(x);
+    let outside: &[f64] = snapshot;
+    x.par_chunks_mut(GS_BLOCK)
+        .enumerate()
+        .for_each(|(k, xs)| sweep(k * GS_BLOCK, xs, outside));
+}
+
+/// The result of a linear multigrid solve.
+#[derive(Debug, Clone)]
+pub struct LinearSolve {
+    /// The solution.
+    pub x: Vec<f64>,
+    /// V-cycles done.
+    pub cycles: usize,
+    /// `‖b − A x‖∞ / ‖b‖∞` at the end.
+    pub relative_residual: f64,
+    /// Wall-clock seconds per phase (setup, coarse operators, cycles).
+    pub phases: Vec<(String, f64)>,
+}
+
+/// Solves the linear system `S x = rhs` (S on the finest level of `hierarchy`, over the
+/// unknowns `dofs`) by V(1,1)-cycles from `x = 0` until `‖rhs − S x‖∞ ≤ tol · scale`: the
+/// linear Poisson multigrid that the contact solver is measured against. `scale = None`
+/// means `‖rhs‖∞` (the plain relative residual); the benchmark passes the model's force
+/// scale, the scaling of the contact solver's KKT certificates, so that both stop at the
+/// same residual (with `‖D‖∞` alone, 1e-10 is below the rounding floor of `S x` from about
+/// a million unknowns on). Not reaching the tolerance (within `max_cycles`, or because the
+/// residual stagnates at rounding level) is an error.
+pub fn poisson_solve(
+    s: &Csr,
+    rhs: &[f64],
+    hierarchy: &Hierarchy,
+    dofs: &DofMap,
+    tol: f64,
+    scale: Option<f64>,
+    max_cycles: usize,
+) -> Result<LinearSolve> {
+    let t0 = std::time::Instant::now();
+    let levels = Levels::new(hierarchy, dofs, s.pattern.clone())?;
+    let setup = t0.elapsed().as_secs_f64();
+    let mut out = linear_solve(s, rhs, &levels, tol, scale, max_cycles)?;
+    out.phases.insert(0, ("setup".into(), setup));
+    Ok(out)
+}
+
+/// [`poisson_solve`] on prebuilt [`Levels`].
+pub fn linear_solve(
+    a: &Csr,
+    rhs: &[f64],
+    levels: &Levels,
+    tol: f64,
+    scale: Option<f64>,
+    max_cycles: usize,
+) -> Result<LinearSolve> {
+    if rhs.len() != a.n() || a.n() != levels.n(levels.len() - 1) {
+        return Err(Error::Solver {
+            solver: "multigrid".into(),
+            message: "right-hand side, matrix and hierarchy sizes differ".into(),
+        });
+    }
+    let mut timer = crate::solve::PhaseTimer::default();
+    let mut mg = Multigrid::new(levels, levels.len() - 1);
+    timer.time("coarse operators", || mg.update(a, None))?;
+    let t0 = std::time::Instant::now();
+    let norm_b = scale.unwrap_or_else(|| crate::sparse::norm_inf(rhs));
+    let mut x = vec![0.0; a.n()];
+    let mut r = vec![0.0; a.n()];
+    let mut cycles = 0;
+    let mut rel = if crate::sparse::norm_inf(rhs) == 0.0 {
+        0.0
+    } else {
+        crate::sparse::norm_inf(rhs) / norm_b
+    };
+    // The best residual so far and when it was reached (stagnation test).
+    let mut best = (rel, 0);
+    while rel > tol && cycles < max_cycles && cycles < best.1 + 4 {
+        mg.v_cycle(a, &mut x, rhs);
+        cycles += 1;
+        residual(a, &x, rhs, &mut r);
+        rel = crate::sparse::norm_inf(&r) / norm_b;
+        if !rel.is_finite() {
+            break;
+        }
+        if rel < 0.9 * best.0 {
+            best = (rel, cycles);
+        }
+    }
+    if rel.is_nan() || rel > tol {
+        return Err(Error::Solver {
+            solver: "multigrid".into(),
+            message: format!(
+                "linear multigrid stopped after {cycles} V-cycles at scaled residual {rel:.3e} \
+                 (tolerance {tol:.1e})"
+            ),
+        });
+    }
+    timer.add("v-cycles", t0.elapsed().as_secs_f64());
+    Ok(LinearSolve {
+        x,
+        cycles,
+        relative_residual: rel,
+        phases: timer.into_phases(),
+    })
+}

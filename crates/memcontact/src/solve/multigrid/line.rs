@@ -1,0 +1,283 @@
+//! The exact line search of TNNMG, `min_α≥0 J(V + αδ)`, in few passes over the data.
+//!
+//! Along the line, J is convex and piecewise quadratic, with breakpoints `t_i` where
+//! `V_i + t_i δ_i = φ_i`. On a piece (a fixed set A of penetrating vertices) the
+//! derivative is linear,
+//!
+//! `J'(α) = g₀ + α s₂ + a + α b`, `a = δ_Aᵀ L_AA w_A`, `b = δ_Aᵀ L_AA δ_A`, `w = V − φ`,
+//!
+//! (`g₀ = δᵀ(SV − D)`, `s₂ = δᵀSδ`), so its root on the piece is exact. One pass at a
+//! point α yields the data of the pieces on both sides of α *and* the nearest breakpoints
+//! on either side, so it tells at once whether the Newton root lies in the current piece
+//! (it is then the exact minimiser), or whether α is a kink minimiser (`J'(α−) ≤ 0 ≤
+//! J'(α+)`). This is the search of [`crate::solve::line_search::exact_step`] (bracketed
+//! Newton on the monotone derivative), with one pass per step instead of several; the step
+//! itself, with its snapping onto φ, is [`crate::solve::line_search::apply_step`].
+
+use super::transfer::PAR_ROWS;
+use crate::model::{FoundationMatrix, Model};
+use rayon::prelude::*;
+
+/// Rows per block of the deterministic reductions.
+const BLOCK: usize = 4096;
+
+/// `(g₀, s₂) = (δᵀ r, δᵀ S δ)`, summed in fixed blocks.
+pub fn line_data(model: &Model, dir: &[f64], r: &[f64]) -> (f64, f64) {
+    let s = &model.s;
+    let block = |b: usize| -> [f64; 2] {
+        let (lo, hi) = (b * BLOCK, ((b + 1) * BLOCK).min(dir.len()));
+        let mut acc = [0.0; 2];
+        for i in lo..hi {
+            if dir[i] != 0.0 {
+                acc[0] += dir[i] * r[i];
+                acc[1] += dir[i] * s.row_dot(i, dir);
+            }
+        }
+        acc
+    };
+    let [g0, s2] = reduce(dir.len(), block, |a, b| [a[0] + b[0], a[1] + b[1]]);
+    (g0, s2)
+}
+
+/// Runs `block` over the fixed blocks of `0..n` (in parallel for large n) and folds the
+/// results in block order.
+fn reduce<T: Send + Copy>(
+    n: usize,
+    block: impl Fn(usize) -> T + Sync + Send,
+    fold: impl Fn(T, T) -> T,
+) -> T {
+    let nb = n.div_ceil(BLOCK).max(1);
+    let parts: Vec<T> = if n >= PAR_ROWS {
+        (0..nb).into_par_iter().map(block).collect()
+    } else {
+        (0..nb).map(block).collect()
+    };
+    let mut it = parts.into_iter();
+    let first = it.next().expect("at least one block");
+    it.fold(first, fold)
+}
+
+/// What one pass at α reveals: the foundation term's derivative data on the pieces left
+/// and right of α, and the nearest breakpoints strictly below and above α.
+#[derive(Clone, Copy)]
+struct Pieces {
+    /// `(a, b)` of the left piece.
+    left: (f64, f64),
+    /// `(a, b)` of the right piece.
+    right: (f64, f64),
+    /// Largest breakpoint `< α` (−∞ if none).
+    below: f64,
+    /// Smallest breakpoint `> α` (+∞ if none).
+    above: f64,
+}
+
+fn merge(p: Pieces, q: Pieces) -> Pieces {
+    Pieces {
+        left: (p.left.0 + q.left.0, p.left.1 + q.left.1),
+        right: (p.right.0 + q.right.0, p.right.1 + q.right.1),
+        below: p.below.max(q.below),
+        above: p.above.min(q.above),
+    }
+}
+
+/// One pass at α (elastic obstacle).
+fn pieces(model: &Model, v: &[f64], dir: &[f64], alpha: f64) -> Pieces {
+    let w = |j: usize| v[j] - model.phi[j];
+    // Penetrating on the left / right piece of α.
+    let side = |j: usize| -> (bool, bool) {
+        if !model.can_touch[j] {
+            return (false, false);
+        }
+        let x = w(j) + alpha * dir[j];
+        if x > 0.0 {
+            (true, true)
+        } else if x < 0.0 {
+            (false, false)
+        } else {
+            (dir[j] < 0.0, dir[j] > 0.0)
+        }
+    };
+    let block = |b: usize| -> Pieces {
+        let (lo, hi) = (b * BLOCK, ((b + 1) * BLOCK).min(v.len()));
+        let mut acc = Pieces {
+            left: (0.0, 0.0),
+            right: (0.0, 0.0),
+            below: f64::NEG_INFINITY,
+            above: f64::INFINITY,
+        };
+        for i in lo..hi {
+            let d = dir[i];
+            if d == 0.0 || !model.can_touch[i] {
+                continue;
+            }
+            let t = -w(i) / d;
+            if t < alpha {
+                acc.below = acc.below.max(t);
+            } else if t > alpha {
+                acc.above = acc.above.min(t);
+            }
+            let (li, ri) = side(i);
+            if !li && !ri {
+                continue;
+            }
+            match &model.l {
+                FoundationMatrix::Lumped(l) => {
+                    let (a, b) = (d * l[i] * w(i), d * l[i] * d);
+                    if li {
+                        acc.left.0 += a;
+                        acc.left.1 += b;
+                    }
+                    if ri {
+                        acc.right.0 += a;
+                        acc.right.1 += b;
+                    }
+                }
+                FoundationMatrix::Consistent(l) => {
+                    let (cols, vals) = l.row(i);
+                    let (mut al, mut bl, mut ar, mut br) = (0.0, 0.0, 0.0, 0.0);
+                    for (&j, &lv) in cols.iter().zip(vals) {
+                        if lv == 0.0 {
+                            continue;
+                        }
+                        let j = j as usize;
+                        let (lj, rj) = side(j);
+                        if lj {
+                            al += lv * w(j);
+                            bl += lv * dir[j];
+                        }
+                        if rj {
+                            ar += lv * w(j);
+                            br += lv * dir[j];
+                        }
+                    }
+                    if li {
+                        acc.left.0 += d * al;
+                        acc.left.1 += d * bl;
+                    }
+                    if ri {
+                        acc.right.0 += d * ar;
+                        acc.right.1 += d * br;
+                    }
+                }
+                FoundationMatrix::Rigid => {}
+            }
+        }
+        acc
+    };
+    reduce(v.len(), block, merge)
+}
+
+/// The exact minimiser α ≥ 0 of `J(V + αδ)` given `g₀ = δᵀ(SV − D)` and `s₂ = δᵀSδ`;
+/// `None` when δ is not a descent direction. For the rigid obstacle the step is limited so
+/// that `V + αδ ≤ φ` on M.
+pub fn exact_step(model: &Model, v: &[f64], dir: &[f64], g0: f64, s2: f64) -> Option<f64> {
+    if s2.is_nan() || s2 <= 0.0 || !g0.is_finite() {
+        return None;
+    }
+    if model.is_rigid() {
+        if g0 >= 0.0 {
+            return None;
+        }
+        let block = |b: usize| -> f64 {
+            let (lo, hi) = (b * BLOCK, ((b + 1) * BLOCK).min(v.len()));
+            let mut m = f64::INFINITY;
+            for i in lo..hi {
+                if model.can_touch[i] && dir[i] > 0.0 {
+                    m = m.min((model.phi[i] - v[i]) / dir[i]);
+                }
+            }
+            m
+        };
+        let amax = reduce(v.len(), block, f64::min);
+        return Some((-g0 / s2).min(amax.max(0.0))).filter(|a| *a > 0.0);
+    }
+    let (mut lo, mut hi) = (0.0f64, f64::INFINITY);
+    let mut alpha = 1.0f64;
+    for _ in 0..200 {
+        let p = pieces(model, v, dir, alpha);
+        let dl = g0 + alpha * s2 + p.left.0 + alpha * p.left.1;
+        let dr = g0 + alpha * s2 + p.right.0 + alpha * p.right.1;
+        if dl <= 0.0 && dr >= 0.0 {
+            // 0 is in the subdifferential at α: a kink minimum.
+            return (alpha > 0.0).then_some(alpha);
+        }
+        let next = if dr < 0.0 {
+            lo = alpha;
+            // The root of the right piece's derivative: exact if it stays in the piece.
+            let c = -(g0 + p.right.0) / (s2 + p.right.1);
+            if c <= p.above {
+                return Some(c);
+            }
+            c
+        } else {
+            hi = alpha;
+            let c = -(g0 + p.left.0) / (s2 + p.left.1);
+            if c >= p.below {
+                return (c > 0.0).then_some(c);
+            }
+            c
+        };
+        alpha = if next > lo && next < hi {
+            next
+        } else if hi.is_finite() {
+            0.5 * (lo + hi)
+        } else {
+            2.0 * lo.max(1.0)
+        };
+        if alpha <= 0.0 {
+            return None;
+        }
+    }
+    Some(if hi.is_finite() { 0.5 * (lo + hi) } else { lo }).filter(|a| *a > 0.0)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::solve::line_search::{self, Line};
+
+    #[test]
+    fn agrees_with_the_reference_line_search() {
+        let hier = super::super::tests::square_hierarchy(4, 3);
+        for (h, f) in [
+            (Some(1000.0), crate::model::Foundation::Consistent),
+            (Some(1000.0), crate::model::Foundation::Lumped),
+            (None, crate::model::Foundation::Lumped),
+        ] {
+            let model = super::super::tests::bench_model(hier.finest(), h, f);
+            let n = model.n();
+            for seed in 0..20 {
+                let s = seed as f64;
+                let mut v: Vec<f64> = (0..n)
+                    .map(|i| model.phi[i] + 0.05 * ((i as f64) * 0.37 + s).sin())
+                    .collect();
+                if h.is_none() {
+                    for (x, p) in v.iter_mut().zip(&model.phi) {
+                        *x = x.min(*p);
+                    }
+                }
+                // A direction towards the free membrane, perturbed.
+                let r = model.residual(&v);
+                let dir: Vec<f64> = (0..n)
+                    .map(|i| -r[i] * (1.0 + 0.5 * ((i as f64) * 1.3 + s).cos()) * 50.0)
+                    .collect();
+                let (g0, s2) = line_data(&model, &dir, &r);
+                let line = Line {
+                    v: &v,
+                    dir: &dir,
+                    g0,
+                    s2,
+                };
+                let reference = line_search::exact_step(&model, &line).filter(|a| *a > 0.0);
+                let ours = exact_step(&model, &v, &dir, g0, s2);
+                match (reference, ours) {
+                    (Some(a), Some(b)) => {
+                        assert!((a - b).abs() <= 1e-10 * a.abs().max(1e-3), "{f:?} {a} {b}")
+                    }
+                    (None, None) => {}
+                    (a, b) => panic!("{f:?}: {a:?} vs {b:?}"),
+                }
+            }
+        }
+    }
+}

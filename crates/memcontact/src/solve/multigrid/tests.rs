@@ -1,0 +1,525 @@
+//! Multigrid checks on small structured squares: the linear V-cycle against Cholesky, TNNMG
+//! against the active-set method, monotone energy, iteration counts under refinement.
+
+use super::*;
+use crate::fem::FnCoefficient;
+use crate::mesh::refine::Refinement;
+use crate::mesh::{DofMap, Mesh};
+use crate::model::{Foundation, ProblemData, Sampling, Stiffness};
+use crate::solve::tests::square;
+use crate::solve::{active_set, Silent};
+use crate::sparse::{norm_inf, Cholesky};
+
+/// The unit square on an `n0 2^k` grid for `k = 0..levels`, "right" diagonals, with the
+/// refinement relations of uniform refinement (every square of the coarse grid into four).
+pub(crate) fn square_hierarchy(n0: usize, levels: usize) -> Hierarchy {
+    let meshes: Vec<Mesh> = (0..levels).map(|k| square(n0 << k)).collect();
+    let refinements = (1..levels)
+        .map(|k| {
+            let n = n0 << k;
+            let nc = n / 2;
+            let (w, wc) = (n + 1, nc + 1);
+            let mut parents = vec![[0u32; 2]; w * w];
+            for j in 0..=n {
+                for i in 0..=n {
+                    let c = |a: usize, b: usize| (b * wc + a) as u32;
+                    parents[j * w + i] = match (i % 2, j % 2) {
+                        (0, 0) => [c(i / 2, j / 2), c(i / 2, j / 2)],
+                        (1, 0) => [c(i / 2, j / 2), c(i / 2 + 1, j / 2)],
+                        (0, 1) => [c(i / 2, j / 2), c(i / 2, j / 2 + 1)],
+                        _ => [c(i / 2, j / 2), c(i / 2 + 1, j / 2 + 1)],
+                    };
+                }
+            }
+            Refinement { parents }
+        })
+        .collect();
+    Hierarchy {
+        levels: meshes,
+        refinements,
+    }
+}
+
+/// The benchmark's data (t = 1, f = 20, h = 1000, φ = 0.5 + 0.1 sin 2πx cos 2πy) on `mesh`;
+/// `h = None` is the rigid obstacle.
+pub(crate) fn bench_model(mesh: &Mesh, h: Option<f64>, foundation: Foundation) -> Model {
+    use std::f64::consts::PI;
+    let phi =
+        FnCoefficient(|p: [f64; 2]| 0.5 + 0.1 * (2.0 * PI * p[0]).sin() * (2.0 * PI * p[1]).cos());
+    let hv = h.unwrap_or(0.0);
+    Model::assemble(
+        mesh,
+        &ProblemData {
+            tension: 1.0,
+            load: &20.0,
+            shape: &phi,
+            stiffness: match h {
+                Some(_) => Stiffness::Elastic(&hv),
+                None => Stiffness::Rigid,
+            },
+            foundation,
+            sampling: Sampling::Nodal,
+        },
+    )
+    .unwrap()
+}
+
+fn settings(tol: f64) -> Settings {
+    Settings {
+        method: Method::Multigrid,
+        tolerance: tol,
+        max_iterations: None,
+    }
+}
+
+fn rel_diff(a: &[f64], b: &[f64]) -> f64 {
+    let num = a
+        .iter()
+        .zip(b)
+        .fold(0.0f64, |m, (x, y)| m.max((x - y).abs()));
+    num / norm_inf(b).max(1e-300)
+}
+
+#[test]
+fn prolongation_reproduces_linear_functions() {
+    let h = square_hierarchy(4, 2);
+    let coarse = DofMap::new(&h.levels[0]);
+    let fine = DofMap::new(&h.levels[1]);
+    let t = Transfer::new(&h.refinements[0], &coarse, &fine).unwrap();
+    // A function vanishing on the boundary that is linear on every coarse triangle.
+    let xc: Vec<f64> = coarse
+        .vertex
+        .iter()
+        .map(|&v| {
+            let p = h.levels[0].points[v as usize];
+            (p[0] * 3.0).sin() + p[1]
+        })
+        .collect();
+    let mut xf = vec![0.0; fine.len()];
+    t.prolongate(&xc, &mut xf);
+    let all_c = coarse.to_vertices(&xc, 0.0);
+    let all_f = h.refinements[0].prolongate(&all_c);
+    assert_eq!(fine.to_unknowns(&all_f), xf);
+    // Pᵀ is the transpose of P.
+    let rf: Vec<f64> = (0..fine.len()).map(|i| (i as f64).cos()).collect();
+    let mut rc = vec![0.0; coarse.len()];
+    t.restrict(&rf, &mut rc);
+    let lhs: f64 = rc.iter().zip(&xc).map(|(a, b)| a * b).sum();
+    let rhs: f64 = rf.iter().zip(&xf).map(|(a, b)| a * b).sum();
+    assert!((lhs - rhs).abs() < 1e-12 * lhs.abs().max(1.0));
+}
+
+#[test]
+fn galerkin_operator_is_the_coarse_stiffness() {
+    // For nested P1 spaces, PᵀSP is the stiffness matrix of the coarse mesh.
+    let h = square_hierarchy(4, 3);
+    let fine = bench_model(h.finest(), Some(1000.0), Foundation::Consistent);
+    let levels = Levels::new(&h, &fine.dofs, fine.s.pattern.clone()).unwrap();
+    let mid = bench_model(&h.levels[1], Some(1000.0), Foundation::Consistent);
+    let mut c = Csr::zeros(levels.patterns[1].clone());
+    levels.transfers[1].galerkin_values(&fine.s, &mut c, None);
+    for i in 0..mid.n() {
+        for j in 0..mid.n() {
+            assert!((c.get(i, j) - mid.s.get(i, j)).abs() < 1e-12, "({i}, {j})");
+        }
+    }
+    // The same for the consistent L, and the lumped l (SPEC §3: l_i = ∫ h g_i).
+    let FoundationMatrix::Consistent(lf) = &fine.l else {
+        panic!()
+    };
+    let FoundationMatrix::Consistent(lm) = &mid.l else {
+        panic!()
+    };
+    levels.transfers[1].galerkin_values(lf, &mut c, None);
+    for i in 0..mid.n() {
+        for j in 0..mid.n() {
+            assert!((c.get(i, j) - lm.get(i, j)).abs() < 1e-12);
+        }
+    }
+}
+
+#[test]
+fn poisson_v_cycles_converge_independently_of_the_mesh() {
+    let mut counts = Vec::new();
+    for levels in 2..=5 {
+        let h = square_hierarchy(4, levels);
+        let model = bench_model(h.finest(), Some(0.0), Foundation::Lumped);
+        let out = poisson_solve(&model.s, &model.d, &h, &model.dofs, 1e-10, None, 50).unwrap();
+        let mut exact = model.d.clone();
+        Cholesky::new(&model.s).unwrap().solve_in_place(&mut exact);
+        assert!(
+            rel_diff(&out.x, &exact) < 1e-8,
+            "{}",
+            rel_diff(&out.x, &exact)
+        );
+        counts.push(out.cycles);
+    }
+    // Below the rounding floor: an error, after a few stagnating cycles, not a hang.
+    let h = square_hierarchy(4, 3);
+    let model = bench_model(h.finest(), Some(0.0), Foundation::Lumped);
+    let e = poisson_solve(&model.s, &model.d, &h, &model.dofs, 1e-30, None, 10_000).unwrap_err();
+    assert!(e.to_string().contains("V-cycles"), "{e}");
+    // The asymptotic rate of a V(1,1)-cycle is about 0.27 in the maximum norm.
+    let (lo, hi) = (counts.iter().min().unwrap(), counts.iter().max().unwrap());
+    assert!(hi - lo <= 4 && *hi <= 24, "{counts:?}");
+}
+
+fn agree(h: Option<f64>, foundation: Foundation) {
+    let hier = square_hierarchy(4, 4); // 32 × 32
+    let model = bench_model(hier.finest(), h, foundation);
+    let reference = active_set::solve(&model, &settings(1e-11), &mut Silent).unwrap();
+    let mg = crate::solve::solve(&model, Some(&hier), &settings(1e-11), &mut Silent).unwrap();
+    assert_eq!(mg.method, Method::Multigrid);
+    let d = rel_diff(&mg.u, &reference.u);
+    assert!(d < 1e-8, "{foundation:?} {h:?}: {d}");
+    assert!(mg.certificate.kkt() <= 1e-11);
+    // J decreases monotonically (to rounding).
+    for w in mg.history.windows(2) {
+        assert!(
+            w[1].energy <= w[0].energy + 1e-13 * w[0].energy.abs(),
+            "{} > {}",
+            w[1].energy,
+            w[0].energy
+        );
+    }
+    let states = model.states(&mg.u);
+    assert!(states.contains(&1) || h.is_none());
+}
+
+#[test]
+fn tnnmg_agrees_with_active_set_consistent() {
+    agree(Some(1000.0), Foundation::Consistent);
+}
+
+#[test]
+fn tnnmg_agrees_with_active_set_lumped() {
+    agree(Some(1000.0), Foundation::Lumped);
+}
+
+#[test]
+fn tnnmg_agrees_with_active_set_rigid() {
+    agree(None, Foundation::Consistent);
+}
+
+#[test]
+fn tnnmg_without_nested_iteration_converges_from_zero() {
+    let hier = square_hierarchy(4, 4);
+    for (h, f) in [
+        (Some(1000.0), Foundation::Consistent),
+        (Some(1000.0), Foundation::Lumped),
+        (None, Foundation::Lumped),
+    ] {
+        let model = bench_model(hier.finest(), h, f);
+        let opts = Options {
+            nested: false,
+            ..Options::default()
+        };
+        let (sol, rep) = solve_with(&model, &hier, &settings(1e-10), &opts, &mut Silent).unwrap();
+        assert!(sol.certificate.kkt() <= 1e-10, "{f:?} {h:?}");
+        assert_eq!(rep.levels.len(), 1);
+        assert!(sol.iterations < 40, "{f:?} {h:?}: {}", sol.iterations);
+        for w in sol.history.windows(2) {
+            assert!(w[1].energy <= w[0].energy + 1e-13 * w[0].energy.abs());
+        }
+    }
+}
+
+#[test]
+fn iteration_counts_do_not_grow_under_refinement() {
+    for (h, f) in [
+        (Some(1000.0), Foundation::Consistent),
+        (Some(1000.0), Foundation::Lumped),
+        (None, Foundation::Lumped),
+    ] {
+        let mut counts = Vec::new();
+        for levels in 4..=7 {
+            // 16 × 16 ... 128 × 128 from a 2 × 2 coarse grid.
+            let hier = square_hierarchy(2, levels);
+            let model = bench_model(hier.finest(), h, f);
+            let sol = solve(&model, &hier, &settings(1e-10), &mut Silent).unwrap();
+            counts.push(sol.iterations);
+        }
+        let (lo, hi) = (counts.iter().min().unwrap(), counts.iter().max().unwrap());
+        assert!(hi - lo <= 2, "{f:?} {h:?}: {counts:?}");
+    }
+}
+
+#[test]
+fn a_hierarchy_of_another_mesh_is_an_error() {
+    let hier = square_hierarchy(4, 3);
+    let other = square_hierarchy(3, 3);
+    let model = bench_model(hier.finest(), Some(1000.0), Foundation::Lumped);
+    let e = solve(&model, &other, &settings(1e-10), &mut Silent).unwrap_err();
+    assert!(e.to_string().contains("finest level"), "{e}");
+    // A hierarchy with a broken refinement relation.
+    let mut broken = hier.clone();
+    broken.refinements[1].parents.pop();
+    let e = solve(&model, &broken, &settings(1e-10), &mut Silent).unwrap_err();
+    assert!(e.to_string().contains("refinement"), "{e}");
+    let mut broken = hier.clone();
+    broken.refinements[0].parents[3] = [10_000, 0];
+    let e = solve(&model, &broken, &settings(1e-10), &mut Silent).unwrap_err();
+    assert!(e.to_string().contains("parent"), "{e}");
+    let mut broken = hier;
+    broken.refinements.pop();
+    assert!(solve(&model, &broken, &settings(1e-10), &mut Silent).is_err());
+}
+
+#[test]
+fn one_level_is_a_direct_truncated_newton() {
+    let hier = square_hierarchy(16, 1);
+    let model = bench_model(hier.finest(), Some(1000.0), Foundation::Consistent);
+    let sol = solve(&model, &hier, &settings(1e-11), &mut Silent).unwrap();
+    let reference = active_set::solve(&model, &settings(1e-11), &mut Silent).unwrap();
+    assert!(rel_diff(&sol.u, &reference.u) < 1e-8);
+}
+
+#[test]
+#[ignore]
+fn print_rates() {
+    for nu in [(1, 1), (2, 2), (2, 1), (3, 3)] {
+        for levels in [3, 5, 6] {
+            let h = square_hierarchy(4, levels);
+            let model = bench_model(h.finest(), Some(0.0), Foundation::Lumped);
+            let lv = Levels::new(&h, &model.dofs, model.s.pattern.clone()).unwrap();
+            let mut mg = Multigrid::new(&lv, lv.len() - 1);
+            mg.smoothing = nu;
+            mg.update(&model.s, None).unwrap();
+            let mut x = vec![0.0; model.n()];
+            let mut r = vec![0.0; model.n()];
+            let mut rates = vec![];
+            let mut last = norm_inf(&model.d);
+            for _ in 0..12 {
+                mg.v_cycle(&model.s, &mut x, &model.d);
+                cycle::residual(&model.s, &x, &model.d, &mut r);
+                let n = norm_inf(&r);
+                rates.push(format!("{:.3}", n / last));
+                last = n;
+            }
+            println!("{nu:?} {levels}: {}", rates.join(" "));
+        }
+    }
+}
+
+#[test]
+#[ignore]
+fn print_counts() {
+    for (h, f) in [
+        (Some(1000.0), Foundation::Consistent),
+        (Some(1000.0), Foundation::Lumped),
+        (None, Foundation::Lumped),
+    ] {
+        for nested in [true, false] {
+            for levels in 3..=7 {
+                let hier = square_hierarchy(2, levels);
+                let model = bench_model(hier.finest(), h, f);
+                let opts = Options {
+                    nested,
+                    ..Options::default()
+                };
+                let (sol, rep) =
+                    solve_with(&model, &hier, &settings(1e-10), &opts, &mut Silent).unwrap();
+                let its: Vec<usize> = rep.levels.iter().map(|l| l.iterations).collect();
+                let res: Vec<String> = sol
+                    .history
+                    .iter()
+                    .map(|r| format!("{:.0e}", r.residual))
+                    .collect();
+                println!(
+                    "{f:?} {h:?} nested={nested} n={}: {its:?} {}",
+                    2 << (levels - 1),
+                    res.join(" ")
+                );
+            }
+        }
+    }
+}
+
+#[test]
+#[ignore]
+fn print_options() {
+    let combos: Vec<(&str, Options)> = vec![
+        ("default", Options::default()),
+        (
+            "ntol 1e-8",
+            Options {
+                nested_tolerance: 1e-8,
+                ..Options::default()
+            },
+        ),
+        (
+            "ntol 1e-4",
+            Options {
+                nested_tolerance: 1e-4,
+                ..Options::default()
+            },
+        ),
+        (
+            "ntol 1e-3",
+            Options {
+                nested_tolerance: 1e-3,
+                ..Options::default()
+            },
+        ),
+        (
+            "V(2,2)",
+            Options {
+                smoothing: (2, 2),
+                ..Options::default()
+            },
+        ),
+        (
+            "2 cycles",
+            Options {
+                cycles: 2,
+                ..Options::default()
+            },
+        ),
+        (
+            "pre 2",
+            Options {
+                presmoothing: 2,
+                ..Options::default()
+            },
+        ),
+        (
+            "pre 0",
+            Options {
+                presmoothing: 0,
+                ..Options::default()
+            },
+        ),
+    ];
+    for (h, f) in [
+        (Some(1000.0), Foundation::Consistent),
+        (Some(1000.0), Foundation::Lumped),
+        (None, Foundation::Lumped),
+    ] {
+        for (name, opts) in &combos {
+            let mut line = format!("{f:?} {h:?} {name}:");
+            for levels in [5, 7] {
+                let hier = square_hierarchy(2, levels);
+                let model = bench_model(hier.finest(), h, f);
+                match solve_with(&model, &hier, &settings(1e-10), opts, &mut Silent) {
+                    Ok((_, rep)) => {
+                        let its: Vec<usize> = rep.levels.iter().map(|l| l.iterations).collect();
+                        line += &format!(" {its:?}");
+                    }
+                    Err(e) => line += &format!(" {e}"),
+                }
+            }
+            println!("{line}");
+        }
+    }
+}
+
+#[test]
+fn fused_newton_system_is_the_active_set_system() {
+    use crate::solve::active_set::{fill_truncated_hessian, piece_gradient};
+    let hier = square_hierarchy(4, 3);
+    for (h, f) in [
+        (Some(1000.0), Foundation::Consistent),
+        (Some(1000.0), Foundation::Lumped),
+        (None, Foundation::Lumped),
+    ] {
+        let model = bench_model(hier.finest(), h, f);
+        // An iterate with clear, touching and penetrating vertices.
+        let mut v: Vec<f64> = (0..model.n())
+            .map(|i| model.phi[i] + 0.05 * ((i as f64) * 0.7).sin())
+            .collect();
+        for i in (0..model.n()).step_by(5) {
+            v[i] = model.phi[i];
+        }
+        if h.is_none() {
+            for (x, p) in v.iter_mut().zip(&model.phi) {
+                *x = x.min(*p);
+            }
+        }
+        let st = NewtonStates::of(&model, &v);
+        let mut reference = Csr::zeros(model.s.pattern.clone());
+        fill_truncated_hessian(&model, &st, &mut reference);
+        let (g_ref, r_ref) = piece_gradient(&model, &v, &st);
+        let mut a = Csr::zeros(model.s.pattern.clone());
+        let (mut g, mut r) = (vec![0.0; model.n()], vec![0.0; model.n()]);
+        newton_system(&model, &v, &st, &mut a, None, &mut g, &mut r);
+        for i in 0..model.n() {
+            assert!((g[i] - g_ref[i]).abs() < 1e-14 && (r[i] - r_ref[i]).abs() < 1e-14);
+            for j in 0..model.n() {
+                // The same matrix, except that truncated rows are zero instead of identity.
+                let expect = if st.truncated[i] {
+                    0.0
+                } else {
+                    reference.get(i, j)
+                };
+                assert_eq!(a.get(i, j), expect, "{f:?} ({i}, {j})");
+            }
+        }
+    }
+}
+
+#[test]
+fn block_gauss_seidel_keeps_the_rate_and_ignores_the_thread_count() {
+    // 255² > GS_BLOCK unknowns: the fine level is smoothed block-parallel.
+    let h = square_hierarchy(4, 7);
+    let model = bench_model(h.finest(), Some(0.0), Foundation::Lumped);
+    assert!(model.n() > cycle::GS_BLOCK);
+    let run = |threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        pool.install(|| {
+            poisson_solve(&model.s, &model.d, &h, &model.dofs, 1e-10, None, 50).unwrap()
+        })
+    };
+    let one = run(1);
+    let two = run(3);
+    assert_eq!(one.x, two.x);
+    assert!(one.cycles <= 24, "{}", one.cycles);
+}
+
+#[test]
+#[ignore]
+fn print_big_poisson() {
+    for levels in [10] {
+        let h = if levels == 9 {
+            square_hierarchy(4, levels)
+        } else {
+            crate::bench::mesh(1024).unwrap()
+        };
+        let model = bench_model(h.finest(), Some(0.0), Foundation::Lumped);
+        let lv = Levels::new(&h, &model.dofs, model.s.pattern.clone()).unwrap();
+        let mut mg = Multigrid::new(&lv, lv.len() - 1);
+        mg.update(&model.s, None).unwrap();
+        let mut x = vec![0.0; model.n()];
+        let mut r = vec![0.0; model.n()];
+        let mut rates = vec![];
+        let mut last = norm_inf(&model.d);
+        for _ in 0..40 {
+            mg.v_cycle(&model.s, &mut x, &model.d);
+            cycle::residual(&model.s, &x, &model.d, &mut r);
+            let n = norm_inf(&r);
+            rates.push(format!("{:.3}({:.0e})", n / last, n / norm_inf(&model.d)));
+            last = n;
+        }
+        println!("{levels}: {}", rates.join(" "));
+    }
+}
+
+#[test]
+#[ignore]
+fn print_bench_poisson() {
+    let h = crate::bench::mesh(1024).unwrap();
+    let model = crate::bench::model(h.finest(), Foundation::Lumped).unwrap();
+    let out = poisson_solve(
+        &model.s,
+        &model.d,
+        &h,
+        &model.dofs,
+        1e-10,
+        Some(model.force_scale()),
+        200,
+    )
+    .unwrap();
+    println!("cycles {}", out.cycles);
+}

@@ -1,0 +1,335 @@
+//! Grid transfer between consecutive levels of a [`Hierarchy`], over the *unknowns* (the
+//! interior vertices, SPEC §2), and the Galerkin coarse operator `A_c = Pᵀ A P`.
+//!
+//! The mesh refinement says that fine vertex `v` carries `½(c[a] + c[b])` of a coarse P1
+//! function (`a = b` when `v` sits on a coarse vertex). Restricted to unknowns, parents on
+//! the boundary ∂Ω are dropped (the coarse function vanishes there), so every fine unknown
+//! has at most two coarse parents with weights ½ (or one with weight 1). P is stored by
+//! rows (fine → parents) for prolongation and by columns (coarse → children) for the
+//! restriction `Pᵀ` and for the Galerkin product, so that every coarse entry is a sum in a
+//! fixed order: results never depend on the number of threads.
+
+use crate::mesh::refine::Refinement;
+use crate::mesh::DofMap;
+use crate::sparse::{Csr, Pattern};
+use crate::{Error, Result};
+use rayon::prelude::*;
+use std::sync::Arc;
+
+/// Below this many rows, loops run serially (threads cost more than they save).
+pub(crate) const PAR_ROWS: usize = 16_384;
+
+/// The prolongation `P` from a coarse level's unknowns to a fine level's unknowns.
+#[derive(Debug, Clone)]
+pub struct Transfer {
+    /// Number of coarse unknowns (columns of P).
+    pub n_coarse: usize,
+    /// Per fine unknown: its (up to) two coarse parents. A missing second parent repeats
+    /// the first with weight 0, so that loops need no branch; a fine unknown with no
+    /// interior parent at all has weights `[0, 0]`.
+    pub parents: Vec<[u32; 2]>,
+    /// The weights of `parents` (½ and ½, or 1 and 0, or 0 where a parent was dropped).
+    pub weights: Vec<[f64; 2]>,
+    /// Columns of P: the children of coarse unknown `I` are
+    /// `children[child_ptr[I]..child_ptr[I + 1]]`, in increasing order.
+    pub child_ptr: Vec<usize>,
+    /// Fine unknowns, grouped by coarse parent.
+    pub children: Vec<u32>,
+    /// `P[child, I]` for every entry of `children`.
+    pub child_weights: Vec<f64>,
+}
+
+impl Transfer {
+    /// P between the unknowns of two consecutive levels. `refinement.parents` must have one
+    /// entry per fine vertex, each naming coarse vertices; anything else is an error.
+    pub fn new(refinement: &Refinement, coarse: &DofMap, fine: &DofMap) -> Result<Transfer> {
+        let n_cv = coarse.dof.len();
+        if refinement.parents.len() != fine.dof.len() {
+            return Err(Error::Mesh(format!(
+                "the refinement relation names parents for {} vertices, but the finer level \
+                 has {} vertices",
+                refinement.parents.len(),
+                fine.dof.len()
+            )));
+        }
+        if let Some((v, p)) = refinement
+            .parents
+            .iter()
+            .enumerate()
+            .find(|(_, p)| p[0] as usize >= n_cv || p[1] as usize >= n_cv)
+        {
+            return Err(Error::Mesh(format!(
+                "vertex {v} of the finer level has parent vertices ({}, {}), but the \
+                 coarser level has only {n_cv} vertices",
+                p[0], p[1]
+            )));
+        }
+        let n_fine = fine.len();
+        let mut parents = Vec::with_capacity(n_fine);
+        let mut weights = Vec::with_capacity(n_fine);
+        for &v in &fine.vertex {
+            let [a, b] = refinement.parents[v as usize];
+            let (da, db) = (coarse.dof[a as usize], coarse.dof[b as usize]);
+            let (p, w) = if a == b {
+                match da {
+                    Some(i) => ([i, i], [1.0, 0.0]),
+                    None => ([0, 0], [0.0, 0.0]),
+                }
+            } else {
+                match (da, db) {
+                    (Some(i), Some(j)) => ([i, j], [0.5, 0.5]),
+                    (Some(i), None) => ([i, i], [0.5, 0.0]),
+                    (None, Some(j)) => ([j, j], [0.5, 0.0]),
+                    (None, None) => ([0, 0], [0.0, 0.0]),
+                }
+            };
+            parents.push(p);
+            weights.push(w);
+        }
+        // Columns: counting sort by parent (children stay in increasing fine order).
+        let n_coarse = coarse.len();
+        let mut child_ptr = vec![0usize; n_coarse + 1];
+        for (p, w) in parents.iter().zip(&weights) {
+            for s in 0..2 {
+                if w[s] != 0.0 {
+                    child_ptr[p[s] as usize + 1] += 1;
+                }
+            }
+        }
+        for i in 0..n_coarse {
+            child_ptr[i + 1] += child_ptr[i];
+        }
+        let mut fill = child_ptr.clone();
+        let mut children = vec![0u32; child_ptr[n_coarse]];
+        let mut child_weights = vec![0.0; child_ptr[n_coarse]];
+        for (v, (p, w)) in parents.iter().zip(&weights).enumerate() {
+            for s in 0..2 {
+                if w[s] != 0.0 {
+                    let k = &mut fill[p[s] as usize];
+                    children[*k] = v as u32;
+                    child_weights[*k] = w[s];
+                    *k += 1;
+                }
+            }
+        }
+        Ok(Transfer {
+            n_coarse,
+            parents,
+            weights,
+            child_ptr,
+            children,
+            child_weights,
+        })
+    }
+
+    /// Number of fine unknowns (rows of P).
+    pub fn n_fine(&self) -> usize {
+        self.parents.len()
+    }
+
+    /// `(P x_c)_v`.
+    #[inline]
+    fn row(&self, v: usize, xc: &[f64]) -> f64 {
+        let [a, b] = self.parents[v];
+        let [wa, wb] = self.weights[v];
+        wa * xc[a as usize] + wb * xc[b as usize]
+    }
+
+    /// `x_f = P x_c`.
+    pub fn prolongate(&self, xc: &[f64], xf: &mut [f64]) {
+        if xc.is_empty() {
+            xf.iter_mut().for_each(|x| *x = 0.0);
+            return;
+        }
+        par_rows(xf, |v, x| *x = self.row(v, xc));
+    }
+
+    /// `x_f += P x_c`.
+    pub fn prolongate_add(&self, xc: &[f64], xf: &mut [f64]) {
+        if xc.is_empty() {
+            return;
+        }
+        par_rows(xf, |v, x| *x += self.row(v, xc));
+    }
+
+    /// `r_c = Pᵀ r_f`.
+    pub fn restrict(&self, rf: &[f64], rc: &mut [f64]) {
+        par_rows(rc, |i, r| {
+            let mut s = 0.0;
+            for k in self.child_ptr[i]..self.child_ptr[i + 1] {
+                s += self.child_weights[k] * rf[self.children[k] as usize];
+            }
+            *r = s;
+        });
+    }
+
+    /// The coarse unknown sitting on the same vertex as each fine unknown, inverted: for
+    /// every coarse unknown, the fine unknown at the same place (the child of weight 1).
+    pub fn injection(&self) -> Vec<u32> {
+        (0..self.n_coarse)
+            .map(|i| {
+                (self.child_ptr[i]..self.child_ptr[i + 1])
+                    .find(|&k| self.child_weights[k] == 1.0)
+                    .map_or(self.children[self.child_ptr[i]], |k| self.children[k])
+            })
+            .collect()
+    }
+
+    /// The sparsity pattern of `Pᵀ A P` for A on `fine` (the symbolic Galerkin product,
+    /// computed once per hierarchy). The diagonal is always stored.
+    pub fn galerkin_pattern(&self, fine: &Pattern) -> Pattern {
+        let n_coarse = self.n_coarse;
+        // `seen[j] == i` marks column j as already in row i (no sort of duplicates).
+        let row = |seen: &mut Vec<u32>, i: usize| {
+            let mut r: Vec<u32> = Vec::with_capacity(16);
+            r.push(i as u32);
+            seen[i] = i as u32;
+            for &v in &self.children[self.child_ptr[i]..self.child_ptr[i + 1]] {
+                let v = v as usize;
+                for &w in &fine.col[fine.row_ptr[v]..fine.row_ptr[v + 1]] {
+                    let (p, wt) = (self.parents[w as usize], self.weights[w as usize]);
+                    for s in 0..2 {
+                        if wt[s] != 0.0 && seen[p[s] as usize] != i as u32 {
+                            seen[p[s] as usize] = i as u32;
+                            r.push(p[s]);
+                        }
+                    }
+                }
+            }
+            r.sort_unstable();
+            r
+        };
+        let rows: Vec<Vec<u32>> = (0..n_coarse)
+            .into_par_iter()
+            .with_min_len(1024)
+            .map_init(|| vec![u32::MAX; n_coarse], row)
+            .collect();
+        let mut row_ptr = Vec::with_capacity(rows.len() + 1);
+        row_ptr.push(0);
+        let mut total = 0;
+        for r in &rows {
+            total += r.len();
+            row_ptr.push(total);
+        }
+        let mut col = Vec::with_capacity(total);
+        for r in rows {
+            col.extend_from_slice(&r);
+        }
+        Pattern { row_ptr, col }
+    }
+
+    /// The numeric Galerkin product: fills the rows of `coarse` (on
+    /// [`Transfer::galerkin_pattern`] of `fine`'s pattern) with `Pᵀ A P`, only the rows
+    /// flagged in `dirty` when given. Every entry is summed in a fixed order (children of
+    /// the row, then the fine row's entries), whatever the number of threads.
+    pub fn galerkin_values(&self, fine: &Csr, coarse: &mut Csr, dirty: Option<&[bool]>) {
+        let n_coarse = self.n_coarse;
+        let cpat = coarse.pattern.clone();
+        let fpat = &fine.pattern;
+        let row = |i: usize, vals: &mut [f64], marker: &mut [u32]| {
+            let cols = &cpat.col[cpat.row_ptr[i]..cpat.row_ptr[i + 1]];
+            for (k, &j) in cols.iter().enumerate() {
+                marker[j as usize] = k as u32;
+                vals[k] = 0.0;
+            }
+            for c in self.child_ptr[i]..self.child_ptr[i + 1] {
+                let v = self.children[c] as usize;
+                let wv = self.child_weights[c];
+                let (s, e) = (fpat.row_ptr[v], fpat.row_ptr[v + 1]);
+                for (&w, &a) in fpat.col[s..e].iter().zip(&fine.val[s..e]) {
+                    if a == 0.0 {
+                        continue;
+                    }
+                    let a = a * wv;
+                    let w = w as usize;
+                    let [p0, p1] = self.parents[w];
+                    let [w0, w1] = self.weights[w];
+                    if w0 != 0.0 {
+                        vals[marker[p0 as usize] as usize] += a * w0;
+                        // A dropped second parent repeats the first with weight 0.
+                        vals[marker[p1 as usize] as usize] += a * w1;
+                    }
+                }
+            }
+        };
+        let chunks = row_chunks(&cpat, &mut coarse.val, 512);
+        let work = |marker: &mut Vec<u32>, (start, vals): (usize, &mut [f64])| {
+            let mut off = 0;
+            let end = (start + 512).min(n_coarse);
+            for i in start..end {
+                let len = cpat.row_ptr[i + 1] - cpat.row_ptr[i];
+                if dirty.is_none_or(|d| d[i]) {
+                    row(i, &mut vals[off..off + len], marker);
+                }
+                off += len;
+            }
+        };
+        if n_coarse >= PAR_ROWS / 4 {
+            chunks
+                .into_par_iter()
+                .for_each_init(|| vec![0u32; n_coarse], work);
+        } else {
+            let mut marker = vec![0u32; n_coarse];
+            for c in chunks {
+                work(&mut marker, c);
+            }
+        }
+    }
+
+    /// Coarse rows to recompute when the fine rows flagged `dirty_fine` changed.
+    pub fn coarse_dirty(&self, dirty_fine: &[bool], dirty_coarse: &mut [bool]) {
+        par_rows(dirty_coarse, |i, d| {
+            *d = self.children[self.child_ptr[i]..self.child_ptr[i + 1]]
+                .iter()
+                .any(|&v| dirty_fine[v as usize]);
+        });
+    }
+}
+
+/// Runs `f(i, &mut x[i])` over all rows, in parallel for long vectors.
+#[inline]
+pub(crate) fn par_rows<T: Send>(x: &mut [T], f: impl Fn(usize, &mut T) + Sync + Send) {
+    if x.len() >= PAR_ROWS {
+        x.par_iter_mut()
+            .enumerate()
+            .with_min_len(4096)
+            .for_each(|(i, xi)| f(i, xi));
+    } else {
+        for (i, xi) in x.iter_mut().enumerate() {
+            f(i, xi);
+        }
+    }
+}
+
+/// Splits the value array of a matrix on `pattern` into blocks of `rows` consecutive rows:
+/// `(first row, values of those rows)`, so that blocks can be filled in parallel.
+pub(crate) fn row_chunks<'a>(
+    pattern: &Pattern,
+    val: &'a mut [f64],
+    rows: usize,
+) -> Vec<(usize, &'a mut [f64])> {
+    let n = pattern.n();
+    let mut out = Vec::with_capacity(n / rows + 1);
+    let mut rest = val;
+    let mut start = 0;
+    while start < n {
+        let end = (start + rows).min(n);
+        let len = pattern.row_ptr[end] - pattern.row_ptr[start];
+        let (head, tail) = rest.split_at_mut(len);
+        out.push((start, head));
+        rest = tail;
+        start = end;
+    }
+    out
+}
+
+/// The Galerkin patterns of a chain of transfers, coarsest first, ending with `finest`.
+pub fn galerkin_patterns(transfers: &[Transfer], finest: Arc<Pattern>) -> Vec<Arc<Pattern>> {
+    let mut pats = vec![finest];
+    for t in transfers.iter().rev() {
+        let p = t.galerkin_pattern(pats.last().expect("at least the finest"));
+        pats.push(Arc::new(p));
+    }
+    pats.reverse();
+    pats
+}
