@@ -740,6 +740,7 @@ fn write_csv(path: &Path, s: &Study) -> Result<()> {
         ("assembly_s", f(&|_, r| Some(r.assembly_seconds))),
         ("solve_s", f(&|_, r| Some(r.solve_seconds))),
         ("error_s", f(&|_, r| Some(r.error_seconds))),
+        ("epsilon", f(&|_, r| r.epsilon)),
     ];
     write_csv_columns(path, &columns)
 }

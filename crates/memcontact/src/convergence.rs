@@ -128,6 +128,8 @@ pub struct LevelResult {
     pub contact_radius_error: Option<f64>,
     /// `|A_h − A|` when the target knows its contact area `A`.
     pub contact_area_error: Option<f64>,
+    /// The mollifier radius ε used on this level (mollified sampling only).
+    pub epsilon: Option<f64>,
     /// The method that solved the level.
     pub method: Method,
     /// Its iterations.
@@ -243,6 +245,7 @@ pub fn run(
             contact,
             contact_radius_error,
             contact_area_error,
+            epsilon: model.epsilon,
             method: solution.method,
             iterations: solution.iterations,
             kkt: solution.certificate.kkt(),
