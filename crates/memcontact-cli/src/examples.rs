@@ -38,6 +38,24 @@ const EXAMPLES: &[Example] = &[
         )],
     },
     Example {
+        name: "disk-rigid",
+        about: "the disc of SPEC §4 on a rigid obstacle (the classical obstacle problem; exact solution known)",
+        files: &[("disk-rigid.toml", include_str!("../../../examples/disk-rigid.toml"))],
+    },
+    Example {
+        name: "disk-step",
+        about: "a disc over a step-shaped obstacle (discontinuous φ): nodal vs mollified sampling",
+        files: &[("disk-step.toml", include_str!("../../../examples/disk-step.toml"))],
+    },
+    Example {
+        name: "manufactured-square",
+        about: "a manufactured solution on the square (varying h and φ) for convergence studies",
+        files: &[(
+            "manufactured-square.toml",
+            include_str!("../../../examples/manufactured-square.toml"),
+        )],
+    },
+    Example {
         name: "gmsh-disk",
         about: "a Gmsh mesh with two physical surfaces (foam, soil) of different stiffness",
         files: &[

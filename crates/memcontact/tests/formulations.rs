@@ -81,9 +81,9 @@ fn all_agree(name: &str, model: &Model) -> Solution {
     let x = q.multipliers.as_ref().expect("the QP returns multipliers");
     let r = model.residual(&q.u);
     let scale = model.force_scale();
-    for i in 0..model.n() {
-        assert!((r[i] + x.x1[i]).abs() <= 1e-8 * scale, "{name}: 2e row {i}");
-        assert!(x.x1[i] >= -1e-9 * scale && x.x2[i] >= -1e-9 * scale);
+    for (i, ((ri, x1), x2)) in r.iter().zip(&x.x1).zip(&x.x2).enumerate() {
+        assert!((ri + x1).abs() <= 1e-8 * scale, "{name}: 2e row {i}");
+        assert!(*x1 >= -1e-9 * scale && *x2 >= -1e-9 * scale);
     }
     a
 }
