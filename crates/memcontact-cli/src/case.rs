@@ -5,7 +5,6 @@ use anyhow::{anyhow, bail, Context, Result};
 use memcontact::field::{Field, Stiffness};
 use memcontact::mesh::generate::{self, Diagonal, PolygonSpec, RectangleSpec};
 use memcontact::mesh::refine::Hierarchy;
-use memcontact::mesh::Mesh;
 use memcontact::model::{Foundation, Sampling};
 use memcontact::solve::{Method, Settings};
 use serde::Deserialize;
@@ -310,7 +309,9 @@ impl Case {
     pub fn build_mesh(&self) -> Result<(Hierarchy, Vec<String>)> {
         let m = &self.mesh;
         let mut warnings = Vec::new();
-        let given = |name: &str, v: bool| if v { Some(name) } else { None };
+        fn given(name: &'static str, v: bool) -> Option<&'static str> {
+            v.then_some(name)
+        }
         let rect_keys = [
             given("x0", m.x0.is_some()),
             given("y0", m.y0.is_some()),
@@ -406,16 +407,14 @@ impl Case {
             ),
         };
         if m.refine > 12 {
-            bail!("mesh.refine = {} is too large (each refinement multiplies the triangles by 4)", m.refine);
+            bail!(
+                "mesh.refine = {} is too large (each refinement multiplies the triangles by 4)",
+                m.refine
+            );
         }
         if m.refine > 0 {
             hierarchy.refine(m.refine);
         }
         Ok((hierarchy, warnings))
     }
-}
-
-/// The finest mesh of a hierarchy, by value-free reference.
-pub fn finest(h: &Hierarchy) -> &Mesh {
-    h.finest()
 }

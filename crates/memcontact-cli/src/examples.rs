@@ -58,7 +58,10 @@ pub fn run(name: Option<&str>, dir: &Path, force: bool) -> Result<()> {
     };
     let Some(example) = EXAMPLES.iter().find(|e| e.name == name) else {
         let names: Vec<&str> = EXAMPLES.iter().map(|e| e.name).collect();
-        bail!("no example named \"{name}\" (examples: {})", names.join(", "));
+        bail!(
+            "no example named \"{name}\" (examples: {})",
+            names.join(", ")
+        );
     };
     std::fs::create_dir_all(dir)
         .with_context(|| format!("cannot create directory {}", dir.display()))?;

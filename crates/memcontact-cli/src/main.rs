@@ -3,7 +3,9 @@
 
 mod case;
 mod commands;
+mod convergence;
 mod examples;
+mod help;
 mod output;
 mod plot;
 
@@ -27,6 +29,7 @@ struct Cli {
 #[derive(Subcommand)]
 enum Command {
     /// Solve a case and write solution.vtu, nodes.csv and summary.json.
+    #[command(after_long_help = help::CASE_KEYS)]
     Solve {
         /// The case file (TOML).
         case: PathBuf,
@@ -41,6 +44,7 @@ enum Command {
         quiet: bool,
     },
     /// Validate a case and report its mesh, without solving.
+    #[command(after_long_help = help::CASE_KEYS)]
     Check {
         /// The case file (TOML).
         case: PathBuf,
@@ -48,6 +52,10 @@ enum Command {
         #[arg(long = "set", value_name = "KEY=VALUE")]
         sets: Vec<String>,
     },
+    /// Measure the convergence of the discrete solution under uniform refinement: errors
+    /// against the case's [exact] solution, rates, convergence.csv and convergence.png
+    /// (or, with --h-sweep, the distance to the rigid limit).
+    Convergence(convergence::Args),
     /// List the example cases, or write one (and any mesh it needs) to a directory.
     Example {
         /// The example to write; omit to list them.
@@ -71,6 +79,7 @@ fn main() -> ExitCode {
             quiet,
         } => commands::solve(&case, &output, &sets, quiet),
         Command::Check { case, sets } => commands::check(&case, &sets),
+        Command::Convergence(args) => convergence::run(&args),
         Command::Example { name, dir, force } => examples::run(name.as_deref(), &dir, force),
     };
     match result {

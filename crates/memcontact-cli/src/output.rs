@@ -162,9 +162,15 @@ fn human(case: &Case, run: &Run, t: &Totals, t_write: f64, total: f64, out: &Pat
         o,
         "  model        t = {}, foundation {}, sampling {}{}",
         m.tension,
-        if m.is_rigid() { "rigid" } else { m.foundation.name() },
+        if m.is_rigid() {
+            "rigid"
+        } else {
+            m.foundation.name()
+        },
         case.obstacle.sampling,
-        m.epsilon.map(|e| format!(" (ε = {e:.4e})")).unwrap_or_default()
+        m.epsilon
+            .map(|e| format!(" (ε = {e:.4e})"))
+            .unwrap_or_default()
     );
     let _ = writeln!(
         o,

@@ -5,9 +5,6 @@
 //! `assets/` (no system font is needed); images are rendered in memory, encoded as PNG and
 //! written atomically, so a failure never leaves a half-written file.
 
-// The CLI commands that call these functions are wired separately.
-#![allow(dead_code)]
-
 use anyhow::{bail, Context, Result};
 use plotters::coord::Shift;
 use plotters::element::DashedPathElement;

@@ -39,7 +39,13 @@ fn summary(dir: &Path) -> serde_json::Value {
 fn solves_the_disk_example_and_writes_consistent_files() {
     let out = tmp("disk");
     let case = examples().join("disk.toml");
-    let o = run(&["solve", case.to_str().unwrap(), "-o", out.to_str().unwrap(), "-q"]);
+    let o = run(&[
+        "solve",
+        case.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+        "-q",
+    ]);
     assert!(o.status.success(), "{}", text(&o));
     assert!(text(&o).contains("certificate"));
     let s = summary(&out);
@@ -92,9 +98,20 @@ fn solves_the_disk_example_and_writes_consistent_files() {
     }
     assert!(rows.iter().any(|r| r[7] == 1.0) && rows.iter().any(|r| r[7] == -1.0));
     let vtu = std::fs::read_to_string(out.join("solution.vtu"))
-        .or_else(|_| std::fs::read(out.join("solution.vtu")).map(|b| String::from_utf8_lossy(&b).into_owned()))
+        .or_else(|_| {
+            std::fs::read(out.join("solution.vtu"))
+                .map(|b| String::from_utf8_lossy(&b).into_owned())
+        })
         .unwrap();
-    for name in ["\"u\"", "\"phi\"", "\"penetration\"", "\"pressure\"", "\"contact_force\"", "\"state\"", "\"region\""] {
+    for name in [
+        "\"u\"",
+        "\"phi\"",
+        "\"penetration\"",
+        "\"pressure\"",
+        "\"contact_force\"",
+        "\"state\"",
+        "\"region\"",
+    ] {
         assert!(vtu.contains(name), "solution.vtu lacks {name}");
     }
 }
@@ -150,7 +167,13 @@ fn example_lists_and_writes() {
     assert!(d.join("gmsh-disk.toml").exists() && d.join("disk.msh").exists());
     // The written example runs where it was written (paths are relative to the case).
     let out = d.join("out");
-    let o = run(&["solve", d.join("gmsh-disk.toml").to_str().unwrap(), "-o", out.to_str().unwrap(), "-q"]);
+    let o = run(&[
+        "solve",
+        d.join("gmsh-disk.toml").to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+        "-q",
+    ]);
     assert!(o.status.success(), "{}", text(&o));
     assert!(out.join("summary.json").exists());
     let o = run(&["example", "nope"]);
@@ -182,10 +205,19 @@ fn fails_with(name: &str, body: &str, needle: &str) {
     let d = tmp(name);
     let p = case_file(&d, body);
     let out = d.join("out");
-    let o = run(&["solve", p.to_str().unwrap(), "-o", out.to_str().unwrap(), "-q"]);
+    let o = run(&[
+        "solve",
+        p.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+        "-q",
+    ]);
     assert!(!o.status.success(), "{name}: expected a failure");
     let t = text(&o);
-    assert!(t.contains(needle), "{name}: message lacks \"{needle}\": {t}");
+    assert!(
+        t.contains(needle),
+        "{name}: message lacks \"{needle}\": {t}"
+    );
     assert!(!t.contains("panicked"), "{name}: {t}");
     assert!(!out.join("summary.json").exists() && !out.join("nodes.csv").exists());
 }
@@ -194,32 +226,86 @@ fn fails_with(name: &str, body: &str, needle: &str) {
 fn good_case_solves() {
     let d = tmp("good");
     let p = case_file(&d, GOOD);
-    let o = run(&["solve", p.to_str().unwrap(), "-o", d.join("out").to_str().unwrap(), "-q"]);
+    let o = run(&[
+        "solve",
+        p.to_str().unwrap(),
+        "-o",
+        d.join("out").to_str().unwrap(),
+        "-q",
+    ]);
     assert!(o.status.success(), "{}", text(&o));
 }
 
 #[test]
 fn bad_inputs_are_clear_errors() {
     fails_with("toml", "[mesh\ngenerator = 1", "malformed TOML");
-    fails_with("unknown-key", &GOOD.replace("nx = 8", "nx = 8\nnz = 3"), "nz");
-    fails_with("tension", &GOOD.replace("tension = 1.0", "tension = -2.0"), "tension");
-    fails_with("zero-tension", &GOOD.replace("tension = 1.0", "tension = 0"), "tension");
-    fails_with("negative-h", &GOOD.replace("stiffness = 100.0", "stiffness = -5.0"), "negative");
-    fails_with("nan", &GOOD.replace("load = \"8\"", "load = \"sqrt(x - 2)\""), "NaN");
-    fails_with("inf", &GOOD.replace("load = \"8\"", "load = \"1/(x-x)\""), "load");
-    fails_with("parse", &GOOD.replace("load = \"8\"", "load = \"8 * (x\""), "load");
-    fails_with("variable", &GOOD.replace("load = \"8\"", "load = \"8 * z\""), "z");
-    fails_with("method", &format!("{GOOD}[solver]\nmethod = \"magic\""), "magic");
+    fails_with(
+        "unknown-key",
+        &GOOD.replace("nx = 8", "nx = 8\nnz = 3"),
+        "nz",
+    );
+    fails_with(
+        "tension",
+        &GOOD.replace("tension = 1.0", "tension = -2.0"),
+        "tension",
+    );
+    fails_with(
+        "zero-tension",
+        &GOOD.replace("tension = 1.0", "tension = 0"),
+        "tension",
+    );
+    fails_with(
+        "negative-h",
+        &GOOD.replace("stiffness = 100.0", "stiffness = -5.0"),
+        "negative",
+    );
+    fails_with(
+        "nan",
+        &GOOD.replace("load = \"8\"", "load = \"sqrt(x - 2)\""),
+        "NaN",
+    );
+    fails_with(
+        "inf",
+        &GOOD.replace("load = \"8\"", "load = \"1/(x-x)\""),
+        "load",
+    );
+    fails_with(
+        "parse",
+        &GOOD.replace("load = \"8\"", "load = \"8 * (x\""),
+        "load",
+    );
+    fails_with(
+        "variable",
+        &GOOD.replace("load = \"8\"", "load = \"8 * z\""),
+        "z",
+    );
+    fails_with(
+        "method",
+        &format!("{GOOD}[solver]\nmethod = \"magic\""),
+        "magic",
+    );
     fails_with(
         "mesh-file",
-        &GOOD.replace("generator = \"rectangle\"\nnx = 8", "file = \"missing.msh\""),
+        &GOOD.replace(
+            "generator = \"rectangle\"\nnx = 8",
+            "file = \"missing.msh\"",
+        ),
         "missing.msh",
     );
     let d = tmp("broken-msh");
-    std::fs::write(d.join("broken.msh"), "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n3\n1 0 0 0\n").unwrap();
+    std::fs::write(
+        d.join("broken.msh"),
+        "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n3\n1 0 0 0\n",
+    )
+    .unwrap();
     let body = GOOD.replace("generator = \"rectangle\"\nnx = 8", "file = \"broken.msh\"");
     let p = case_file(&d, &body);
-    let o = run(&["solve", p.to_str().unwrap(), "-o", d.join("out").to_str().unwrap()]);
+    let o = run(&[
+        "solve",
+        p.to_str().unwrap(),
+        "-o",
+        d.join("out").to_str().unwrap(),
+    ]);
     assert!(!o.status.success());
     assert!(text(&o).contains("broken.msh"), "{}", text(&o));
     fails_with(

@@ -28,7 +28,7 @@
 
 use crate::exact::ExactSolution;
 use crate::mesh::Mesh;
-use crate::quadrature::{map, DEGREE5};
+use crate::quadrature::{gauss_legendre, map, DEGREE5};
 use crate::{Error, Result};
 use rayon::prelude::*;
 use std::f64::consts::PI;
@@ -249,44 +249,6 @@ fn disk_gap(mesh: &Mesh, exact: &dyn ExactSolution, c: [f64; 2], r: f64) -> Resu
         )));
     }
     Ok(out)
-}
-
-/// Gauss-Legendre points and weights on [-1, 1] (Newton's method on the Legendre
-/// polynomial `P_n`, from the Chebyshev-like initial guesses).
-fn gauss_legendre(n: usize) -> (Vec<f64>, Vec<f64>) {
-    let mut x = vec![0.0; n];
-    let mut w = vec![0.0; n];
-    for i in 0..n {
-        let mut z = (PI * (i as f64 + 0.75) / (n as f64 + 0.5)).cos();
-        for _ in 0..100 {
-            // P_n(z) and P_n'(z) by the three-term recurrence.
-            let (mut p0, mut p1) = (1.0, z);
-            for k in 2..=n {
-                let kf = k as f64;
-                let p2 = ((2.0 * kf - 1.0) * z * p1 - (kf - 1.0) * p0) / kf;
-                p0 = p1;
-                p1 = p2;
-            }
-            let dp = n as f64 * (z * p1 - p0) / (z * z - 1.0);
-            let dz = p1 / dp;
-            z -= dz;
-            if dz.abs() <= 1e-16 {
-                break;
-            }
-        }
-        // P_n'(z) at the final z, for the weight.
-        let (mut p0, mut p1) = (1.0, z);
-        for k in 2..=n {
-            let kf = k as f64;
-            let p2 = ((2.0 * kf - 1.0) * z * p1 - (kf - 1.0) * p0) / kf;
-            p0 = p1;
-            p1 = p2;
-        }
-        let dp = n as f64 * (z * p1 - p0) / (z * z - 1.0);
-        x[i] = z;
-        w[i] = 2.0 / ((1.0 - z * z) * dp * dp);
-    }
-    (x, w)
 }
 
 /// Observed convergence rates `log(e_{k-1}/e_k) / log(l_{k-1}/l_k)` of a sequence of errors

@@ -5,6 +5,7 @@
 //! it. Rows are independent, so they are built in parallel and the result does not depend
 //! on the number of threads.
 
+pub use crate::mesh::VertexTriangles;
 use crate::mesh::{DofMap, Mesh, Point};
 use crate::quadrature::{map, DEGREE5};
 use crate::sparse::{Csr, Pattern};
@@ -113,122 +114,129 @@ impl Element {
     }
 }
 
-/// The triangles around every vertex (the patch `Q_i` of the paper).
-#[derive(Debug, Clone)]
-pub struct VertexTriangles {
-    ptr: Vec<usize>,
-    tri: Vec<u32>,
+/// Collects into `buf` the unknowns sharing a triangle with vertex `v`, sorted and unique.
+fn row_columns(mesh: &Mesh, dofs: &DofMap, adj: &VertexTriangles, v: usize, buf: &mut Vec<u32>) {
+    buf.clear();
+    for &k in adj.of(v) {
+        for &w in &mesh.triangles[k as usize] {
+            if let Some(j) = dofs.dof[w as usize] {
+                buf.push(j);
+            }
+        }
+    }
+    buf.sort_unstable();
+    buf.dedup();
 }
 
-impl VertexTriangles {
-    /// Builds the adjacency of `mesh`.
-    pub fn new(mesh: &Mesh) -> VertexTriangles {
-        let n = mesh.n_vertices();
-        let mut ptr = vec![0usize; n + 1];
-        for t in &mesh.triangles {
-            for &v in t {
-                ptr[v as usize + 1] += 1;
-            }
-        }
-        for i in 0..n {
-            ptr[i + 1] += ptr[i];
-        }
-        let mut fill = ptr.clone();
-        let mut tri = vec![0u32; ptr[n]];
-        for (k, t) in mesh.triangles.iter().enumerate() {
-            for &v in t {
-                tri[fill[v as usize]] = k as u32;
-                fill[v as usize] += 1;
-            }
-        }
-        VertexTriangles { ptr, tri }
+/// Splits `val` into the rows of `pattern`, so that rows can be written in parallel.
+fn split_rows<'a, T>(pattern: &Pattern, mut val: &'a mut [T]) -> Vec<&'a mut [T]> {
+    let mut rows = Vec::with_capacity(pattern.n());
+    for i in 0..pattern.n() {
+        let (head, tail) = val.split_at_mut(pattern.row_ptr[i + 1] - pattern.row_ptr[i]);
+        rows.push(head);
+        val = tail;
     }
-
-    /// The triangles having vertex `v`.
-    #[inline]
-    pub fn of(&self, v: usize) -> &[u32] {
-        &self.tri[self.ptr[v]..self.ptr[v + 1]]
-    }
+    rows
 }
 
 /// The sparsity pattern over unknowns: `(i, j)` is stored when vertices `a_i`, `a_j` share
-/// a triangle. S and the consistent L live on it.
+/// a triangle. S and the consistent L live on it. Two parallel passes (lengths, then
+/// columns) with one scratch buffer per task: no allocation per row.
 pub fn unknowns_pattern(mesh: &Mesh, dofs: &DofMap, adj: &VertexTriangles) -> Pattern {
-    let rows: Vec<Vec<u32>> = dofs
+    let lengths: Vec<usize> = dofs
         .vertex
         .par_iter()
-        .with_min_len(1024)
-        .map(|&v| {
-            let mut r: Vec<u32> = Vec::with_capacity(16);
-            for &k in adj.of(v as usize) {
-                for &w in &mesh.triangles[k as usize] {
-                    if let Some(j) = dofs.dof[w as usize] {
-                        r.push(j);
-                    }
-                }
-            }
-            r.sort_unstable();
-            r.dedup();
-            r
-        })
+        .with_min_len(4096)
+        .map_init(
+            || Vec::with_capacity(32),
+            |buf, &v| {
+                row_columns(mesh, dofs, adj, v as usize, buf);
+                buf.len()
+            },
+        )
         .collect();
-    let mut row_ptr = Vec::with_capacity(rows.len() + 1);
+    let mut row_ptr = Vec::with_capacity(lengths.len() + 1);
     row_ptr.push(0);
     let mut total = 0;
-    for r in &rows {
-        total += r.len();
+    for l in &lengths {
+        total += l;
         row_ptr.push(total);
     }
-    let mut col = Vec::with_capacity(total);
-    for r in rows {
-        col.extend_from_slice(&r);
-    }
-    Pattern { row_ptr, col }
+    let mut pattern = Pattern {
+        row_ptr,
+        col: vec![0; total],
+    };
+    let mut col = std::mem::take(&mut pattern.col);
+    split_rows(&pattern, &mut col)
+        .into_par_iter()
+        .enumerate()
+        .with_min_len(4096)
+        .for_each_init(
+            || Vec::with_capacity(32),
+            |buf, (i, row)| {
+                row_columns(mesh, dofs, adj, dofs.vertex[i] as usize, buf);
+                row.copy_from_slice(buf);
+            },
+        );
+    pattern.col = col;
+    pattern
 }
 
-/// Fills the values of a matrix on `pattern`: entry `(i, j)` is the sum over the
-/// triangles around `a_i` of `local(element, region, a, b)`, where `a`, `b` are the local
-/// indices of `a_i`, `a_j`. Rows are assembled in parallel.
-pub fn assemble_matrix(
+/// Assembles the stiffness matrix `S_ij = t ∫ ∇g_i·∇g_j` and, when `h` is given, the
+/// consistent foundation matrix `L_ij = ∫ h g_i g_j` on `pattern`, in one pass over the rows
+/// (SPEC §2). Entry `(i, j)` sums the element integrals of the triangles around `a_i`; rows
+/// are assembled in parallel and element geometry is computed once per (row, triangle).
+pub fn assemble_stiffness_and_mass(
     mesh: &Mesh,
     dofs: &DofMap,
     adj: &VertexTriangles,
     pattern: &Arc<Pattern>,
-    local: &(dyn Fn(&Element, u32, usize, usize) -> f64 + Sync),
-) -> Csr {
-    let mut m = Csr::zeros(pattern.clone());
-    let row_ptr = &pattern.row_ptr;
-    // Split the value array into rows so that every row is written by one task.
-    let mut rows: Vec<&mut [f64]> = Vec::with_capacity(pattern.n());
-    let mut rest: &mut [f64] = &mut m.val;
-    for i in 0..pattern.n() {
-        let (head, tail) = rest.split_at_mut(row_ptr[i + 1] - row_ptr[i]);
-        rows.push(head);
-        rest = tail;
-    }
-    rows.par_iter_mut()
+    t: f64,
+    h: Option<&dyn Coefficient>,
+) -> (Csr, Option<Csr>) {
+    let mut s = Csr::zeros(pattern.clone());
+    let mut l = h.map(|_| Csr::zeros(pattern.clone()));
+    let s_rows = split_rows(pattern, &mut s.val);
+    let l_rows: Vec<Option<&mut [f64]>> = match &mut l {
+        Some(l) => split_rows(pattern, &mut l.val)
+            .into_iter()
+            .map(Some)
+            .collect(),
+        None => (0..pattern.n()).map(|_| None).collect(),
+    };
+    s_rows
+        .into_par_iter()
+        .zip(l_rows)
         .enumerate()
-        .with_min_len(512)
-        .for_each(|(i, row)| {
+        .with_min_len(1024)
+        .for_each(|(i, (srow, mut lrow))| {
             let v = dofs.vertex[i] as usize;
-            let cols = &pattern.col[row_ptr[i]..row_ptr[i + 1]];
+            let cols = &pattern.col[pattern.row_ptr[i]..pattern.row_ptr[i + 1]];
             for &k in adj.of(v) {
-                let t = mesh.triangles[k as usize];
+                let tri = mesh.triangles[k as usize];
                 let e = Element::of(mesh, k as usize);
                 let region = mesh.regions[k as usize];
-                let a = t
+                let a = tri
                     .iter()
                     .position(|&w| w as usize == v)
                     .expect("v in triangle");
-                for (b, &w) in t.iter().enumerate() {
-                    if let Some(j) = dofs.dof[w as usize] {
-                        let pos = cols.binary_search(&j).expect("pattern covers the patch");
-                        row[pos] += local(&e, region, a, b);
+                let h_const = h.and_then(|h| h.on_region(region));
+                for (b, &w) in tri.iter().enumerate() {
+                    let Some(j) = dofs.dof[w as usize] else {
+                        continue;
+                    };
+                    let pos = cols.binary_search(&j).expect("pattern covers the patch");
+                    srow[pos] += t * e.stiffness(a, b);
+                    if let (Some(lrow), Some(h)) = (lrow.as_deref_mut(), h) {
+                        lrow[pos] += match h_const {
+                            Some(c) => c * e.area * if a == b { 1.0 / 6.0 } else { 1.0 / 12.0 },
+                            None => e.weighted_mass(h, region, a, b),
+                        };
                     }
                 }
             }
         });
-    m
+    (s, l)
 }
 
 /// Fills a vector over unknowns: entry `i` sums `local(element, region, a)` over the
@@ -322,7 +330,9 @@ mod tests {
         let dofs = DofMap::new(&m);
         let adj = VertexTriangles::new(&m);
         let pat = Arc::new(unknowns_pattern(&m, &dofs, &adj));
-        let s = assemble_matrix(&m, &dofs, &adj, &pat, &|e, _, a, b| e.stiffness(a, b));
+        let (s, l) = assemble_stiffness_and_mass(&m, &dofs, &adj, &pat, 1.0, Some(&2.0));
+        // ∫ h g² over the patch = h × 6 × (area/6) with area 1/8 per triangle.
+        assert!((l.unwrap().get(0, 0) - 2.0 * 6.0 * (1.0 / 8.0) / 6.0).abs() < 1e-15);
         // P1 on right triangles gives the 5-point stencil: diagonal 4.
         assert_eq!(s.n(), 1);
         assert!((s.get(0, 0) - 4.0).abs() < 1e-14);

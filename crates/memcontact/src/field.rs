@@ -600,6 +600,15 @@ impl serde::Serialize for Stiffness {
     }
 }
 
+impl crate::fem::Coefficient for BoundField {
+    fn at(&self, p: [f64; 2], region: u32) -> f64 {
+        self.eval(p, region)
+    }
+    fn on_region(&self, region: u32) -> Option<f64> {
+        self.region_constant(region)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -871,14 +880,5 @@ mod tests {
         check::<Field>();
         check::<BoundField>();
         check::<Stiffness>();
-    }
-}
-
-impl crate::fem::Coefficient for BoundField {
-    fn at(&self, p: [f64; 2], region: u32) -> f64 {
-        self.eval(p, region)
-    }
-    fn on_region(&self, region: u32) -> Option<f64> {
-        self.region_constant(region)
     }
 }

@@ -4,9 +4,11 @@
 //! certificates of Problems 2e and 2f.
 
 use crate::fem::{
-    assemble_matrix, assemble_vector, unknowns_pattern, Coefficient, Element, VertexTriangles,
+    assemble_stiffness_and_mass, assemble_vector, unknowns_pattern, Coefficient, Element,
+    VertexTriangles,
 };
-use crate::mesh::{DofMap, Mesh, Point};
+use crate::mesh::{DofMap, Mesh};
+use crate::quadrature::gauss_legendre;
 use crate::sparse::{norm_inf, Csr};
 use crate::{Error, Result};
 use rayon::prelude::*;
@@ -174,24 +176,50 @@ impl Model {
                 "membrane.tension must be a finite number > 0, got {t}"
             )));
         }
-        let dofs = DofMap::new(mesh);
+        let adj = VertexTriangles::new(mesh);
+        let dofs = DofMap::with_adjacency(mesh, &adj);
         if dofs.is_empty() {
             return Err(Error::Mesh(
                 "the mesh has no interior vertex: there is no unknown to solve for".into(),
             ));
         }
-        let adj = VertexTriangles::new(mesh);
-        check_field(mesh, &adj, "membrane.load f", data.load, false)?;
-        check_field(mesh, &adj, "obstacle.shape φ", data.shape, false)?;
-        if let Stiffness::Elastic(h) = data.stiffness {
-            check_field(mesh, &adj, "obstacle.stiffness h", h, true)?;
-        }
+        // Data checks: every value finite, h ≥ 0. f and h at the triangle centroids (their
+        // quadrature), φ and h at the vertices (their samples).
+        check_centroids(mesh, "membrane.load f", data.load, false)?;
+        let h_vertices = match data.stiffness {
+            Stiffness::Rigid => vec![f64::INFINITY; mesh.n_vertices()],
+            Stiffness::Elastic(h) => {
+                check_centroids(mesh, "obstacle.stiffness h", h, true)?;
+                let hv = vertex_average(mesh, &adj, h);
+                check_vertices(mesh, "obstacle.stiffness h", &hv, true)?;
+                hv
+            }
+        };
         let pattern = Arc::new(unknowns_pattern(mesh, &dofs, &adj));
-        let s = assemble_matrix(mesh, &dofs, &adj, &pattern, &|e, _, a, b| {
-            t * e.stiffness(a, b)
-        });
+        let consistent_h = match (data.stiffness, data.foundation) {
+            (Stiffness::Elastic(h), Foundation::Consistent) => Some(h),
+            _ => None,
+        };
+        let (s, l_consistent) =
+            assemble_stiffness_and_mass(mesh, &dofs, &adj, &pattern, t, consistent_h);
+        let l = match (data.stiffness, l_consistent) {
+            (Stiffness::Rigid, _) => FoundationMatrix::Rigid,
+            (_, Some(l)) => FoundationMatrix::Consistent(l),
+            (Stiffness::Elastic(h), None) => {
+                FoundationMatrix::Lumped(assemble_vector(mesh, &dofs, &adj, &|e, r, a| {
+                    e.weighted_load(h, r, a)
+                }))
+            }
+        };
         let load = data.load;
         let d = assemble_vector(mesh, &dofs, &adj, &|e, r, a| e.weighted_load(load, r, a));
+        if let Some(i) = d.iter().position(|v| !v.is_finite()) {
+            let p = mesh.points[dofs.vertex[i] as usize];
+            return Err(Error::Data(format!(
+                "membrane.load f is not finite near ({}, {})",
+                p[0], p[1]
+            )));
+        }
         let total_load: f64 = (0..mesh.n_triangles())
             .into_par_iter()
             .with_min_len(4096)
@@ -201,29 +229,6 @@ impl Model {
                 (0..3).map(|a| e.weighted_load(load, r, a)).sum::<f64>()
             })
             .sum();
-        let (l, h_vertices) = match data.stiffness {
-            Stiffness::Rigid => (
-                FoundationMatrix::Rigid,
-                vec![f64::INFINITY; mesh.n_vertices()],
-            ),
-            Stiffness::Elastic(h) => {
-                let l = match data.foundation {
-                    Foundation::Consistent => FoundationMatrix::Consistent(assemble_matrix(
-                        mesh,
-                        &dofs,
-                        &adj,
-                        &pattern,
-                        &|e, r, a, b| e.weighted_mass(h, r, a, b),
-                    )),
-                    Foundation::Lumped => {
-                        FoundationMatrix::Lumped(assemble_vector(mesh, &dofs, &adj, &|e, r, a| {
-                            e.weighted_load(h, r, a)
-                        }))
-                    }
-                };
-                (l, vertex_average(mesh, &adj, h))
-            }
-        };
         let can_touch: Vec<bool> = (0..dofs.len())
             .map(|i| l.is_rigid() || l.diag(i) > 0.0)
             .collect();
@@ -242,6 +247,7 @@ impl Model {
                 (mollify(mesh, &adj, data.shape, eps), Some(eps))
             }
         };
+        check_vertices(mesh, "obstacle.shape φ", &phi_vertices, false)?;
         let phi = dofs.to_unknowns(&phi_vertices);
         Ok(Model {
             dofs,
@@ -433,51 +439,50 @@ impl Certificate {
     }
 }
 
-/// Checks a coefficient at every vertex (per incident region) and triangle centroid:
-/// finite, and non-negative when asked.
-fn check_field(
-    mesh: &Mesh,
-    adj: &VertexTriangles,
-    name: &str,
-    c: &dyn Coefficient,
-    non_negative: bool,
-) -> Result<()> {
-    let bad = |v: f64| !v.is_finite() || (non_negative && v < 0.0);
-    let report = |v: f64, p: Point| {
-        let what = if v.is_nan() {
-            "is NaN".to_string()
-        } else if !v.is_finite() {
-            format!("is infinite ({v})")
-        } else {
-            format!("is negative ({v})")
-        };
-        Err(Error::Data(format!(
-            "{name} {what} at ({}, {})",
-            p[0], p[1]
-        )))
+/// The error for a bad value `v` of `name` at `p`.
+fn bad_value(name: &str, v: f64, p: [f64; 2]) -> Error {
+    let what = if v.is_nan() {
+        "is NaN".to_string()
+    } else if !v.is_finite() {
+        format!("is infinite ({v})")
+    } else {
+        format!("is negative ({v})")
     };
-    for (k, t) in mesh.triangles.iter().enumerate() {
-        let r = mesh.regions[k];
-        if let Some(v) = c.on_region(r) {
-            if bad(v) {
-                return report(v, mesh.points[t[0] as usize]);
-            }
-            continue;
-        }
-        let cs = mesh.corners(k);
-        let g = [
-            (cs[0][0] + cs[1][0] + cs[2][0]) / 3.0,
-            (cs[0][1] + cs[1][1] + cs[2][1]) / 3.0,
-        ];
-        for p in [cs[0], cs[1], cs[2], g] {
-            let v = c.at(p, r);
-            if bad(v) {
-                return report(v, p);
-            }
-        }
+    Error::Data(format!("{name} {what} at ({}, {})", p[0], p[1]))
+}
+
+/// Checks a coefficient at every triangle centroid: finite, and non-negative when asked
+/// (once per region where it is constant).
+fn check_centroids(mesh: &Mesh, name: &str, c: &dyn Coefficient, non_negative: bool) -> Result<()> {
+    let bad = |v: f64| !v.is_finite() || (non_negative && v < 0.0);
+    let found = (0..mesh.n_triangles())
+        .into_par_iter()
+        .with_min_len(4096)
+        .find_map_first(|k| {
+            let r = mesh.regions[k];
+            let cs = mesh.corners(k);
+            let p = [
+                (cs[0][0] + cs[1][0] + cs[2][0]) / 3.0,
+                (cs[0][1] + cs[1][1] + cs[2][1]) / 3.0,
+            ];
+            let v = c.on_region(r).unwrap_or_else(|| c.at(p, r));
+            bad(v).then_some((v, p))
+        });
+    match found {
+        Some((v, p)) => Err(bad_value(name, v, p)),
+        None => Ok(()),
     }
-    let _ = adj;
-    Ok(())
+}
+
+/// Checks sampled vertex values: finite, and non-negative when asked.
+fn check_vertices(mesh: &Mesh, name: &str, values: &[f64], non_negative: bool) -> Result<()> {
+    match values
+        .iter()
+        .position(|&v| !v.is_finite() || (non_negative && v < 0.0))
+    {
+        Some(i) => Err(bad_value(name, values[i], mesh.points[i])),
+        None => Ok(()),
+    }
 }
 
 /// A coefficient at every vertex: the average over the triangles around it of its value
@@ -557,62 +562,10 @@ fn mollify(mesh: &Mesh, adj: &VertexTriangles, phi: &dyn Coefficient, eps: f64) 
         .collect()
 }
 
-/// Gauss-Legendre nodes and weights on (−1, 1) (Newton on the Legendre recurrence).
-pub fn gauss_legendre(n: usize) -> (Vec<f64>, Vec<f64>) {
-    let mut x = vec![0.0; n];
-    let mut w = vec![0.0; n];
-    for i in 0..n {
-        let mut z = (std::f64::consts::PI * (i as f64 + 0.75) / (n as f64 + 0.5)).cos();
-        for _ in 0..100 {
-            let (mut p0, mut p1) = (1.0, z);
-            for k in 2..=n {
-                let p2 = ((2 * k - 1) as f64 * z * p1 - (k - 1) as f64 * p0) / k as f64;
-                p0 = p1;
-                p1 = p2;
-            }
-            let dp = n as f64 * (z * p1 - p0) / (z * z - 1.0);
-            let dz = p1 / dp;
-            z -= dz;
-            if dz.abs() < 1e-16 {
-                let (mut p0, mut p1) = (1.0, z);
-                for k in 2..=n {
-                    let p2 = ((2 * k - 1) as f64 * z * p1 - (k - 1) as f64 * p0) / k as f64;
-                    p0 = p1;
-                    p1 = p2;
-                }
-                let dp = n as f64 * (z * p1 - p0) / (z * z - 1.0);
-                x[i] = z;
-                w[i] = 2.0 / ((1.0 - z * z) * dp * dp);
-                break;
-            }
-        }
-    }
-    (x, w)
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
-    use std::collections::BTreeMap;
-
-    pub(crate) fn square(n: usize) -> Mesh {
-        let mut p = Vec::new();
-        for j in 0..=n {
-            for i in 0..=n {
-                p.push([i as f64 / n as f64, j as f64 / n as f64]);
-            }
-        }
-        let mut t = Vec::new();
-        let w = (n + 1) as u32;
-        for j in 0..n as u32 {
-            for i in 0..n as u32 {
-                let a = j * w + i;
-                t.push([a, a + 1, a + w + 1]);
-                t.push([a, a + w + 1, a + w]);
-            }
-        }
-        Mesh::new(p, t, vec![], BTreeMap::new()).unwrap()
-    }
+    use crate::solve::tests::square;
 
     fn data<'a>(h: &'a f64, foundation: Foundation) -> ProblemData<'a> {
         ProblemData {
@@ -674,7 +627,7 @@ mod tests {
     fn mollification_keeps_constants_and_linear_functions() {
         let m = square(4);
         let adj = VertexTriangles::new(&m);
-        let c = crate::fem::FnCoefficient(|p: Point| 2.0 * p[0] - p[1] + 0.5);
+        let c = crate::fem::FnCoefficient(|p: crate::mesh::Point| 2.0 * p[0] - p[1] + 0.5);
         let v = mollify(&m, &adj, &c, 0.3);
         for (k, p) in m.points.iter().enumerate() {
             assert!((v[k] - (2.0 * p[0] - p[1] + 0.5)).abs() < 1e-13);

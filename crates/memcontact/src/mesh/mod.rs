@@ -241,39 +241,42 @@ impl Mesh {
     }
 
     /// The boundary edges ∂Ω_n: edges of exactly one triangle, as `(a, b)` in the
-    /// triangle's (counter-clockwise) order.
+    /// triangle's (counter-clockwise) order, in triangle order. An edge `a → b` of a
+    /// triangle is on the boundary when no other triangle around `a` contains `b`.
     pub fn boundary_edges(&self) -> Vec<[u32; 2]> {
-        // Each interior edge appears once in each direction; sort half-edges to pair them.
-        let mut half: Vec<(u32, u32)> = Vec::with_capacity(self.triangles.len() * 3);
-        for t in &self.triangles {
-            for e in 0..3 {
-                half.push((t[e], t[(e + 1) % 3]));
-            }
-        }
-        let mut keyed: Vec<(u64, u32, u32)> = half
-            .iter()
-            .map(|&(a, b)| (((a.min(b) as u64) << 32) | b.max(a) as u64, a, b))
-            .collect();
-        keyed.sort_unstable_by_key(|k| k.0);
-        let mut out = Vec::new();
-        let mut i = 0;
-        while i < keyed.len() {
-            let mut j = i + 1;
-            while j < keyed.len() && keyed[j].0 == keyed[i].0 {
-                j += 1;
-            }
-            if j - i == 1 {
-                out.push([keyed[i].1, keyed[i].2]);
-            }
-            i = j;
-        }
-        out
+        self.boundary_edges_with(&VertexTriangles::new(self))
+    }
+
+    /// [`Mesh::boundary_edges`] with a prebuilt vertex → triangles adjacency.
+    pub fn boundary_edges_with(&self, adj: &VertexTriangles) -> Vec<[u32; 2]> {
+        use rayon::prelude::*;
+        self.triangles
+            .par_iter()
+            .enumerate()
+            .with_min_len(4096)
+            .flat_map_iter(|(k, t)| {
+                let adj = &adj;
+                (0..3).filter_map(move |e| {
+                    let (a, b) = (t[e], t[(e + 1) % 3]);
+                    let shared = adj
+                        .of(a as usize)
+                        .iter()
+                        .any(|&o| o as usize != k && self.triangles[o as usize].contains(&b));
+                    (!shared).then_some([a, b])
+                })
+            })
+            .collect()
     }
 
     /// `true` for every vertex on the boundary ∂Ω_n.
     pub fn boundary_vertices(&self) -> Vec<bool> {
+        self.boundary_vertices_with(&VertexTriangles::new(self))
+    }
+
+    /// [`Mesh::boundary_vertices`] with a prebuilt vertex → triangles adjacency.
+    pub fn boundary_vertices_with(&self, adj: &VertexTriangles) -> Vec<bool> {
         let mut on = vec![false; self.points.len()];
-        for [a, b] in self.boundary_edges() {
+        for [a, b] in self.boundary_edges_with(adj) {
             on[a as usize] = true;
             on[b as usize] = true;
         }
@@ -343,6 +346,44 @@ impl Mesh {
     }
 }
 
+/// The triangles around every vertex (the patch `Q_i` of the paper).
+#[derive(Debug, Clone)]
+pub struct VertexTriangles {
+    ptr: Vec<usize>,
+    tri: Vec<u32>,
+}
+
+impl VertexTriangles {
+    /// Builds the adjacency of `mesh`.
+    pub fn new(mesh: &Mesh) -> VertexTriangles {
+        let n = mesh.n_vertices();
+        let mut ptr = vec![0usize; n + 1];
+        for t in &mesh.triangles {
+            for &v in t {
+                ptr[v as usize + 1] += 1;
+            }
+        }
+        for i in 0..n {
+            ptr[i + 1] += ptr[i];
+        }
+        let mut fill = ptr.clone();
+        let mut tri = vec![0u32; ptr[n]];
+        for (k, t) in mesh.triangles.iter().enumerate() {
+            for &v in t {
+                tri[fill[v as usize]] = k as u32;
+                fill[v as usize] += 1;
+            }
+        }
+        VertexTriangles { ptr, tri }
+    }
+
+    /// The triangles having vertex `v`.
+    #[inline]
+    pub fn of(&self, v: usize) -> &[u32] {
+        &self.tri[self.ptr[v]..self.ptr[v + 1]]
+    }
+}
+
 /// The map between mesh vertices and unknowns: the unknowns are the interior vertices
 /// `a_1, ..., a_m` (SPEC §2). Vectors over unknowns and over vertices are different things;
 /// convert only through this type.
@@ -357,7 +398,12 @@ pub struct DofMap {
 impl DofMap {
     /// Numbers the interior vertices of `mesh` in vertex order.
     pub fn new(mesh: &Mesh) -> DofMap {
-        let boundary = mesh.boundary_vertices();
+        DofMap::with_adjacency(mesh, &VertexTriangles::new(mesh))
+    }
+
+    /// [`DofMap::new`] with a prebuilt vertex → triangles adjacency.
+    pub fn with_adjacency(mesh: &Mesh, adj: &VertexTriangles) -> DofMap {
+        let boundary = mesh.boundary_vertices_with(adj);
         let mut vertex = Vec::with_capacity(boundary.len());
         let mut dof = vec![None; boundary.len()];
         for (v, &b) in boundary.iter().enumerate() {

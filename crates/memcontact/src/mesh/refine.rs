@@ -155,11 +155,17 @@ fn number_edges(n_vertices: usize, triangles: &[[u32; 3]]) -> Edges {
     }
 }
 
+/// Whether `p` lies on the circle (up to round-off): only boundary edges with both ends on
+/// it are curved edges (a disc with a straight cut or a hole keeps its straight parts).
+fn on_circle(c: &super::Circle, p: Point) -> bool {
+    (super::dist(p, c.center) - c.radius).abs() <= 1e-9 * c.radius
+}
+
 /// Uniform ("red") refinement: every triangle into four by its edge midpoints. Coarse
 /// vertices keep their indices and the midpoints follow, one per edge in lexicographic
 /// order of the edge's endpoints; triangle `k` becomes triangles `4k .. 4k + 4` with its
 /// region. When the mesh approximates a circle (`mesh.curve`), the midpoints of boundary
-/// edges are moved onto it so that Ω_n approaches the disc; the [`Refinement`] still gives
+/// edges whose two ends lie on the circle are moved onto it so that Ω_n approaches the disc; the [`Refinement`] still gives
 /// the two edge endpoints (the prolongation stays the P1 interpolation on the old edge).
 ///
 /// The fine mesh is conforming and counter-clockwise if the coarse one is;
@@ -180,7 +186,7 @@ pub fn refine_uniform(mesh: &Mesh) -> (Mesh, Refinement) {
             let (p, q) = (mesh.points[a as usize], mesh.points[b as usize]);
             let m = [0.5 * (p[0] + q[0]), 0.5 * (p[1] + q[1])];
             match curve {
-                Some(c) if on_boundary => c.project(m),
+                Some(c) if on_boundary && on_circle(&c, p) && on_circle(&c, q) => c.project(m),
                 _ => m,
             }
         })
@@ -346,5 +352,35 @@ mod tests {
         let polygon = 0.5 * n * (2.0 * pi / n).sin();
         assert!((h.finest().total_area() - polygon).abs() < 1e-12);
         assert_eq!(h.finest().curve, Some(circle));
+    }
+    #[test]
+    fn straight_boundary_edges_of_a_curved_mesh_stay_straight() {
+        // Half a hexagon: the arc is curved, the diameter through the centre is not.
+        let c = [0.0, 0.0];
+        let mut p = vec![c];
+        for i in 0..4 {
+            let a = i as f64 * std::f64::consts::PI / 3.0;
+            p.push([a.cos(), a.sin()]);
+        }
+        let t = vec![[0, 1, 2], [0, 2, 3], [0, 3, 4]];
+        let mut m = Mesh::new(p, t, vec![], BTreeMap::new()).unwrap();
+        m.curve = Some(Circle {
+            center: c,
+            radius: 1.0,
+        });
+        let (f, _) = refine_uniform(&m);
+        let bv = f.boundary_vertices();
+        let on_diameter = f
+            .points
+            .iter()
+            .zip(&bv)
+            .filter(|(p, b)| **b && p[1].abs() < 1e-15);
+        assert_eq!(on_diameter.count(), 5); // -1, -0.5, 0, 0.5, 1
+        let on_arc = f
+            .points
+            .iter()
+            .zip(&bv)
+            .filter(|(p, b)| **b && (p[0].hypot(p[1]) - 1.0).abs() < 1e-15);
+        assert_eq!(on_arc.count(), 7);
     }
 }

@@ -205,7 +205,27 @@ pub fn solve(model: &Model, settings: &Settings, observer: &mut dyn Observer) ->
         timer.time("solve", || {
             chol.as_ref().expect("factorised").solve_in_place(&mut rhs)
         });
-        timer.time("line search", || line_step(model, &mut v, &rhs, &r));
+        timer.time("line search", || {
+            // For the rigid obstacle the feasible line search stops at the first vertex that
+            // hits φ; the projected full step min(V + δ, φ) lets the whole contact set move
+            // at once (as a primal-dual active-set method does). Keep whichever is lower.
+            let projected = model.is_rigid().then(|| {
+                let mut w = v.clone();
+                for i in 0..w.len() {
+                    w[i] += rhs[i];
+                    if model.can_touch[i] && w[i] > model.phi[i] {
+                        w[i] = model.phi[i];
+                    }
+                }
+                w
+            });
+            line_step(model, &mut v, &rhs, &r);
+            if let Some(w) = projected {
+                if model.energy(&w) < model.energy(&v) {
+                    v = w;
+                }
+            }
+        });
         certificate = timer.time("certificate", || model.certificate(&v));
         let record = IterationRecord {
             iteration: iterations,

@@ -243,4 +243,4 @@ pub fn solve(
 }
 
 #[cfg(test)]
-mod tests;
+pub(crate) mod tests;

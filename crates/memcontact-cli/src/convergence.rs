@@ -1,0 +1,881 @@
+//! `memcontact convergence`: the case's `[exact]` section, the convergence table, its CSV
+//! and log-log plot, the lumped/consistent and nodal/mollified comparisons and the
+//! rigid-limit sweep. The numerics are in `memcontact::convergence`.
+
+use crate::case::{self, Case};
+use crate::plot;
+use anyhow::{anyhow, bail, Context, Result};
+use memcontact::convergence::{
+    self as study, LevelResult, ManufacturedLoad, Study, StudySettings, Sweep, Target,
+};
+use memcontact::exact::{DiskSolution, ExactSolution, Manufactured};
+use memcontact::field::{BoundField, Stiffness as FieldStiffness};
+use memcontact::io::csv::write_columns_csv;
+use memcontact::io::vtu::DataArray;
+use memcontact::mesh::refine::Hierarchy;
+use memcontact::mesh::Mesh;
+use memcontact::model::{Foundation, ProblemData, Sampling, Stiffness};
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+/// The stiffnesses of `--h-sweep` when `--h-values` is not given: 10, 10², ..., 10⁶.
+const DEFAULT_SWEEP: [f64; 6] = [1e1, 1e2, 1e3, 1e4, 1e5, 1e6];
+
+/// The largest `--levels` accepted (each level multiplies the triangles by 4).
+const MAX_LEVELS: usize = 10;
+
+/// Which variants `--compare` runs.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum Compare {
+    /// The paper's consistent foundation matrix against the lumped diagonal.
+    Foundation,
+    /// Nodal sampling of φ against the paper's mollified sampling.
+    Sampling,
+}
+
+/// Arguments of `memcontact convergence`.
+#[derive(Debug, clap::Args)]
+pub struct Args {
+    /// The case file (TOML); its `[exact]` section names the exact solution (without one,
+    /// errors are measured against the finest level's solution).
+    pub case: PathBuf,
+    /// Refinement levels beyond the case's mesh (K ≥ 1: K + 1 meshes are solved). With
+    /// --h-sweep: the fixed mesh is the case's mesh refined K times (K ≥ 0).
+    #[arg(long, value_name = "K")]
+    pub levels: usize,
+    /// Output directory (created if needed).
+    #[arg(short, long, default_value = "out")]
+    pub output: PathBuf,
+    /// Override a case key, e.g. --set mesh.size=0.2 --set obstacle.foundation=lumped.
+    #[arg(long = "set", value_name = "KEY=VALUE")]
+    pub sets: Vec<String>,
+    /// Run the study for both variants (consistent and lumped L, or nodal and mollified φ)
+    /// and write convergence-<variant>.csv for each.
+    #[arg(long, value_enum, conflicts_with = "h_sweep")]
+    pub compare: Option<Compare>,
+    /// Instead of the study: the rigid limit. On the fixed mesh, solve with the obstacle
+    /// rigid and with each constant stiffness h, and write h_sweep.csv and h_sweep.png.
+    #[arg(long)]
+    pub h_sweep: bool,
+    /// The stiffnesses of --h-sweep, comma separated (default 10,100,...,1e6).
+    #[arg(
+        long,
+        value_delimiter = ',',
+        requires = "h_sweep",
+        value_name = "H,H,..."
+    )]
+    pub h_values: Vec<f64>,
+    /// Print no progress lines.
+    #[arg(short, long)]
+    pub quiet: bool,
+}
+
+/// The exact solution a case names in `[exact]`.
+pub enum Exact {
+    /// `kind = "disk"`: the axisymmetric disc of SPEC §4.
+    Disk(DiskCase),
+    /// `kind = "manufactured"`: the load is replaced by `f = −tΔu + h(u − φ)⁺`.
+    Manufactured(Manufactured),
+}
+
+impl Exact {
+    /// The solution as the library's trait object.
+    pub fn solution(&self) -> &dyn ExactSolution {
+        match self {
+            Exact::Disk(d) => &d.solution,
+            Exact::Manufactured(m) => m,
+        }
+    }
+}
+
+/// The disc's solution and the constants it was built from (for the rigid-limit sweep).
+pub struct DiskCase {
+    /// The solution with the case's h (or rigid).
+    pub solution: DiskSolution,
+    center: [f64; 2],
+    radius: f64,
+    t: f64,
+    f: f64,
+    phi: f64,
+}
+
+impl DiskCase {
+    /// The same disc with another stiffness (`None`: rigid).
+    fn with_stiffness(&self, h: Option<f64>) -> memcontact::Result<DiskSolution> {
+        DiskSolution::new(self.center, self.radius, self.t, self.f, h, self.phi)
+    }
+}
+
+/// Reads `[exact]`: `None` when the case has none; errors for an unknown kind or key, a
+/// kind that does not fit the mesh generator, or data that the kind cannot take.
+pub fn parse_exact(case: &Case) -> Result<Option<Exact>> {
+    let Some(table) = &case.exact else {
+        return Ok(None);
+    };
+    let kind = match table.get("kind") {
+        Some(toml::Value::String(s)) => s.as_str(),
+        Some(v) => bail!("[exact] kind must be a string (\"disk\" or \"manufactured\"), got {v}"),
+        None => bail!("[exact] needs kind = \"disk\" or kind = \"manufactured\""),
+    };
+    let allowed: &[&str] = match kind {
+        "disk" => &["kind"],
+        "manufactured" => &["kind", "domain", "amplitude"],
+        k => bail!("[exact] kind = \"{k}\" is unknown (choose \"disk\" or \"manufactured\")"),
+    };
+    if let Some(k) = table.keys().find(|k| !allowed.contains(&k.as_str())) {
+        bail!(
+            "[exact] key \"{k}\" is not used by kind = \"{kind}\" (its keys: {})",
+            allowed.join(", ")
+        );
+    }
+    let generator = match (&case.mesh.file, case.mesh.generator.as_deref()) {
+        (Some(_), _) => None,
+        (None, g) => g,
+    };
+    let disc_geometry = || -> Result<([f64; 2], f64)> {
+        if generator != Some("disk") {
+            bail!(
+                "[exact] kind = \"{kind}\" on a disc needs [mesh] generator = \"disk\" (its \
+                 centre and radius define the domain); this case uses {}",
+                describe_mesh(case)
+            );
+        }
+        Ok((
+            case.mesh.center.unwrap_or([0.0, 0.0]),
+            case.mesh.radius.unwrap_or(1.0),
+        ))
+    };
+    let t = case.tension()?;
+    match kind {
+        "disk" => {
+            let (center, radius) = disc_geometry()?;
+            let constant = |name: &str, f: &memcontact::field::Field| -> Result<f64> {
+                f.constant().ok_or_else(|| {
+                    anyhow!(
+                        "[exact] kind = \"disk\" needs a constant {name} (the closed form is for \
+                         constant t, f, h, φ), not an expression or a table of different values"
+                    )
+                })
+            };
+            let f = constant("membrane.load", &case.membrane.load)?;
+            let phi = constant("obstacle.shape", &case.obstacle.shape)?;
+            let h = match &case.obstacle.stiffness {
+                FieldStiffness::Rigid => None,
+                FieldStiffness::Elastic(h) => Some(constant("obstacle.stiffness", h)?),
+            };
+            let solution = DiskSolution::new(center, radius, t, f, h, phi)
+                .context("[exact] kind = \"disk\"")?;
+            Ok(Some(Exact::Disk(DiskCase {
+                solution,
+                center,
+                radius,
+                t,
+                f,
+                phi,
+            })))
+        }
+        _ => {
+            if case.obstacle.stiffness.is_rigid() {
+                bail!(
+                    "[exact] kind = \"manufactured\" needs a finite obstacle.stiffness h: its \
+                     load f = −tΔu + h(u − φ)⁺ has no meaning for the rigid obstacle"
+                );
+            }
+            let amplitude = match table.get("amplitude") {
+                Some(toml::Value::Float(a)) => *a,
+                Some(toml::Value::Integer(a)) => *a as f64,
+                Some(v) => bail!("[exact] amplitude must be a number, got {v}"),
+                None => bail!("[exact] kind = \"manufactured\" needs amplitude = A (u's scale)"),
+            };
+            if !(amplitude.is_finite() && amplitude != 0.0) {
+                bail!("[exact] amplitude must be a finite non-zero number, got {amplitude}");
+            }
+            let domain = match table.get("domain") {
+                Some(toml::Value::String(s)) => s.as_str(),
+                Some(v) => bail!("[exact] domain must be \"rectangle\" or \"disk\", got {v}"),
+                None => bail!(
+                    "[exact] kind = \"manufactured\" needs domain = \"rectangle\" or \"disk\""
+                ),
+            };
+            let m = match domain {
+                "rectangle" => {
+                    if generator != Some("rectangle") {
+                        bail!(
+                            "[exact] domain = \"rectangle\" needs [mesh] generator = \
+                             \"rectangle\" (its x0, y0, x1, y1 define the domain); this case \
+                             uses {}",
+                            describe_mesh(case)
+                        );
+                    }
+                    let me = &case.mesh;
+                    Manufactured::rectangle(
+                        me.x0.unwrap_or(0.0),
+                        me.y0.unwrap_or(0.0),
+                        me.x1.unwrap_or(1.0),
+                        me.y1.unwrap_or(1.0),
+                        amplitude,
+                    )
+                }
+                "disk" => {
+                    let (center, radius) = disc_geometry()?;
+                    Manufactured::disk(center, radius, amplitude)
+                }
+                d => {
+                    bail!("[exact] domain = \"{d}\" is unknown (choose \"rectangle\" or \"disk\")")
+                }
+            }
+            .context("[exact] kind = \"manufactured\"")?;
+            Ok(Some(Exact::Manufactured(m)))
+        }
+    }
+}
+
+fn describe_mesh(case: &Case) -> String {
+    match (&case.mesh.file, &case.mesh.generator) {
+        (Some(f), _) => format!("the mesh file {}", f.display()),
+        (None, Some(g)) => format!("generator = \"{g}\""),
+        (None, None) => "no mesh".into(),
+    }
+}
+
+/// The case's fields bound to the mesh's regions, with the manufactured load when the
+/// exact solution is manufactured.
+struct Fields {
+    load: BoundField,
+    shape: BoundField,
+    stiffness: Option<BoundField>,
+}
+
+impl Fields {
+    fn bind(case: &Case, mesh: &Mesh) -> Result<Fields> {
+        let mut tags = mesh.regions.clone();
+        tags.sort_unstable();
+        tags.dedup();
+        let names = &mesh.region_names;
+        Ok(Fields {
+            load: case.membrane.load.bind("membrane.load", names, &tags)?,
+            shape: case.obstacle.shape.bind("obstacle.shape", names, &tags)?,
+            stiffness: match &case.obstacle.stiffness {
+                FieldStiffness::Rigid => None,
+                FieldStiffness::Elastic(h) => Some(h.bind("obstacle.stiffness", names, &tags)?),
+            },
+        })
+    }
+
+    fn stiffness(&self) -> Stiffness<'_> {
+        match &self.stiffness {
+            Some(h) => Stiffness::Elastic(h),
+            None => Stiffness::Rigid,
+        }
+    }
+}
+
+/// One variant of the problem (the case itself, or one side of `--compare`).
+struct Variant {
+    name: &'static str,
+    foundation: Foundation,
+    sampling: Sampling,
+}
+
+/// The sampling named in the case, and the mollified sampling with the case's ε (if any).
+fn sampling_variants(case: &Case) -> Result<(Sampling, Sampling)> {
+    let eps = case.obstacle.epsilon.map(|n| n.0);
+    if let Some(e) = eps {
+        if !(e.is_finite() && e > 0.0) {
+            bail!("obstacle.epsilon must be a finite number > 0, got {e}");
+        }
+    }
+    Ok((Sampling::Nodal, Sampling::Mollified { epsilon: eps }))
+}
+
+fn variants(case: &Case, compare: Option<Compare>) -> Result<Vec<Variant>> {
+    Ok(match compare {
+        None => vec![Variant {
+            name: "",
+            foundation: case.foundation()?,
+            sampling: case.sampling()?,
+        }],
+        Some(Compare::Foundation) => {
+            let sampling = case.sampling()?;
+            vec![
+                Variant {
+                    name: "consistent",
+                    foundation: Foundation::Consistent,
+                    sampling,
+                },
+                Variant {
+                    name: "lumped",
+                    foundation: Foundation::Lumped,
+                    sampling,
+                },
+            ]
+        }
+        Some(Compare::Sampling) => {
+            let foundation = case.foundation()?;
+            let (nodal, mollified) = sampling_variants(case)?;
+            vec![
+                Variant {
+                    name: "nodal",
+                    foundation,
+                    sampling: nodal,
+                },
+                Variant {
+                    name: "mollified",
+                    foundation,
+                    sampling: mollified,
+                },
+            ]
+        }
+    })
+}
+
+/// `memcontact convergence`.
+pub fn run(args: &Args) -> Result<()> {
+    if args.levels == 0 && !args.h_sweep {
+        bail!("--levels must be at least 1 for a convergence study (K + 1 meshes are solved)");
+    }
+    let case = case::load(&args.case, &args.sets)?;
+    let exact = parse_exact(&case)?;
+    let settings = case.settings()?;
+    let t = case.tension()?;
+    if args.levels > MAX_LEVELS {
+        bail!(
+            "--levels {} is too large (at most {MAX_LEVELS}: each level multiplies the triangles by 4)",
+            args.levels
+        );
+    }
+    let (mut hierarchy, warnings) = case.build_mesh()?;
+    for w in &warnings {
+        eprintln!("warning: {w}");
+    }
+    let fields = Fields::bind(&case, hierarchy.finest())?;
+    let manufactured_load;
+    let load: &dyn memcontact::fem::Coefficient = match &exact {
+        Some(Exact::Manufactured(m)) => {
+            manufactured_load = ManufacturedLoad {
+                exact: m,
+                tension: t,
+                stiffness: fields
+                    .stiffness
+                    .as_ref()
+                    .expect("elastic, checked by parse_exact"),
+                shape: &fields.shape,
+            };
+            &manufactured_load
+        }
+        _ => &fields.load,
+    };
+    std::fs::create_dir_all(&args.output).with_context(|| {
+        format!(
+            "cannot create the output directory {}",
+            args.output.display()
+        )
+    })?;
+    let mut out = String::new();
+    let _ = writeln!(out, "memcontact convergence: {}", case.path.display());
+    match &exact {
+        Some(e) => {
+            let _ = writeln!(out, "  exact        {}", e.solution().describe());
+        }
+        None => {
+            let _ = writeln!(
+                out,
+                "  exact        none: errors against the finest level's solution (reference)"
+            );
+        }
+    }
+    if let Some(Exact::Manufactured(_)) = &exact {
+        let _ = writeln!(
+            out,
+            "  load         membrane.load replaced by the manufactured f = −tΔu + h(u − φ)⁺"
+        );
+    }
+    if args.h_sweep {
+        hierarchy.refine(args.levels);
+        let hs: Vec<f64> = if args.h_values.is_empty() {
+            DEFAULT_SWEEP.to_vec()
+        } else {
+            args.h_values.clone()
+        };
+        let v = &variants(&case, None)?[0];
+        let data = ProblemData {
+            tension: t,
+            load,
+            shape: &fields.shape,
+            stiffness: fields.stiffness(),
+            foundation: v.foundation,
+            sampling: v.sampling,
+        };
+        if !args.quiet {
+            eprintln!(
+                "h sweep on {} vertices: rigid, then h = {:?}",
+                hierarchy.finest().n_vertices(),
+                hs
+            );
+        }
+        let sweep = study::rigid_limit_sweep(&hierarchy, &data, &hs, &settings)?;
+        let disk = match &exact {
+            Some(Exact::Disk(d)) => Some(d),
+            _ => None,
+        };
+        out.push_str(&sweep_report(
+            &case,
+            &hierarchy,
+            &sweep,
+            disk,
+            v,
+            &args.output,
+        )?);
+        print!("{out}");
+        return Ok(());
+    }
+    let study_settings = StudySettings {
+        levels: args.levels,
+        solver: settings,
+    };
+    let mut studies: Vec<(Variant, Study)> = Vec::new();
+    for v in variants(&case, args.compare)? {
+        let data = ProblemData {
+            tension: t,
+            load,
+            shape: &fields.shape,
+            stiffness: fields.stiffness(),
+            foundation: v.foundation,
+            sampling: v.sampling,
+        };
+        let target = match (&exact, studies.first()) {
+            (Some(e), _) => Target::Exact(e.solution()),
+            (None, None) => Target::Finest,
+            (None, Some((_, first))) => Target::Discrete(&first.finest_u),
+        };
+        let quiet = args.quiet;
+        let label = v.name;
+        let mut progress = |r: &LevelResult| {
+            if !quiet {
+                eprintln!(
+                    "  {}level {}: {} vertices, {} {} iterations, assembly {:.2} s, solve {:.2} s",
+                    if label.is_empty() {
+                        String::new()
+                    } else {
+                        format!("[{label}] ")
+                    },
+                    r.level,
+                    r.vertices,
+                    r.method.name(),
+                    r.iterations,
+                    r.assembly_seconds,
+                    r.solve_seconds
+                );
+            }
+        };
+        let s = study::run(
+            hierarchy.clone(),
+            &data,
+            target,
+            &study_settings,
+            &mut progress,
+        )?;
+        studies.push((v, s));
+    }
+    let reference_note = match (&exact, args.compare) {
+        (Some(_), _) => None,
+        (None, None) => Some("errors against the finest level's solution".to_string()),
+        (None, Some(_)) => Some(format!(
+            "errors of every variant against the finest level of the {} variant",
+            studies[0].0.name
+        )),
+    };
+    let mut plot_series = Vec::new();
+    let mut written = Vec::new();
+    for (v, s) in &studies {
+        out.push_str(&table(
+            &case,
+            v,
+            s,
+            exact.is_some(),
+            reference_note.as_deref(),
+        ));
+        let file = if v.name.is_empty() {
+            "convergence.csv".to_string()
+        } else {
+            format!("convergence-{}.csv", v.name)
+        };
+        write_csv(&args.output.join(&file), s)?;
+        written.push(file);
+        let suffix = if v.name.is_empty() {
+            String::new()
+        } else {
+            format!(" ({})", v.name)
+        };
+        let pts = |f: &dyn Fn(&LevelResult) -> Option<f64>| -> Vec<(f64, f64)> {
+            s.levels
+                .iter()
+                .filter_map(|r| f(r).map(|e| (r.l_n, e)))
+                .collect()
+        };
+        plot_series.push((
+            format!("L² error{suffix}"),
+            pts(&|r| r.errors.map(|e| e.l2)),
+        ));
+        plot_series.push((
+            format!("H¹ error{suffix}"),
+            pts(&|r| r.errors.map(|e| e.h1_semi)),
+        ));
+    }
+    let title = format!(
+        "Convergence: {}",
+        case.path
+            .file_name()
+            .map(|n| n.to_string_lossy().into_owned())
+            .unwrap_or_default()
+    );
+    plot::loglog_plot(
+        &args.output.join("convergence.png"),
+        &title,
+        "mesh size lₙ",
+        if exact.is_some() {
+            "error against the exact solution"
+        } else {
+            "error against the reference solution"
+        },
+        &plot_series,
+        &[1.0, 2.0],
+    )?;
+    written.push("convergence.png".into());
+    let _ = writeln!(
+        out,
+        "  wrote        {}/{{{}}}",
+        args.output.display(),
+        written.join(", ")
+    );
+    print!("{out}");
+    Ok(())
+}
+
+/// A number in the table, or a dash.
+fn sci(v: Option<f64>) -> String {
+    match v {
+        Some(x) if x.is_finite() => format!("{x:.3e}"),
+        _ => "—".into(),
+    }
+}
+
+fn rate(v: Option<f64>) -> String {
+    match v {
+        Some(x) if x.is_finite() => format!("{x:.2}"),
+        _ => "—".into(),
+    }
+}
+
+/// The human table of one study.
+fn table(case: &Case, v: &Variant, s: &Study, exact: bool, reference: Option<&str>) -> String {
+    let mut o = String::new();
+    let sampling = match v.sampling {
+        Sampling::Nodal => "nodal".to_string(),
+        Sampling::Mollified { epsilon: None } => "mollified (paper's ε_n)".to_string(),
+        Sampling::Mollified { epsilon: Some(e) } => format!("mollified (ε = {e})"),
+    };
+    let _ = writeln!(
+        o,
+        "\n  {}foundation {}, sampling {}, solver {} (tolerance {:.0e}){}",
+        if v.name.is_empty() {
+            String::new()
+        } else {
+            format!("[{}] ", v.name)
+        },
+        if case.obstacle.stiffness.is_rigid() {
+            "rigid"
+        } else {
+            v.foundation.name()
+        },
+        sampling,
+        case.solver.method,
+        case.solver.tolerance.0,
+        reference.map(|r| format!("; {r}")).unwrap_or_default()
+    );
+    let radius = exact && s.levels.iter().any(|r| r.contact_radius_error.is_some());
+    let _ = write!(
+        o,
+        "  {:>5} {:>9} {:>10} {:>10} {:>5} {:>10} {:>5} {:>10} {:>5}",
+        "level", "vertices", "l_n", "L² error", "rate", "H¹ error", "rate", "max nodal", "rate"
+    );
+    if radius {
+        let _ = write!(o, " {:>10} {:>10}", "radius a_h", "|a_h − a|");
+    } else if !exact {
+        let _ = write!(o, " {:>10} {:>5}", "H¹ Δu_k", "rate");
+    }
+    let _ = writeln!(o, " {:>6} {:>10} {:>8}", "iters", "method", "solve s");
+    for (k, r) in s.levels.iter().enumerate() {
+        let e = r.errors;
+        let _ = write!(
+            o,
+            "  {:>5} {:>9} {:>10.4e} {:>10} {:>5} {:>10} {:>5} {:>10} {:>5}",
+            r.level,
+            r.vertices,
+            r.l_n,
+            sci(e.map(|e| e.l2)),
+            rate(s.l2_rates[k]),
+            sci(e.map(|e| e.h1_semi)),
+            rate(s.h1_rates[k]),
+            sci(e.map(|e| e.max_nodal)),
+            rate(s.max_nodal_rates[k]),
+        );
+        if radius {
+            let _ = write!(
+                o,
+                " {:>10.6} {:>10}",
+                r.contact.radius,
+                sci(r.contact_radius_error)
+            );
+        } else if !exact {
+            let _ = write!(
+                o,
+                " {:>10} {:>5}",
+                sci(r.increment.map(|d| d[1])),
+                rate(s.h1_increment_rates[k])
+            );
+        }
+        let _ = writeln!(
+            o,
+            " {:>6} {:>10} {:>8.3}",
+            r.iterations,
+            r.method.name(),
+            r.solve_seconds
+        );
+    }
+    // The same note on several levels is printed once, with the levels it applies to.
+    let mut notes: Vec<(&str, Vec<usize>)> = Vec::new();
+    for r in &s.levels {
+        if let Some(n) = &r.note {
+            match notes.iter_mut().find(|(m, _)| *m == n.as_str()) {
+                Some((_, levels)) => levels.push(r.level),
+                None => notes.push((n, vec![r.level])),
+            }
+        }
+    }
+    for (n, levels) in notes {
+        let l: Vec<String> = levels.iter().map(|l| l.to_string()).collect();
+        let _ = writeln!(
+            o,
+            "  note: level{} {}: {n}",
+            if l.len() > 1 { "s" } else { "" },
+            l.join(", ")
+        );
+    }
+    if let (Some(Some(l2)), Some(Some(h1))) = (s.l2_rates.last(), s.h1_rates.last()) {
+        let _ = writeln!(
+            o,
+            "  last rates   L² {l2:.3}, H¹ {h1:.3} (optimal for P1: 2 and 1)"
+        );
+    }
+    o
+}
+
+/// An owned CSV column: floats (NaN for a missing value, written as an empty field) or
+/// integers.
+enum Column {
+    F(Vec<f64>),
+    I(Vec<i32>),
+}
+
+/// Writes named columns atomically with [`write_columns_csv`].
+fn write_csv_columns(path: &Path, columns: &[(&str, Column)]) -> Result<()> {
+    let arrays: Vec<(&str, DataArray)> = columns
+        .iter()
+        .map(|(name, c)| {
+            (
+                *name,
+                match c {
+                    Column::F(v) => DataArray::F64(v),
+                    Column::I(v) => DataArray::I32(v),
+                },
+            )
+        })
+        .collect();
+    write_columns_csv(path, &arrays)?;
+    Ok(())
+}
+
+/// Writes one study as CSV: the required columns `level, vertices, l_n, l2_error,
+/// h1_error, max_nodal_error, l2_rate, h1_rate` first, then the extras (missing values
+/// are empty fields).
+fn write_csv(path: &Path, s: &Study) -> Result<()> {
+    let rows = &s.levels;
+    let f = |g: &dyn Fn(usize, &LevelResult) -> Option<f64>| -> Column {
+        Column::F(
+            rows.iter()
+                .enumerate()
+                .map(|(k, r)| g(k, r).unwrap_or(f64::NAN))
+                .collect(),
+        )
+    };
+    let i = |g: &dyn Fn(&LevelResult) -> usize| -> Column {
+        Column::I(rows.iter().map(|r| g(r) as i32).collect())
+    };
+    let columns = [
+        ("level", i(&|r| r.level)),
+        ("vertices", i(&|r| r.vertices)),
+        ("l_n", f(&|_, r| Some(r.l_n))),
+        ("l2_error", f(&|_, r| r.errors.map(|e| e.l2))),
+        ("h1_error", f(&|_, r| r.errors.map(|e| e.h1_semi))),
+        ("max_nodal_error", f(&|_, r| r.errors.map(|e| e.max_nodal))),
+        ("l2_rate", f(&|k, _| s.l2_rates[k])),
+        ("h1_rate", f(&|k, _| s.h1_rates[k])),
+        ("triangles", i(&|r| r.triangles)),
+        ("unknowns", i(&|r| r.unknowns)),
+        ("max_nodal_rate", f(&|k, _| s.max_nodal_rates[k])),
+        ("contact_area", f(&|_, r| Some(r.contact.area))),
+        ("contact_radius", f(&|_, r| Some(r.contact.radius))),
+        ("contact_area_error", f(&|_, r| r.contact_area_error)),
+        ("contact_radius_error", f(&|_, r| r.contact_radius_error)),
+        ("gap_area", f(&|_, r| r.errors.map(|e| e.gap_area))),
+        ("gap_l2", f(&|_, r| r.errors.map(|e| e.gap_l2))),
+        ("gap_h1", f(&|_, r| r.errors.map(|e| e.gap_h1_semi))),
+        ("l2_increment", f(&|_, r| r.increment.map(|d| d[0]))),
+        ("h1_increment", f(&|_, r| r.increment.map(|d| d[1]))),
+        ("l2_increment_rate", f(&|k, _| s.l2_increment_rates[k])),
+        ("h1_increment_rate", f(&|k, _| s.h1_increment_rates[k])),
+        ("iterations", i(&|r| r.iterations)),
+        ("kkt_residual", f(&|_, r| Some(r.kkt))),
+        ("assembly_s", f(&|_, r| Some(r.assembly_seconds))),
+        ("solve_s", f(&|_, r| Some(r.solve_seconds))),
+        ("error_s", f(&|_, r| Some(r.error_seconds))),
+    ];
+    write_csv_columns(path, &columns)
+}
+
+/// Prints the h sweep and writes h_sweep.csv and h_sweep.png.
+fn sweep_report(
+    case: &Case,
+    hierarchy: &Hierarchy,
+    sweep: &Sweep,
+    disk: Option<&DiskCase>,
+    v: &Variant,
+    dir: &Path,
+) -> Result<String> {
+    let mesh = hierarchy.finest();
+    let q = mesh.quality();
+    // The continuous distance at the vertices, when the disc's closed forms are known.
+    let continuous: Vec<Option<f64>> = sweep
+        .rows
+        .iter()
+        .map(|r| -> Result<Option<f64>> {
+            let Some(d) = disk else { return Ok(None) };
+            let rigid = d.with_stiffness(None)?;
+            let elastic = d.with_stiffness(Some(r.h))?;
+            Ok(Some(mesh.points.iter().fold(0.0f64, |m, &p| {
+                m.max((elastic.value(p) - rigid.value(p)).abs())
+            })))
+        })
+        .collect::<Result<_>>()
+        .context("the disc's exact solutions for the sweep")?;
+    let mut o = String::new();
+    let _ = writeln!(
+        o,
+        "  rigid limit  {} vertices, l_n = {:.4e}, foundation {}; distance of u_h(h) to the \
+         discrete rigid solution u_h(∞) (rigid: {} iterations, contact radius {:.6})",
+        q.vertices,
+        q.l_n,
+        v.foundation.name(),
+        sweep.rigid_iterations,
+        sweep.rigid_contact.radius
+    );
+    let _ = write!(
+        o,
+        "  {:>10} {:>12} {:>12} {:>12} {:>10}",
+        "h", "max nodal", "H¹ semi", "L²", "radius"
+    );
+    if disk.is_some() {
+        let _ = write!(o, " {:>14}", "exact max |Δu|");
+    }
+    let _ = writeln!(o, " {:>6} {:>8}", "iters", "solve s");
+    for (r, c) in sweep.rows.iter().zip(&continuous) {
+        let _ = write!(
+            o,
+            "  {:>10.1e} {:>12.4e} {:>12.4e} {:>12.4e} {:>10.6}",
+            r.h, r.max_nodal, r.h1_semi, r.l2, r.contact.radius
+        );
+        if disk.is_some() {
+            let _ = write!(o, " {:>14}", sci(*c));
+        }
+        let _ = writeln!(o, " {:>6} {:>8.3}", r.iterations, r.solve_seconds);
+    }
+    let monotone = sweep
+        .rows
+        .windows(2)
+        .all(|w| w[1].max_nodal < w[0].max_nodal && w[1].h1_semi < w[0].h1_semi);
+    let _ = writeln!(
+        o,
+        "  the distance {} monotonically with h",
+        if monotone {
+            "decreases"
+        } else {
+            "does NOT decrease"
+        }
+    );
+    let r = &sweep.rows;
+    let col = |g: &dyn Fn(&memcontact::convergence::SweepRow) -> f64| -> Column {
+        Column::F(r.iter().map(g).collect())
+    };
+    write_csv_columns(
+        &dir.join("h_sweep.csv"),
+        &[
+            ("h", col(&|r| r.h)),
+            ("max_nodal_distance", col(&|r| r.max_nodal)),
+            ("h1_distance", col(&|r| r.h1_semi)),
+            ("l2_distance", col(&|r| r.l2)),
+            ("contact_area", col(&|r| r.contact.area)),
+            ("contact_radius", col(&|r| r.contact.radius)),
+            (
+                "exact_max_distance",
+                Column::F(continuous.iter().map(|c| c.unwrap_or(f64::NAN)).collect()),
+            ),
+            (
+                "iterations",
+                Column::I(r.iter().map(|r| r.iterations as i32).collect()),
+            ),
+            ("solve_s", col(&|r| r.solve_seconds)),
+        ],
+    )?;
+    let mut series = vec![
+        (
+            "max nodal |u_h(h) − u_h(∞)|".to_string(),
+            sweep.rows.iter().map(|r| (r.h, r.max_nodal)).collect(),
+        ),
+        (
+            "H¹ seminorm".to_string(),
+            sweep.rows.iter().map(|r| (r.h, r.h1_semi)).collect(),
+        ),
+    ];
+    if disk.is_some() {
+        series.push((
+            "exact max |u(h) − u(∞)|".to_string(),
+            sweep
+                .rows
+                .iter()
+                .zip(&continuous)
+                .filter_map(|(r, c)| c.map(|c| (r.h, c)))
+                .collect(),
+        ));
+    }
+    plot::loglog_plot(
+        &dir.join("h_sweep.png"),
+        &format!(
+            "Rigid limit: {}",
+            case.path
+                .file_name()
+                .map(|n| n.to_string_lossy().into_owned())
+                .unwrap_or_default()
+        ),
+        "stiffness h",
+        "distance to the rigid solution",
+        &series,
+        &[-0.5, -1.0],
+    )?;
+    let _ = writeln!(
+        o,
+        "  wrote        {}/{{h_sweep.csv, h_sweep.png}}",
+        dir.display()
+    );
+    Ok(o)
+}

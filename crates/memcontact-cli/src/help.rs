@@ -1,0 +1,28 @@
+//! Long help texts: the case-file keys with their units and defaults.
+
+/// The case-file reference printed by `memcontact solve --help` and `check --help`.
+pub const CASE_KEYS: &str = "\
+CASE FILE (TOML; paths relative to the case file; unknown keys are errors)
+
+[mesh]        file = \"mesh.msh\"          Gmsh MSH 2.2/4.1, ASCII or binary; or instead
+              generator = \"rectangle\"    x0, y0, x1, y1 (0, 0, 1, 1), nx (16), ny (nx),
+                                         diagonal = right | left | alternate | crossed (right)
+              generator = \"disk\"         center ([0, 0]), radius (1), size (radius/8)
+              generator = \"polygon\"      outer = [[x, y], ...], holes = [[[x, y], ...]],
+                                         regions = [{ name, polygon }], size, min_angle (25°)
+              refine = 0                 uniform refinements (levels kept for multigrid)
+[membrane]    tension = t > 0            force/length
+              load = f                   force/area: number, expression in x, y, or region table
+[obstacle]    shape = φ                  length: number, expression or region table
+              stiffness = h ≥ 0          force/length³, or \"rigid\" (u ≤ φ)
+              foundation = consistent    or lumped (l_i = ∫ h g_i)
+              sampling = nodal           or mollified (φ_n = r_n(J_ε * φ)); epsilon = ε (paper's ε_n)
+[solver]      method = auto              linear | active-set | qp | coordinate | multigrid
+              tolerance = 1e-10          on the scaled KKT residual (2e, 2f)
+              max_iterations             per method by default
+[output]      vtu = binary               or ascii
+
+Units: any consistent system (e.g. m, kN: t in kN/m, f in kN/m², h in kN/m³).
+Expressions: x, y, r, pi, e; + - * / ^; < <= > >= == != && || !; sin cos tan asin acos atan
+atan2 sinh cosh tanh exp ln log log10 sqrt abs min max pow floor ceil round sign hypot step
+if(c, a, b).";
