@@ -8,58 +8,17 @@ use memcontact::bench::{run_bench, BenchRow};
 use memcontact::model::Foundation;
 use memcontact::solve::multigrid::Options;
 
-/// `-- --micro N`: times the kernels of one V-cycle on the N × N benchmark mesh.
+/// `-- --micro N`: times the kernels of one TNNMG iteration on the N × N benchmark mesh.
 fn micro(n: usize) {
-    use memcontact::solve::multigrid::{Levels, Multigrid};
-    use std::time::Instant;
     let h = memcontact::bench::mesh(n).unwrap();
-    let m = memcontact::bench::model(h.finest(), Foundation::Lumped).unwrap();
-    let levels = Levels::new(&h, &m.dofs, m.s.pattern.clone()).unwrap();
-    let mut mg = Multigrid::new(&levels, levels.len() - 1);
-    mg.update(&m.s, None).unwrap();
-    let mut x = vec![0.0; m.n()];
-    let mut y = vec![0.0; m.n()];
-    let reps = 10;
-    let t0 = Instant::now();
-    for _ in 0..reps {
-        m.s.mul_into(&x, &mut y);
+    for f in [Foundation::Lumped, Foundation::Consistent] {
+        let m = memcontact::bench::model(h.finest(), f).unwrap();
+        let t = memcontact::solve::multigrid::kernel_timings(&m, &h, 10).unwrap();
+        println!("{}:                      wall ms   cpu ms", f.name());
+        for (name, ms, cpu) in t {
+            println!("  {name:<24} {ms:8.2} {cpu:8.2}");
+        }
     }
-    println!(
-        "matvec      {:.2} ms",
-        t0.elapsed().as_secs_f64() * 1e3 / reps as f64
-    );
-    let t0 = Instant::now();
-    for _ in 0..reps {
-        mg.v_cycle(&m.s, &mut x, &m.d);
-    }
-    println!(
-        "V(1,1)      {:.2} ms",
-        t0.elapsed().as_secs_f64() * 1e3 / reps as f64
-    );
-    let t0 = Instant::now();
-    for _ in 0..reps {
-        mg.update(&m.s, None).unwrap();
-    }
-    println!(
-        "galerkin    {:.2} ms",
-        t0.elapsed().as_secs_f64() * 1e3 / reps as f64
-    );
-    let t0 = Instant::now();
-    for _ in 0..reps {
-        memcontact::solve::local::sweep_forward(&m, &mut x);
-    }
-    println!(
-        "nonsmooth   {:.2} ms",
-        t0.elapsed().as_secs_f64() * 1e3 / reps as f64
-    );
-    let t0 = Instant::now();
-    for _ in 0..reps {
-        std::hint::black_box(m.certificate(&x));
-    }
-    println!(
-        "certificate {:.2} ms",
-        t0.elapsed().as_secs_f64() * 1e3 / reps as f64
-    );
 }
 
 fn main() {

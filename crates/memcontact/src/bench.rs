@@ -60,6 +60,9 @@ pub struct BenchRow {
     pub poisson_phases: Vec<(String, f64)>,
 }
 
+/// Seconds, V-cycles and phases of one Poisson yardstick solve.
+type PoissonRun = (f64, usize, Vec<(String, f64)>);
+
 /// The benchmark's obstacle φ(x, y) = 0.5 + 0.1 sin(2πx) cos(2πy).
 pub fn obstacle(p: [f64; 2]) -> f64 {
     0.5 + 0.1 * (2.0 * PI * p[0]).sin() * (2.0 * PI * p[1]).cos()
@@ -113,7 +116,8 @@ pub fn run_bench(
         max_iterations: None,
     };
     for &n in sizes {
-        let mut poisson: Option<(f64, usize, Vec<(String, f64)>)> = None;
+        // (seconds, V-cycles, phases) of the Poisson solve, once per size.
+        let mut poisson: Option<PoissonRun> = None;
         for &foundation in foundations {
             reset_peak_memory();
             let t0 = Instant::now();
@@ -175,6 +179,17 @@ pub fn peak_memory() -> Option<u64> {
     let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
     let kb: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
     Some(kb * 1024)
+}
+
+/// CPU seconds used by the process so far, all threads (user + system, from
+/// `/proc/self/stat`, 10 ms resolution); `None` where unavailable.
+pub fn cpu_seconds() -> Option<f64> {
+    let stat = std::fs::read_to_string("/proc/self/stat").ok()?;
+    let rest = &stat[stat.rfind(')')? + 2..];
+    let f: Vec<&str> = rest.split_whitespace().collect();
+    let utime: f64 = f.get(11)?.parse().ok()?;
+    let stime: f64 = f.get(12)?.parse().ok()?;
+    Some((utime + stime) / 100.0)
 }
 
 /// Resets the peak resident set size to the current one (Linux `clear_refs` value 5);

@@ -80,22 +80,39 @@ fn merge(p: Pieces, q: Pieces) -> Pieces {
     }
 }
 
-/// One pass at α (elastic obstacle).
-fn pieces(model: &Model, v: &[f64], dir: &[f64], alpha: f64) -> Pieces {
+/// Penetrating on the left (bit 0) and right (bit 1) piece of α.
+#[inline]
+fn side_code(model: &Model, v: &[f64], dir: &[f64], alpha: f64, j: usize) -> u8 {
+    if !model.can_touch[j] {
+        return 0;
+    }
+    let x = v[j] - model.phi[j] + alpha * dir[j];
+    if x > 0.0 {
+        3
+    } else if x < 0.0 {
+        0
+    } else {
+        u8::from(dir[j] < 0.0) | (u8::from(dir[j] > 0.0) << 1)
+    }
+}
+
+/// One pass at α (elastic obstacle). For the consistent L, `codes` receives the side codes
+/// of every vertex first (one light pass), so that the rows of L read them instead of
+/// recomputing them for every neighbour.
+fn pieces(model: &Model, v: &[f64], dir: &[f64], alpha: f64, codes: &mut [u8]) -> Pieces {
     let w = |j: usize| v[j] - model.phi[j];
-    // Penetrating on the left / right piece of α.
+    let consistent = matches!(model.l, FoundationMatrix::Consistent(_));
+    if consistent {
+        super::transfer::par_rows(codes, |j, c| *c = side_code(model, v, dir, alpha, j));
+    }
+    let codes: &[u8] = codes;
     let side = |j: usize| -> (bool, bool) {
-        if !model.can_touch[j] {
-            return (false, false);
-        }
-        let x = w(j) + alpha * dir[j];
-        if x > 0.0 {
-            (true, true)
-        } else if x < 0.0 {
-            (false, false)
+        let c = if consistent {
+            codes[j]
         } else {
-            (dir[j] < 0.0, dir[j] > 0.0)
-        }
+            side_code(model, v, dir, alpha, j)
+        };
+        (c & 1 != 0, c & 2 != 0)
     };
     let block = |b: usize| -> Pieces {
         let (lo, hi) = (b * BLOCK, ((b + 1) * BLOCK).min(v.len()));
@@ -193,8 +210,12 @@ pub fn exact_step(model: &Model, v: &[f64], dir: &[f64], g0: f64, s2: f64) -> Op
     }
     let (mut lo, mut hi) = (0.0f64, f64::INFINITY);
     let mut alpha = 1.0f64;
+    let mut codes = match model.l {
+        FoundationMatrix::Consistent(_) => vec![0u8; v.len()],
+        _ => Vec::new(),
+    };
     for _ in 0..200 {
-        let p = pieces(model, v, dir, alpha);
+        let p = pieces(model, v, dir, alpha, &mut codes);
         let dl = g0 + alpha * s2 + p.left.0 + alpha * p.left.1;
         let dr = g0 + alpha * s2 + p.right.0 + alpha * p.right.1;
         if dl <= 0.0 && dr >= 0.0 {

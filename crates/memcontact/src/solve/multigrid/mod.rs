@@ -467,7 +467,8 @@ fn newton_system(
         }
     };
     let blocks = transfer::row_chunks(&pat, &mut a.val, CHUNK);
-    let work = |((start, vals), (gc, rc)): ((usize, &mut [f64]), (&mut [f64], &mut [f64]))| {
+    type Block<'a> = ((usize, &'a mut [f64]), (&'a mut [f64], &'a mut [f64]));
+    let work = |((start, vals), (gc, rc)): Block| {
         let mut off = 0;
         for (k, (gi, ri)) in gc.iter_mut().zip(rc.iter_mut()).enumerate() {
             let i = start + k;
@@ -523,71 +524,78 @@ const BLOCK: usize = 4096;
 /// `q ≥ 0` (elastic), `q = 0` where `p > 0`, `r = 0` where `V < φ`; off M, `r = 0`; for
 /// the rigid obstacle also `V ≤ φ`, measured against `max(‖V‖∞, ‖φ‖∞)`.
 fn fast_kkt(model: &Model, v: &[f64], scale: f64) -> (f64, f64) {
+    match &model.l {
+        FoundationMatrix::Consistent(l) => fast_kkt_with(model, v, scale, |i, s, e| {
+            let mut lp = 0.0;
+            for (&j, &lv) in l.pattern.col[s..e].iter().zip(&l.val[s..e]) {
+                let j = j as usize;
+                if lv != 0.0 && model.can_touch[j] {
+                    lp += lv * (v[j] - model.phi[j]).max(0.0);
+                }
+            }
+            let _ = i;
+            lp
+        }),
+        FoundationMatrix::Lumped(d) => fast_kkt_with(model, v, scale, |i, _, _| {
+            if model.can_touch[i] {
+                d[i] * (v[i] - model.phi[i]).max(0.0)
+            } else {
+                0.0
+            }
+        }),
+        FoundationMatrix::Rigid => fast_kkt_with(model, v, scale, |_, _, _| 0.0),
+    }
+}
+
+/// [`fast_kkt`] with `(L p)_i = lp(i, row start, row end)` (S and a consistent L share
+/// their pattern).
+fn fast_kkt_with(
+    model: &Model,
+    v: &[f64],
+    scale: f64,
+    lp_of: impl Fn(usize, usize, usize) -> f64 + Sync,
+) -> (f64, f64) {
     let n = model.n();
     let rigid = model.is_rigid();
-    let pen = |j: usize| {
-        if model.can_touch[j] {
-            (v[j] - model.phi[j]).max(0.0)
-        } else {
-            0.0
-        }
-    };
+    let pat = &model.s.pattern;
+    let sval = &model.s.val;
     // Per block: (force violation, feasibility violation, max |V|, vᵀr − vᵀD, pᵀLp).
     let block = |b: usize| -> [f64; 5] {
         let mut acc = [0.0f64; 5];
         let (lo, hi) = (b * BLOCK, ((b + 1) * BLOCK).min(n));
         for i in lo..hi {
-            let (cols, svals) = model.s.row(i);
+            let (s, e) = (pat.row_ptr[i], pat.row_ptr[i + 1]);
             let mut sv = 0.0;
-            let mut lp = 0.0;
-            match &model.l {
-                FoundationMatrix::Consistent(l) => {
-                    let lvals = &l.val[l.pattern.row_ptr[i]..l.pattern.row_ptr[i + 1]];
-                    for ((&j, &s), &lv) in cols.iter().zip(svals).zip(lvals) {
-                        let j = j as usize;
-                        sv += s * v[j];
-                        if lv != 0.0 {
-                            lp += lv * pen(j);
-                        }
-                    }
-                }
-                FoundationMatrix::Lumped(d) => {
-                    for (&j, &s) in cols.iter().zip(svals) {
-                        sv += s * v[j as usize];
-                    }
-                    lp = d[i] * pen(i);
-                }
-                FoundationMatrix::Rigid => {
-                    for (&j, &s) in cols.iter().zip(svals) {
-                        sv += s * v[j as usize];
-                    }
-                }
+            for (&j, &a) in pat.col[s..e].iter().zip(&sval[s..e]) {
+                sv += a * v[j as usize];
             }
             let r = sv - model.d[i];
-            let p = pen(i);
-            let mut force = 0.0f64;
-            if model.can_touch[i] {
+            let (vi, fi) = (v[i], model.phi[i]);
+            let force = if model.can_touch[i] {
+                let lp = lp_of(i, s, e);
+                let p = (vi - fi).max(0.0);
                 let q = r + lp;
-                force = force.max(r);
+                let mut f = r;
                 if !rigid {
-                    force = force.max(-q);
+                    f = f.max(-q);
                 }
                 if p > 0.0 {
-                    force = force.max(q.abs());
+                    f = f.max(q.abs());
                 }
-                if v[i] < model.phi[i] {
-                    force = force.max(r.abs());
+                if vi < fi {
+                    f = f.max(r.abs());
                 }
                 if rigid {
-                    acc[1] = acc[1].max(v[i] - model.phi[i]);
+                    acc[1] = acc[1].max(vi - fi);
                 }
+                acc[4] += p * lp;
+                f
             } else {
-                force = r.abs();
-            }
+                r.abs()
+            };
             acc[0] = acc[0].max(force);
-            acc[2] = acc[2].max(v[i].abs()).max(model.phi[i].abs());
-            acc[3] += v[i] * (r - model.d[i]);
-            acc[4] += p * lp;
+            acc[2] = acc[2].max(vi.abs()).max(fi.abs());
+            acc[3] += vi * (r - model.d[i]);
         }
         acc
     };
@@ -613,4 +621,91 @@ fn fast_kkt(model: &Model, v: &[f64], scale: f64) -> (f64, f64) {
         0.5 * tot[3] + 0.5 * tot[4]
     };
     (if kkt.is_nan() { f64::INFINITY } else { kkt }, energy)
+}
+
+/// Wall-clock and CPU (all threads) milliseconds per call of the kernels of one TNNMG
+/// iteration on `model` (for the benchmark's `--micro` mode; `reps` calls each, at a point
+/// with every vertex state).
+#[doc(hidden)]
+pub fn kernel_timings(
+    model: &Model,
+    hierarchy: &Hierarchy,
+    reps: usize,
+) -> Result<Vec<(&'static str, f64, f64)>> {
+    let mut out = Vec::new();
+    let mut time = |name: &'static str, f: &mut dyn FnMut()| {
+        let c0 = crate::bench::cpu_seconds().unwrap_or(f64::NAN);
+        let t0 = Instant::now();
+        for _ in 0..reps {
+            f();
+        }
+        let wall = t0.elapsed().as_secs_f64() * 1e3 / reps as f64;
+        let cpu = (crate::bench::cpu_seconds().unwrap_or(f64::NAN) - c0) * 1e3 / reps as f64;
+        out.push((name, wall, cpu));
+    };
+    let mut levels = None;
+    time("levels setup", &mut || {
+        levels = Levels::new(hierarchy, &model.dofs, model.s.pattern.clone()).ok()
+    });
+    let levels = levels.ok_or_else(|| crate::Error::Mesh("hierarchy does not fit".into()))?;
+    let top = levels.len() - 1;
+    time("coarse models", &mut || {
+        std::hint::black_box(coarse_model(
+            model,
+            &levels.transfers[top - 1],
+            &levels,
+            top - 1,
+        ));
+    });
+    let n = model.n();
+    let mut v: Vec<f64> = (0..n)
+        .map(|i| model.phi[i] + 0.01 * ((i as f64) * 0.37).sin())
+        .collect();
+    let scale = model.force_scale();
+    time("fast kkt", &mut || {
+        std::hint::black_box(fast_kkt(model, &v, scale));
+    });
+    time("force scale", &mut || {
+        std::hint::black_box(model.force_scale());
+    });
+    time("model certificate", &mut || {
+        std::hint::black_box(model.certificate(&v));
+    });
+    time("nonsmooth sweep", &mut || sweep_forward(model, &mut v));
+    let mut st = NewtonStates::of(model, &v);
+    time("states", &mut || st = NewtonStates::of(model, &v));
+    let mut a = Csr::zeros(model.s.pattern.clone());
+    let (mut g, mut r) = (vec![0.0; n], vec![0.0; n]);
+    time("newton system", &mut || {
+        newton_system(model, &v, &st, &mut a, None, &mut g, &mut r)
+    });
+    let (mut changed, mut dirty) = (vec![false; n], vec![false; n]);
+    let prev = st.clone();
+    time("mark dirty", &mut || {
+        mark_dirty(&model.s.pattern, &prev, &st, &mut changed, &mut dirty);
+    });
+    let mut mg = Multigrid::new(&levels, top);
+    time("coarse operators (all)", &mut || {
+        mg.update(&a, None).unwrap_or(())
+    });
+    let mut delta = vec![0.0; n];
+    let rhs: Vec<f64> = g.iter().map(|x| -x).collect();
+    time("v-cycle", &mut || mg.v_cycle(&a, &mut delta, &rhs));
+    for (i, d) in delta.iter_mut().enumerate() {
+        if st.truncated[i] {
+            *d = 0.0;
+        }
+    }
+    let mut gs = (0.0, 0.0);
+    time("line data", &mut || gs = line::line_data(model, &delta, &r));
+    let mut alpha = None;
+    time("exact step", &mut || {
+        alpha = line::exact_step(model, &v, &delta, gs.0, gs.1)
+    });
+    let mut w = v.clone();
+    time("apply step", &mut || {
+        w.copy_from_slice(&v);
+        apply_step(model, &mut w, &delta, alpha.unwrap_or(0.0));
+    });
+    Ok(out)
 }

@@ -275,145 +275,6 @@ fn one_level_is_a_direct_truncated_newton() {
 }
 
 #[test]
-#[ignore]
-fn print_rates() {
-    for nu in [(1, 1), (2, 2), (2, 1), (3, 3)] {
-        for levels in [3, 5, 6] {
-            let h = square_hierarchy(4, levels);
-            let model = bench_model(h.finest(), Some(0.0), Foundation::Lumped);
-            let lv = Levels::new(&h, &model.dofs, model.s.pattern.clone()).unwrap();
-            let mut mg = Multigrid::new(&lv, lv.len() - 1);
-            mg.smoothing = nu;
-            mg.update(&model.s, None).unwrap();
-            let mut x = vec![0.0; model.n()];
-            let mut r = vec![0.0; model.n()];
-            let mut rates = vec![];
-            let mut last = norm_inf(&model.d);
-            for _ in 0..12 {
-                mg.v_cycle(&model.s, &mut x, &model.d);
-                cycle::residual(&model.s, &x, &model.d, &mut r);
-                let n = norm_inf(&r);
-                rates.push(format!("{:.3}", n / last));
-                last = n;
-            }
-            println!("{nu:?} {levels}: {}", rates.join(" "));
-        }
-    }
-}
-
-#[test]
-#[ignore]
-fn print_counts() {
-    for (h, f) in [
-        (Some(1000.0), Foundation::Consistent),
-        (Some(1000.0), Foundation::Lumped),
-        (None, Foundation::Lumped),
-    ] {
-        for nested in [true, false] {
-            for levels in 3..=7 {
-                let hier = square_hierarchy(2, levels);
-                let model = bench_model(hier.finest(), h, f);
-                let opts = Options {
-                    nested,
-                    ..Options::default()
-                };
-                let (sol, rep) =
-                    solve_with(&model, &hier, &settings(1e-10), &opts, &mut Silent).unwrap();
-                let its: Vec<usize> = rep.levels.iter().map(|l| l.iterations).collect();
-                let res: Vec<String> = sol
-                    .history
-                    .iter()
-                    .map(|r| format!("{:.0e}", r.residual))
-                    .collect();
-                println!(
-                    "{f:?} {h:?} nested={nested} n={}: {its:?} {}",
-                    2 << (levels - 1),
-                    res.join(" ")
-                );
-            }
-        }
-    }
-}
-
-#[test]
-#[ignore]
-fn print_options() {
-    let combos: Vec<(&str, Options)> = vec![
-        ("default", Options::default()),
-        (
-            "ntol 1e-8",
-            Options {
-                nested_tolerance: 1e-8,
-                ..Options::default()
-            },
-        ),
-        (
-            "ntol 1e-4",
-            Options {
-                nested_tolerance: 1e-4,
-                ..Options::default()
-            },
-        ),
-        (
-            "ntol 1e-3",
-            Options {
-                nested_tolerance: 1e-3,
-                ..Options::default()
-            },
-        ),
-        (
-            "V(2,2)",
-            Options {
-                smoothing: (2, 2),
-                ..Options::default()
-            },
-        ),
-        (
-            "2 cycles",
-            Options {
-                cycles: 2,
-                ..Options::default()
-            },
-        ),
-        (
-            "pre 2",
-            Options {
-                presmoothing: 2,
-                ..Options::default()
-            },
-        ),
-        (
-            "pre 0",
-            Options {
-                presmoothing: 0,
-                ..Options::default()
-            },
-        ),
-    ];
-    for (h, f) in [
-        (Some(1000.0), Foundation::Consistent),
-        (Some(1000.0), Foundation::Lumped),
-        (None, Foundation::Lumped),
-    ] {
-        for (name, opts) in &combos {
-            let mut line = format!("{f:?} {h:?} {name}:");
-            for levels in [5, 7] {
-                let hier = square_hierarchy(2, levels);
-                let model = bench_model(hier.finest(), h, f);
-                match solve_with(&model, &hier, &settings(1e-10), opts, &mut Silent) {
-                    Ok((_, rep)) => {
-                        let its: Vec<usize> = rep.levels.iter().map(|l| l.iterations).collect();
-                        line += &format!(" {its:?}");
-                    }
-                    Err(e) => line += &format!(" {e}"),
-                }
-            }
-            println!("{line}");
-        }
-    }
-}
-
-#[test]
 fn fused_newton_system_is_the_active_set_system() {
     use crate::solve::active_set::{fill_truncated_hessian, piece_gradient};
     let hier = square_hierarchy(4, 3);
@@ -479,47 +340,37 @@ fn block_gauss_seidel_keeps_the_rate_and_ignores_the_thread_count() {
 }
 
 #[test]
-#[ignore]
-fn print_big_poisson() {
-    for levels in [10] {
-        let h = if levels == 9 {
-            square_hierarchy(4, levels)
-        } else {
-            crate::bench::mesh(1024).unwrap()
-        };
-        let model = bench_model(h.finest(), Some(0.0), Foundation::Lumped);
-        let lv = Levels::new(&h, &model.dofs, model.s.pattern.clone()).unwrap();
-        let mut mg = Multigrid::new(&lv, lv.len() - 1);
-        mg.update(&model.s, None).unwrap();
-        let mut x = vec![0.0; model.n()];
-        let mut r = vec![0.0; model.n()];
-        let mut rates = vec![];
-        let mut last = norm_inf(&model.d);
-        for _ in 0..40 {
-            mg.v_cycle(&model.s, &mut x, &model.d);
-            cycle::residual(&model.s, &x, &model.d, &mut r);
-            let n = norm_inf(&r);
-            rates.push(format!("{:.3}({:.0e})", n / last, n / norm_inf(&model.d)));
-            last = n;
+fn fast_certificate_and_energy_are_the_models() {
+    let hier = square_hierarchy(4, 3);
+    for (h, f) in [
+        (Some(1000.0), Foundation::Consistent),
+        (Some(1000.0), Foundation::Lumped),
+        (None, Foundation::Lumped),
+    ] {
+        let model = bench_model(hier.finest(), h, f);
+        let scale = model.force_scale();
+        for shift in [-0.02, 0.0, 0.03] {
+            let mut v: Vec<f64> = (0..model.n())
+                .map(|i| model.phi[i] + shift + 0.05 * ((i as f64) * 0.7).sin())
+                .collect();
+            if h.is_none() && shift < 0.0 {
+                for (x, p) in v.iter_mut().zip(&model.phi) {
+                    *x = x.min(*p);
+                }
+            }
+            let (kkt, energy) = fast_kkt(&model, &v, scale);
+            let c = model.certificate(&v);
+            assert!(
+                (kkt - c.kkt()).abs() <= 1e-14 * c.kkt(),
+                "{f:?}: {kkt} {}",
+                c.kkt()
+            );
+            let e = model.energy(&v);
+            if e.is_finite() {
+                assert!((energy - e).abs() <= 1e-12 * e.abs(), "{energy} {e}");
+            } else {
+                assert!(energy.is_infinite());
+            }
         }
-        println!("{levels}: {}", rates.join(" "));
     }
-}
-
-#[test]
-#[ignore]
-fn print_bench_poisson() {
-    let h = crate::bench::mesh(1024).unwrap();
-    let model = crate::bench::model(h.finest(), Foundation::Lumped).unwrap();
-    let out = poisson_solve(
-        &model.s,
-        &model.d,
-        &h,
-        &model.dofs,
-        1e-10,
-        Some(model.force_scale()),
-        200,
-    )
-    .unwrap();
-    println!("cycles {}", out.cycles);
 }

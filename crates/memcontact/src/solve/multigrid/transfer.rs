@@ -65,12 +65,10 @@ impl Transfer {
             )));
         }
         let n_fine = fine.len();
-        let mut parents = Vec::with_capacity(n_fine);
-        let mut weights = Vec::with_capacity(n_fine);
-        for &v in &fine.vertex {
+        let map = |&v: &u32| -> ([u32; 2], [f64; 2]) {
             let [a, b] = refinement.parents[v as usize];
             let (da, db) = (coarse.dof[a as usize], coarse.dof[b as usize]);
-            let (p, w) = if a == b {
+            if a == b {
                 match da {
                     Some(i) => ([i, i], [1.0, 0.0]),
                     None => ([0, 0], [0.0, 0.0]),
@@ -82,10 +80,13 @@ impl Transfer {
                     (None, Some(j)) => ([j, j], [0.5, 0.0]),
                     (None, None) => ([0, 0], [0.0, 0.0]),
                 }
-            };
-            parents.push(p);
-            weights.push(w);
-        }
+            }
+        };
+        let (parents, weights): (Vec<[u32; 2]>, Vec<[f64; 2]>) = if n_fine >= PAR_ROWS {
+            fine.vertex.par_iter().with_min_len(4096).map(map).unzip()
+        } else {
+            fine.vertex.iter().map(map).unzip()
+        };
         // Columns: counting sort by parent (children stay in increasing fine order).
         let n_coarse = coarse.len();
         let mut child_ptr = vec![0usize; n_coarse + 1];
@@ -178,42 +179,56 @@ impl Transfer {
     /// The sparsity pattern of `Pᵀ A P` for A on `fine` (the symbolic Galerkin product,
     /// computed once per hierarchy). The diagonal is always stored.
     pub fn galerkin_pattern(&self, fine: &Pattern) -> Pattern {
+        const ROWS: usize = 4096;
         let n_coarse = self.n_coarse;
+        // Per block of coarse rows: the row lengths and the concatenated sorted columns.
         // `seen[j] == i` marks column j as already in row i (no sort of duplicates).
-        let row = |seen: &mut Vec<u32>, i: usize| {
-            let mut r: Vec<u32> = Vec::with_capacity(16);
-            r.push(i as u32);
-            seen[i] = i as u32;
-            for &v in &self.children[self.child_ptr[i]..self.child_ptr[i + 1]] {
-                let v = v as usize;
-                for &w in &fine.col[fine.row_ptr[v]..fine.row_ptr[v + 1]] {
-                    let (p, wt) = (self.parents[w as usize], self.weights[w as usize]);
-                    for s in 0..2 {
-                        if wt[s] != 0.0 && seen[p[s] as usize] != i as u32 {
-                            seen[p[s] as usize] = i as u32;
-                            r.push(p[s]);
+        let block = |seen: &mut Vec<u32>, b: usize| -> (Vec<usize>, Vec<u32>) {
+            let (lo, hi) = (b * ROWS, ((b + 1) * ROWS).min(n_coarse));
+            let mut lens = Vec::with_capacity(hi - lo);
+            let mut cols = Vec::with_capacity((hi - lo) * 9);
+            let mut r: Vec<u32> = Vec::with_capacity(64);
+            for i in lo..hi {
+                r.clear();
+                r.push(i as u32);
+                seen[i] = i as u32;
+                for &v in &self.children[self.child_ptr[i]..self.child_ptr[i + 1]] {
+                    let v = v as usize;
+                    for &w in &fine.col[fine.row_ptr[v]..fine.row_ptr[v + 1]] {
+                        let (p, wt) = (self.parents[w as usize], self.weights[w as usize]);
+                        for s in 0..2 {
+                            if wt[s] != 0.0 && seen[p[s] as usize] != i as u32 {
+                                seen[p[s] as usize] = i as u32;
+                                r.push(p[s]);
+                            }
                         }
                     }
                 }
+                r.sort_unstable();
+                lens.push(r.len());
+                cols.extend_from_slice(&r);
             }
-            r.sort_unstable();
-            r
+            (lens, cols)
         };
-        let rows: Vec<Vec<u32>> = (0..n_coarse)
-            .into_par_iter()
-            .with_min_len(1024)
-            .map_init(|| vec![u32::MAX; n_coarse], row)
-            .collect();
-        let mut row_ptr = Vec::with_capacity(rows.len() + 1);
+        let nb = n_coarse.div_ceil(ROWS);
+        let blocks: Vec<(Vec<usize>, Vec<u32>)> = if n_coarse >= PAR_ROWS {
+            (0..nb)
+                .into_par_iter()
+                .map_init(|| vec![u32::MAX; n_coarse], block)
+                .collect()
+        } else {
+            let mut seen = vec![u32::MAX; n_coarse];
+            (0..nb).map(|b| block(&mut seen, b)).collect()
+        };
+        let total: usize = blocks.iter().map(|b| b.1.len()).sum();
+        let mut row_ptr = Vec::with_capacity(n_coarse + 1);
         row_ptr.push(0);
-        let mut total = 0;
-        for r in &rows {
-            total += r.len();
-            row_ptr.push(total);
-        }
         let mut col = Vec::with_capacity(total);
-        for r in rows {
-            col.extend_from_slice(&r);
+        for (lens, cols) in blocks {
+            for l in lens {
+                row_ptr.push(row_ptr.last().copied().unwrap_or(0) + l);
+            }
+            col.extend_from_slice(&cols);
         }
         Pattern { row_ptr, col }
     }
