@@ -1,6 +1,7 @@
 //! `memcontact`: the command-line tool. Parses arguments, reads the case, runs the library,
 //! prints a summary and writes the outputs. All the numerics live in the library.
 
+mod bench;
 mod case;
 mod commands;
 mod convergence;
@@ -56,6 +57,20 @@ enum Command {
     /// against the case's [exact] solution, rates, convergence.csv and convergence.png
     /// (or, with --h-sweep, the distance to the rigid limit).
     Convergence(convergence::Args),
+    /// The standard benchmark (issue 4): TNNMG on the N × N unit square against one
+    /// linear Poisson multigrid solve; prints unknowns, iterations (total and per level),
+    /// mesh / assembly / solve seconds, peak memory and the final KKT certificate.
+    Bench {
+        /// Cells per side, comma-separated (release build recommended).
+        #[arg(long, value_delimiter = ',', default_values_t = [128usize, 256, 512, 1024, 2048])]
+        sizes: Vec<usize>,
+        /// lumped, consistent or both.
+        #[arg(long, default_value = "both")]
+        foundation: String,
+        /// Also print the time per solver phase.
+        #[arg(long)]
+        phases: bool,
+    },
     /// List the example cases, or write one (and any mesh it needs) to a directory.
     Example {
         /// The example to write; omit to list them.
@@ -81,6 +96,11 @@ fn main() -> ExitCode {
         Command::Check { case, sets } => commands::check(&case, &sets),
         Command::Convergence(args) => convergence::run(&args),
         Command::Example { name, dir, force } => examples::run(name.as_deref(), &dir, force),
+        Command::Bench {
+            sizes,
+            foundation,
+            phases,
+        } => bench::run(&sizes, &foundation, phases),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
