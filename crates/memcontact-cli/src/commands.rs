@@ -124,6 +124,9 @@ pub fn solve(case_path: &Path, out: &Path, sets: &[String], quiet: bool) -> Resu
         .with_context(|| format!("cannot create the output directory {}", out.display()))?;
     let report = output::write_all(&case, &run, out, t0)?;
     print!("{report}");
+    // The process ends right after this: returning the (possibly gigabytes of) mesh
+    // levels and matrices to the allocator page by page would only delay the exit.
+    std::mem::forget(run);
     Ok(())
 }
 
@@ -142,7 +145,10 @@ pub fn check(case_path: &Path, sets: &[String]) -> Result<()> {
     // Binding and assembling checks the data on the mesh (regions, signs, NaN).
     let model = assemble(&case, &hierarchy)?;
     println!("case {}: valid", case_path.display());
-    print!("{}", output::mesh_report(mesh, hierarchy.depth()));
+    print!(
+        "{}",
+        output::mesh_report(mesh, &mesh.quality(), hierarchy.depth())
+    );
     println!(
         "  obstacle     {} vertices can touch (M), foundation {}{}",
         model.can_touch.iter().filter(|&&c| c).count(),

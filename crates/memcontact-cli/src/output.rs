@@ -7,7 +7,7 @@ use anyhow::{bail, Result};
 use memcontact::io::csv::write_columns_csv;
 use memcontact::io::json::write_json;
 use memcontact::io::vtu::{write_vtu, DataArray, VtuEncoding};
-use memcontact::mesh::Mesh;
+use memcontact::mesh::{Mesh, MeshQuality};
 use memcontact::results::{derive, Totals};
 use serde_json::json;
 use std::fmt::Write as _;
@@ -15,8 +15,7 @@ use std::path::Path;
 use std::time::Instant;
 
 /// The mesh report of `check` and `solve`.
-pub fn mesh_report(mesh: &Mesh, levels: usize) -> String {
-    let q = mesh.quality();
+pub fn mesh_report(mesh: &Mesh, q: &MeshQuality, levels: usize) -> String {
     let mut s = String::new();
     let _ = writeln!(
         s,
@@ -85,9 +84,10 @@ pub fn write_all(case: &Case, run: &Run, out: &Path, t0: Instant) -> Result<Stri
     )?;
     let t_write = t_out.elapsed().as_secs_f64();
     let total = t0.elapsed().as_secs_f64();
-    let summary = summary_json(case, run, &totals, t_write, total);
+    let q = mesh.quality();
+    let summary = summary_json(case, run, &q, &totals, t_write, total);
     write_json(&out.join("summary.json"), &summary)?;
-    Ok(human(case, run, &totals, t_write, total, out))
+    Ok(human(case, run, &q, &totals, t_write, total, out))
 }
 
 fn time_of(run: &Run, name: &str) -> f64 {
@@ -97,9 +97,14 @@ fn time_of(run: &Run, name: &str) -> f64 {
         .map_or(0.0, |t| t.1)
 }
 
-fn summary_json(case: &Case, run: &Run, t: &Totals, t_write: f64, total: f64) -> serde_json::Value {
-    let mesh = run.hierarchy.finest();
-    let q = mesh.quality();
+fn summary_json(
+    case: &Case,
+    run: &Run,
+    q: &MeshQuality,
+    t: &Totals,
+    t_write: f64,
+    total: f64,
+) -> serde_json::Value {
     let s = &run.solution;
     let m = &run.model;
     let phases: serde_json::Map<String, serde_json::Value> = s
@@ -151,13 +156,21 @@ fn summary_json(case: &Case, run: &Run, t: &Totals, t_write: f64, total: f64) ->
     })
 }
 
-fn human(case: &Case, run: &Run, t: &Totals, t_write: f64, total: f64, out: &Path) -> String {
+fn human(
+    case: &Case,
+    run: &Run,
+    q: &MeshQuality,
+    t: &Totals,
+    t_write: f64,
+    total: f64,
+    out: &Path,
+) -> String {
     let mesh = run.hierarchy.finest();
     let s = &run.solution;
     let m = &run.model;
     let mut o = String::new();
     let _ = writeln!(o, "memcontact: {}", case.path.display());
-    o.push_str(&mesh_report(mesh, run.hierarchy.depth()));
+    o.push_str(&mesh_report(mesh, q, run.hierarchy.depth()));
     let _ = writeln!(
         o,
         "  model        t = {}, foundation {}, sampling {}{}",
