@@ -224,7 +224,21 @@ pub fn solve(
                           choose method = \"active-set\""
                     .into(),
             })?;
-            multigrid::solve(model, h, settings, observer)?
+            match multigrid::solve(model, h, settings, observer) {
+                // `auto` chose multigrid: if it cannot reach the tolerance, the exact
+                // active-set method (with a direct solver) is the robust fallback.
+                Ok(s)
+                    if settings.method == Method::Auto
+                        && (s.certificate.kkt().is_nan()
+                            || s.certificate.kkt() > settings.tolerance) =>
+                {
+                    active_set::solve(model, settings, observer)?
+                }
+                Err(_) if settings.method == Method::Auto => {
+                    active_set::solve(model, settings, observer)?
+                }
+                other => other?,
+            }
         }
         Method::Auto => unreachable!("resolved above"),
     };
