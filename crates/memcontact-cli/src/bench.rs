@@ -3,7 +3,7 @@
 //! 1e-10), solved by TNNMG, with one linear Poisson multigrid solve as the yardstick.
 
 use anyhow::{bail, Result};
-use memcontact::bench::{run_bench, BenchRow};
+use memcontact::bench::{run_bench, table_header, table_row, BenchRow};
 use memcontact::model::Foundation;
 use memcontact::solve::multigrid::Options;
 
@@ -23,51 +23,8 @@ pub fn run(sizes: &[usize], foundation: &str, phases: bool) -> Result<()> {
         "threads: {} (rayon); times in seconds, memory = peak resident set (VmHWM)",
         rayon::current_num_threads()
     );
-    println!(
-        "{:>5} {:>10} {:>10} {:>5} {:>24} {:>7} {:>7} {:>7} {:>8} {:>9} {:>8} {:>6} {:>6}",
-        "N",
-        "unknowns",
-        "foundation",
-        "its",
-        "its per level",
-        "mesh",
-        "asm",
-        "solve",
-        "mem MiB",
-        "KKT",
-        "poisson",
-        "cycles",
-        "ratio"
-    );
-    let mut print = |r: &BenchRow| {
-        let levels: Vec<String> = r.level_iterations.iter().map(|i| i.to_string()).collect();
-        println!(
-            "{:>5} {:>10} {:>10} {:>5} {:>24} {:>7.3} {:>7.3} {:>7.3} {:>8.0} {:>9.2e} {:>8.3} {:>6} {:>6.2}",
-            r.n,
-            r.unknowns,
-            r.foundation.name(),
-            r.iterations,
-            levels.join(","),
-            r.time_mesh,
-            r.time_assembly,
-            r.time_solve,
-            r.peak_memory.map_or(f64::NAN, |b| b as f64 / 1048576.0),
-            r.certificate,
-            r.time_poisson,
-            r.poisson_cycles,
-            r.time_solve / r.time_poisson
-        );
-        if phases {
-            let f = |p: &[(String, f64)]| {
-                p.iter()
-                    .map(|(n, t)| format!("{n} {t:.3}"))
-                    .collect::<Vec<_>>()
-                    .join(", ")
-            };
-            println!("        tnnmg: {}", f(&r.phases));
-            println!("        poisson: {}", f(&r.poisson_phases));
-        }
-    };
+    println!("{}", table_header());
+    let mut print = |r: &BenchRow| println!("{}", table_row(r, phases));
     run_bench(sizes, &foundations, &Options::default(), &mut print)?;
     Ok(())
 }

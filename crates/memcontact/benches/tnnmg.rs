@@ -39,49 +39,9 @@ fn main() {
     } else {
         vec![Foundation::Lumped, Foundation::Consistent]
     };
-    println!(
-        "{:>5} {:>9} {:>10} {:>5} {:>22} {:>7} {:>7} {:>7} {:>8} {:>9} {:>7} {:>4}",
-        "N",
-        "unknowns",
-        "foundation",
-        "its",
-        "per level",
-        "mesh s",
-        "asm s",
-        "solve s",
-        "peak MB",
-        "KKT",
-        "poisson",
-        "cyc"
-    );
-    let mut print = |r: &BenchRow| {
-        let levels: Vec<String> = r.level_iterations.iter().map(|i| i.to_string()).collect();
-        println!(
-            "{:>5} {:>9} {:>10} {:>5} {:>22} {:>7.3} {:>7.3} {:>7.3} {:>8.0} {:>9.2e} {:>7.3} {:>4}",
-            r.n,
-            r.unknowns,
-            r.foundation.name(),
-            r.iterations,
-            levels.join(","),
-            r.time_mesh,
-            r.time_assembly,
-            r.time_solve,
-            r.peak_memory.map_or(f64::NAN, |b| b as f64 / 1048576.0),
-            r.certificate,
-            r.time_poisson,
-            r.poisson_cycles
-        );
-        if std::env::var_os("MEMCONTACT_PHASES").is_some() {
-            let f = |p: &[(String, f64)]| {
-                p.iter()
-                    .map(|(n, t)| format!("{n} {t:.3}"))
-                    .collect::<Vec<_>>()
-                    .join(", ")
-            };
-            println!("      tnnmg: {}", f(&r.phases));
-            println!("      poisson: {}", f(&r.poisson_phases));
-        }
-    };
+    println!("{}", memcontact::bench::table_header());
+    let phases = std::env::var_os("MEMCONTACT_PHASES").is_some();
+    let mut print = |r: &BenchRow| println!("{}", memcontact::bench::table_row(r, phases));
     let mut options = Options::default();
     if let Some(t) = std::env::var("MEMCONTACT_NESTED_TOL")
         .ok()
