@@ -731,6 +731,10 @@ mod tests {
         assert_eq!(get("offsets").values, vec![3.0, 6.0, 9.0, 12.0]);
         let t = get("types");
         assert_eq!((t.ty.as_str(), t.values.clone()), ("UInt8", vec![5.0; 4]));
+        // For an independent look: MEMCONTACT_KEEP_VTU=dir, then scripts/check_vtu.py.
+        if let Ok(keep) = std::env::var("MEMCONTACT_KEEP_VTU") {
+            std::fs::copy(&path, Path::new(&keep).join(path.file_name().unwrap())).unwrap();
+        }
         std::fs::remove_file(&path).unwrap();
     }
 
