@@ -292,7 +292,11 @@ fn push_int(buf: &mut Vec<u8>, x: i64) {
 }
 
 fn push_sep(buf: &mut Vec<u8>, i: usize, per_line: usize) {
-    buf.push(if i % per_line == per_line - 1 { b'\n' } else { b' ' });
+    buf.push(if i % per_line == per_line - 1 {
+        b'\n'
+    } else {
+        b' '
+    });
 }
 
 /// Escapes the five XML special characters of an attribute value.
