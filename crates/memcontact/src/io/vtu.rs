@@ -881,11 +881,13 @@ mod tests {
             .collect();
         let path = tmp("speed.vtu");
         let t = std::time::Instant::now();
+        let cpu = crate::io::csv::tests::cpu_seconds();
         write_vtu(&path, &mesh, &point_data, &[], VtuEncoding::Binary).unwrap();
         let dt = t.elapsed();
+        let cpu = crate::io::csv::tests::cpu_seconds() - cpu;
         let size = std::fs::metadata(&path).unwrap().len();
         eprintln!(
-            "binary VTU: {} vertices, {} triangles, 6 arrays: {:.3} s, {:.1} MB",
+            "binary VTU: {} vertices, {} triangles, 6 arrays: {:.3} s wall, {cpu:.2} s CPU, {:.1} MB",
             mesh.points.len(),
             mesh.triangles.len(),
             dt.as_secs_f64(),
