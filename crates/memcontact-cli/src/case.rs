@@ -160,6 +160,9 @@ pub struct OutputSection {
     /// VTU encoding: "binary" (default, raw appended) or "ascii".
     #[serde(default = "default_vtu")]
     pub vtu: String,
+    /// Write `deflection.png`, a colour map of u (default: on meshes of at most
+    /// 200 000 triangles).
+    pub plot: Option<bool>,
 }
 
 fn default_vtu() -> String {
@@ -168,7 +171,10 @@ fn default_vtu() -> String {
 
 impl Default for OutputSection {
     fn default() -> Self {
-        OutputSection { vtu: default_vtu() }
+        OutputSection {
+            vtu: default_vtu(),
+            plot: None,
+        }
     }
 }
 

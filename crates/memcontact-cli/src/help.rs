@@ -21,6 +21,7 @@ CASE FILE (TOML; paths relative to the case file; unknown keys are errors)
               tolerance = 1e-10          on the scaled KKT residual (2e, 2f)
               max_iterations             per method by default
 [output]      vtu = binary               or ascii
+              plot = true|false          deflection.png (default: meshes ≤ 200 000 triangles)
 
 Units: any consistent system (e.g. m, kN: t in kN/m, f in kN/m², h in kN/m³).
 Expressions: x, y, r, pi, e; + - * / ^; < <= > >= == != && || !; sin cos tan asin acos atan

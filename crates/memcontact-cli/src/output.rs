@@ -14,6 +14,10 @@ use std::fmt::Write as _;
 use std::path::Path;
 use std::time::Instant;
 
+/// Above this many triangles `deflection.png` is written only when asked for (it draws
+/// every triangle).
+const PLOT_TRIANGLES: usize = 200_000;
+
 /// The mesh report of `check` and `solve`.
 pub fn mesh_report(mesh: &Mesh, q: &MeshQuality, levels: usize) -> String {
     let mut s = String::new();
@@ -82,12 +86,32 @@ pub fn write_all(case: &Case, run: &Run, out: &Path, t0: Instant) -> Result<Stri
             ("state", DataArray::I32(&state)),
         ],
     )?;
+    let plotted = case
+        .output
+        .plot
+        .unwrap_or(mesh.n_triangles() <= PLOT_TRIANGLES);
+    if plotted {
+        crate::plot::field_plot(
+            &out.join("deflection.png"),
+            &mesh.points,
+            &mesh.triangles,
+            &fields.u,
+            &format!("deflection u: {}", case.path.display()),
+        )?;
+    }
     let t_write = t_out.elapsed().as_secs_f64();
     let total = t0.elapsed().as_secs_f64();
     let q = mesh.quality();
     let summary = summary_json(case, run, &q, &totals, t_write, total);
     write_json(&out.join("summary.json"), &summary)?;
-    Ok(human(case, run, &q, &totals, t_write, total, out))
+    let mut text = human(case, run, &q, &totals, t_write, total);
+    let _ = writeln!(
+        text,
+        "  wrote        {}/{{solution.vtu, nodes.csv, summary.json{}}}",
+        out.display(),
+        if plotted { ", deflection.png" } else { "" }
+    );
+    Ok(text)
 }
 
 fn time_of(run: &Run, name: &str) -> f64 {
@@ -156,15 +180,7 @@ fn summary_json(
     })
 }
 
-fn human(
-    case: &Case,
-    run: &Run,
-    q: &MeshQuality,
-    t: &Totals,
-    t_write: f64,
-    total: f64,
-    out: &Path,
-) -> String {
+fn human(case: &Case, run: &Run, q: &MeshQuality, t: &Totals, t_write: f64, total: f64) -> String {
     let mesh = run.hierarchy.finest();
     let s = &run.solution;
     let m = &run.model;
@@ -231,10 +247,5 @@ fn human(
             .collect();
         let _ = writeln!(o, "  solver time  {}", phases.join(", "));
     }
-    let _ = writeln!(
-        o,
-        "  wrote        {}/{{solution.vtu, nodes.csv, summary.json}}",
-        out.display()
-    );
     o
 }

@@ -47,6 +47,8 @@ fn solves_the_disk_example_and_writes_consistent_files() {
     }
     assert!(s["kkt_residual"].as_f64().unwrap() <= 1e-9);
     assert_eq!(s["foundation"], "consistent");
+    let png = std::fs::read(out.join("deflection.png")).unwrap();
+    assert_eq!(&png[..8], b"\x89PNG\r\n\x1a\n");
     // Load = f × area of Ω_n (the disc's inscribed polygon, within 2% of π).
     let load = s["total_load"].as_f64().unwrap();
     assert!((load / 8.0 - std::f64::consts::PI).abs() < 0.02 * std::f64::consts::PI);

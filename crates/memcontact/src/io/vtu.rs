@@ -292,7 +292,7 @@ fn push_int(buf: &mut Vec<u8>, x: i64) {
 }
 
 fn push_sep(buf: &mut Vec<u8>, i: usize, per_line: usize) {
-    buf.push(if (i + 1).is_multiple_of(per_line) {
+    buf.push(if i % per_line == per_line - 1 {
         b'\n'
     } else {
         b' '
@@ -735,6 +735,10 @@ mod tests {
         assert_eq!(get("offsets").values, vec![3.0, 6.0, 9.0, 12.0]);
         let t = get("types");
         assert_eq!((t.ty.as_str(), t.values.clone()), ("UInt8", vec![5.0; 4]));
+        // For an independent look: MEMCONTACT_KEEP_VTU=dir, then scripts/check_vtu.py.
+        if let Ok(keep) = std::env::var("MEMCONTACT_KEEP_VTU") {
+            std::fs::copy(&path, Path::new(&keep).join(path.file_name().unwrap())).unwrap();
+        }
         std::fs::remove_file(&path).unwrap();
     }
 
@@ -877,11 +881,13 @@ mod tests {
             .collect();
         let path = tmp("speed.vtu");
         let t = std::time::Instant::now();
+        let cpu = crate::io::csv::tests::cpu_seconds();
         write_vtu(&path, &mesh, &point_data, &[], VtuEncoding::Binary).unwrap();
         let dt = t.elapsed();
+        let cpu = crate::io::csv::tests::cpu_seconds() - cpu;
         let size = std::fs::metadata(&path).unwrap().len();
         eprintln!(
-            "binary VTU: {} vertices, {} triangles, 6 arrays: {:.3} s, {:.1} MB",
+            "binary VTU: {} vertices, {} triangles, 6 arrays: {:.3} s wall, {cpu:.2} s CPU, {:.1} MB",
             mesh.points.len(),
             mesh.triangles.len(),
             dt.as_secs_f64(),
