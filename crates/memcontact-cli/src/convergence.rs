@@ -365,6 +365,15 @@ pub fn run(args: &Args) -> Result<()> {
         }
         _ => &fields.load,
     };
+    // The problem data of one variant (foundation, sampling) of the case.
+    let data_for = |v: &Variant| ProblemData {
+        tension: t,
+        load,
+        shape: &fields.shape,
+        stiffness: fields.stiffness(),
+        foundation: v.foundation,
+        sampling: v.sampling,
+    };
     std::fs::create_dir_all(&args.output).with_context(|| {
         format!(
             "cannot create the output directory {}",
@@ -398,14 +407,7 @@ pub fn run(args: &Args) -> Result<()> {
             args.h_values.clone()
         };
         let v = &variants(&case, None)?[0];
-        let data = ProblemData {
-            tension: t,
-            load,
-            shape: &fields.shape,
-            stiffness: fields.stiffness(),
-            foundation: v.foundation,
-            sampling: v.sampling,
-        };
+        let data = data_for(v);
         if !args.quiet {
             eprintln!(
                 "h sweep on {} vertices: rigid, then h = {:?}",
@@ -435,14 +437,7 @@ pub fn run(args: &Args) -> Result<()> {
     };
     let mut studies: Vec<(Variant, Study)> = Vec::new();
     for v in variants(&case, args.compare)? {
-        let data = ProblemData {
-            tension: t,
-            load,
-            shape: &fields.shape,
-            stiffness: fields.stiffness(),
-            foundation: v.foundation,
-            sampling: v.sampling,
-        };
+        let data = data_for(&v);
         let target = match (&exact, studies.first()) {
             (Some(e), _) => Target::Exact(e.solution()),
             (None, None) => Target::Finest,

@@ -40,6 +40,18 @@ pub fn map(c: &[[f64; 2]; 3], b: &[f64; 3]) -> [f64; 2] {
     ]
 }
 
+/// `P_n(z)` and `P_n'(z)` by the three-term recurrence of the Legendre polynomials.
+fn legendre(n: usize, z: f64) -> (f64, f64) {
+    let (mut p0, mut p1) = (1.0, z);
+    for k in 2..=n {
+        let kf = k as f64;
+        let p2 = ((2.0 * kf - 1.0) * z * p1 - (kf - 1.0) * p0) / kf;
+        p0 = p1;
+        p1 = p2;
+    }
+    (p1, n as f64 * (z * p1 - p0) / (z * z - 1.0))
+}
+
 /// Gauss-Legendre points and weights on [-1, 1] (Newton's method on the Legendre
 /// polynomial `P_n`, from the Chebyshev-like initial guesses).
 pub fn gauss_legendre(n: usize) -> (Vec<f64>, Vec<f64>) {
@@ -48,30 +60,14 @@ pub fn gauss_legendre(n: usize) -> (Vec<f64>, Vec<f64>) {
     for i in 0..n {
         let mut z = (std::f64::consts::PI * (i as f64 + 0.75) / (n as f64 + 0.5)).cos();
         for _ in 0..100 {
-            // P_n(z) and P_n'(z) by the three-term recurrence.
-            let (mut p0, mut p1) = (1.0, z);
-            for k in 2..=n {
-                let kf = k as f64;
-                let p2 = ((2.0 * kf - 1.0) * z * p1 - (kf - 1.0) * p0) / kf;
-                p0 = p1;
-                p1 = p2;
-            }
-            let dp = n as f64 * (z * p1 - p0) / (z * z - 1.0);
-            let dz = p1 / dp;
+            let (p, dp) = legendre(n, z);
+            let dz = p / dp;
             z -= dz;
             if dz.abs() <= 1e-16 {
                 break;
             }
         }
-        // P_n'(z) at the final z, for the weight.
-        let (mut p0, mut p1) = (1.0, z);
-        for k in 2..=n {
-            let kf = k as f64;
-            let p2 = ((2.0 * kf - 1.0) * z * p1 - (kf - 1.0) * p0) / kf;
-            p0 = p1;
-            p1 = p2;
-        }
-        let dp = n as f64 * (z * p1 - p0) / (z * z - 1.0);
+        let (_, dp) = legendre(n, z);
         x[i] = z;
         w[i] = 2.0 / ((1.0 - z * z) * dp * dp);
     }
