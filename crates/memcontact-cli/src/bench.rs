@@ -1,4 +1,4 @@
-//! `memcontact bench`: the standard benchmark table of issue 4 (Ω = (0,1)², t = 1, f = 20,
+//! `memcontact bench`: the standard benchmark table (Ω = (0,1)², t = 1, f = 20,
 //! h = 1000, φ = 0.5 + 0.1 sin(2πx) cos(2πy), N × N "right" mesh, nodal φ, tolerance
 //! 1e-10), solved by TNNMG, with one linear Poisson multigrid solve as the yardstick.
 

@@ -1,32 +1,17 @@
-//! The `solve` and `check` commands, and the case → mesh → model → solution pipeline they
-//! share with the other commands.
+//! The `solve` and `check` commands: thin shells over the library's run.
 
-use crate::case::{self, Case};
 use crate::output;
-use anyhow::{Context, Result};
-use memcontact::field::{BoundField, Stiffness as FieldStiffness};
-use memcontact::mesh::refine::Hierarchy;
-use memcontact::mesh::Mesh;
-use memcontact::model::{Model, ProblemData, Stiffness};
-use memcontact::solve::{self, IterationRecord, Observer, Solution};
+use anyhow::{bail, Result};
+use memcontact::output::{write_result_set, WriteOptions};
+use memcontact::solve::{IterationRecord, Observer};
+use memcontact::{Case, Discretization, Outcome};
 use std::path::Path;
 use std::time::Instant;
 
-/// Everything a solved case produced.
-pub struct Run {
-    /// The mesh levels; the finest is the solved mesh.
-    pub hierarchy: Hierarchy,
-    /// The assembled model.
-    pub model: Model,
-    /// The solution.
-    pub solution: Solution,
-    /// Wall-clock seconds: mesh, assembly, solve.
-    pub timings: Vec<(String, f64)>,
-}
-
-/// Prints one line per iteration on stderr.
-struct Progress {
-    quiet: bool,
+/// Prints one line per iteration on stderr (unless quiet).
+pub struct Progress {
+    /// Print nothing.
+    pub quiet: bool,
 }
 
 impl Observer for Progress {
@@ -40,125 +25,108 @@ impl Observer for Progress {
     }
 }
 
-/// The case's data bound to the mesh's regions.
-pub struct BoundData {
-    load: BoundField,
-    shape: BoundField,
-    stiffness: Option<BoundField>,
-}
-
-impl BoundData {
-    /// Binds f, φ and h to the regions of `mesh`.
-    pub fn new(case: &Case, mesh: &Mesh) -> Result<BoundData> {
-        let mut tags: Vec<u32> = mesh.regions.clone();
-        tags.sort_unstable();
-        tags.dedup();
-        let names = &mesh.region_names;
-        Ok(BoundData {
-            load: case.membrane.load.bind("membrane.load", names, &tags)?,
-            shape: case.obstacle.shape.bind("obstacle.shape", names, &tags)?,
-            stiffness: match &case.obstacle.stiffness {
-                FieldStiffness::Rigid => None,
-                FieldStiffness::Elastic(h) => Some(h.bind("obstacle.stiffness", names, &tags)?),
-            },
-        })
-    }
-
-    /// The library's view of the data.
-    pub fn problem<'a>(&'a self, case: &Case) -> Result<ProblemData<'a>> {
-        Ok(ProblemData {
-            tension: case.tension()?,
-            load: &self.load,
-            shape: &self.shape,
-            stiffness: match &self.stiffness {
-                Some(h) => Stiffness::Elastic(h),
-                None => Stiffness::Rigid,
-            },
-            foundation: case.foundation()?,
-            sampling: case.sampling()?,
-        })
-    }
-}
-
-/// Assembles the model of `case` on the finest level of `hierarchy`.
-pub fn assemble(case: &Case, hierarchy: &Hierarchy) -> Result<Model> {
-    let mesh = hierarchy.finest();
-    let data = BoundData::new(case, mesh)?;
-    Ok(Model::assemble(mesh, &data.problem(case)?)?)
-}
-
-/// Runs the pipeline: mesh, assembly, solve.
-pub fn run(case: &Case, quiet: bool) -> Result<Run> {
-    let settings = case.settings()?;
-    let t0 = Instant::now();
-    let (hierarchy, warnings) = case.build_mesh()?;
-    for w in &warnings {
+/// Prints the mesh reader's warnings.
+pub fn print_warnings(d: &Discretization) {
+    for w in &d.warnings {
         eprintln!("warning: {w}");
     }
-    let t_mesh = t0.elapsed().as_secs_f64();
-    let t1 = Instant::now();
-    let model = assemble(case, &hierarchy)?;
-    let t_assembly = t1.elapsed().as_secs_f64();
-    let t2 = Instant::now();
-    let h = (hierarchy.depth() > 1).then_some(&hierarchy);
-    let solution = solve::solve(&model, h, &settings, &mut Progress { quiet })?;
-    let t_solve = t2.elapsed().as_secs_f64();
-    Ok(Run {
-        hierarchy,
-        model,
-        solution,
-        timings: vec![
-            ("mesh".into(), t_mesh),
-            ("assembly".into(), t_assembly),
-            ("solve".into(), t_solve),
-        ],
-    })
+}
+
+/// How `memcontact solve` writes its results.
+pub struct SolveFlags<'a> {
+    /// The output directory.
+    pub out: &'a Path,
+    /// `--set` overrides.
+    pub sets: &'a [String],
+    /// No progress lines.
+    pub quiet: bool,
+    /// Replace an output directory holding other files.
+    pub force: bool,
+    /// Write the result files of a solve that did not converge (marked in summary.json).
+    pub write_unconverged: bool,
 }
 
 /// `memcontact solve`.
-pub fn solve(case_path: &Path, out: &Path, sets: &[String], quiet: bool) -> Result<()> {
-    let t0 = Instant::now();
-    let case = case::load(case_path, sets)?;
-    let run = run(&case, quiet)?;
-    std::fs::create_dir_all(out)
-        .with_context(|| format!("cannot create the output directory {}", out.display()))?;
-    let report = output::write_all(&case, &run, out, t0)?;
-    print!("{report}");
+pub fn solve(case_path: &Path, flags: &SolveFlags) -> Result<()> {
+    let started = Instant::now();
+    let case = Case::load(case_path, flags.sets)?;
+    let mut progress = Progress { quiet: flags.quiet };
+    let outcome = memcontact::run(&case.problem, &case.settings, &mut progress)?;
+    print_warnings(&outcome.discretization);
+    let converged = outcome.status().is_converged();
+    if !converged && !flags.write_unconverged {
+        eprint!(
+            "{}",
+            output::human(&case_path.display().to_string(), &outcome, None)
+        );
+        bail!(
+            "{}; no result files were written (pass --write-unconverged to keep the \
+             iterate, marked as unconverged in summary.json)",
+            not_converged(&outcome)
+        );
+    }
+    let options = WriteOptions {
+        label: case_path.display().to_string(),
+        vtu: case.output.vtu,
+        force: flags.force,
+        started,
+    };
+    let summary = {
+        let mut pictures = output::pictures(&case, &outcome, &options.label);
+        write_result_set(flags.out, &outcome, &case, &options, &mut pictures)?
+    };
+    print!(
+        "{}",
+        output::human(&options.label, &outcome, Some((&summary, flags.out)))
+    );
+    if !converged {
+        bail!(
+            "{}; the files in {} hold the unconverged iterate (summary.json: \"converged\": \
+             false)",
+            not_converged(&outcome),
+            flags.out.display()
+        );
+    }
     // The process ends right after this: returning the (possibly gigabytes of) mesh
     // levels and matrices to the allocator page by page would only delay the exit.
-    std::mem::forget(run);
+    std::mem::forget(outcome);
     Ok(())
+}
+
+/// The message for a solve that did not converge.
+fn not_converged(outcome: &Outcome) -> String {
+    outcome
+        .report
+        .error()
+        .map(|e| e.to_string())
+        .unwrap_or_default()
 }
 
 /// `memcontact check`.
 pub fn check(case_path: &Path, sets: &[String]) -> Result<()> {
-    let case = case::load(case_path, sets)?;
-    case.settings()?;
-    case.tension()?;
-    case.foundation()?;
-    case.sampling()?;
-    let (hierarchy, warnings) = case.build_mesh()?;
-    for w in &warnings {
-        eprintln!("warning: {w}");
-    }
-    let mesh = hierarchy.finest();
-    // Binding and assembling checks the data on the mesh (regions, signs, NaN).
-    let model = assemble(&case, &hierarchy)?;
+    let case = Case::load(case_path, sets)?;
+    // Building the mesh, binding and assembling checks the data on the mesh (regions,
+    // signs, NaN), everything `solve` checks before it solves.
+    let d = Discretization::new(&case.problem, &mut Progress { quiet: true })?;
+    print_warnings(&d);
+    let mesh = d.mesh();
     println!("case {}: valid", case_path.display());
     print!(
         "{}",
-        output::mesh_report(mesh, &mesh.quality(), hierarchy.depth())
+        output::mesh_report(mesh, &mesh.quality(), d.hierarchy.depth())
     );
     println!(
         "  obstacle     {} vertices can touch (M), foundation {}{}",
-        model.can_touch.iter().filter(|&&c| c).count(),
-        model.foundation.name(),
-        if model.is_rigid() { ", rigid" } else { "" }
+        d.model.can_touch.iter().filter(|&&c| c).count(),
+        d.model.foundation.name(),
+        if d.model.is_rigid() { ", rigid" } else { "" }
     );
+    let (method, choice) = d.auto_choice();
     println!(
-        "  solver       {} (auto picks {})",
-        case.solver.method,
-        solve::auto_method(&model, (hierarchy.depth() > 1).then_some(&hierarchy)).name()
+        "  solver       {} (auto picks {}: {})",
+        case.settings.method.name(),
+        method.name(),
+        choice.reason()
     );
     Ok(())
 }

@@ -2,19 +2,21 @@
 //! and log-log plot, the lumped/consistent and nodal/mollified comparisons and the
 //! rigid-limit sweep. The numerics are in `memcontact::convergence`.
 
-use crate::case::{self, Case};
 use crate::plot;
 use anyhow::{anyhow, bail, Context, Result};
 use memcontact::convergence::{
     self as study, LevelResult, ManufacturedLoad, Study, StudySettings, Sweep, Target,
 };
 use memcontact::exact::{DiskSolution, ExactSolution, Manufactured};
-use memcontact::field::{BoundField, Stiffness as FieldStiffness};
+use memcontact::field::Stiffness as FieldStiffness;
 use memcontact::io::csv::write_columns_csv;
+use memcontact::io::result_set::ResultSet;
 use memcontact::io::vtu::DataArray;
 use memcontact::mesh::refine::Hierarchy;
-use memcontact::mesh::Mesh;
-use memcontact::model::{Foundation, ProblemData, Sampling, Stiffness};
+use memcontact::model::{Foundation, ProblemData, Sampling};
+use memcontact::problem::{ExactSpec, ManufacturedDomain, MeshSource};
+use memcontact::run::BoundData;
+use memcontact::Case;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
@@ -68,11 +70,14 @@ pub struct Args {
     /// Print no progress lines.
     #[arg(short, long)]
     pub quiet: bool,
+    /// Replace the output directory even if it holds files that are not a result.
+    #[arg(long)]
+    pub force: bool,
 }
 
 /// The exact solution a case names in `[exact]`.
 pub enum Exact {
-    /// `kind = "disk"`: the axisymmetric disc of SPEC §4.
+    /// `kind = "disk"`: the axisymmetric disc (Bessel functions).
     Disk(DiskCase),
     /// `kind = "manufactured"`: the load is replaced by `f = −tΔu + h(u − φ)⁺`.
     Manufactured(Manufactured),
@@ -106,48 +111,27 @@ impl DiskCase {
     }
 }
 
-/// Reads `[exact]`: `None` when the case has none; errors for an unknown kind or key, a
-/// kind that does not fit the mesh generator, or data that the kind cannot take.
+/// Builds the exact solution the case names in `[exact]` (`None` when it has none);
+/// errors for a kind that does not fit the mesh generator, or data the kind cannot take.
 pub fn parse_exact(case: &Case) -> Result<Option<Exact>> {
-    let Some(table) = &case.exact else {
+    let Some(spec) = &case.exact else {
         return Ok(None);
     };
-    let kind = match table.get("kind") {
-        Some(toml::Value::String(s)) => s.as_str(),
-        Some(v) => bail!("[exact] kind must be a string (\"disk\" or \"manufactured\"), got {v}"),
-        None => bail!("[exact] needs kind = \"disk\" or kind = \"manufactured\""),
-    };
-    let allowed: &[&str] = match kind {
-        "disk" => &["kind"],
-        "manufactured" => &["kind", "domain", "amplitude"],
-        k => bail!("[exact] kind = \"{k}\" is unknown (choose \"disk\" or \"manufactured\")"),
-    };
-    if let Some(k) = table.keys().find(|k| !allowed.contains(&k.as_str())) {
-        bail!(
-            "[exact] key \"{k}\" is not used by kind = \"{kind}\" (its keys: {})",
-            allowed.join(", ")
-        );
-    }
-    let generator = match (&case.mesh.file, case.mesh.generator.as_deref()) {
-        (Some(_), _) => None,
-        (None, g) => g,
-    };
+    let kind = spec.kind();
+    let p = &case.problem;
     let disc_geometry = || -> Result<([f64; 2], f64)> {
-        if generator != Some("disk") {
-            bail!(
+        match p.mesh.source {
+            MeshSource::Disk { center, radius, .. } => Ok((center, radius)),
+            _ => bail!(
                 "[exact] kind = \"{kind}\" on a disc needs [mesh] generator = \"disk\" (its \
                  centre and radius define the domain); this case uses {}",
                 describe_mesh(case)
-            );
+            ),
         }
-        Ok((
-            case.mesh.center.unwrap_or([0.0, 0.0]),
-            case.mesh.radius.unwrap_or(1.0),
-        ))
     };
-    let t = case.tension()?;
-    match kind {
-        "disk" => {
+    let t = p.membrane.tension;
+    match spec {
+        ExactSpec::Disk {} => {
             let (center, radius) = disc_geometry()?;
             let constant = |name: &str, f: &memcontact::field::Field| -> Result<f64> {
                 f.constant().ok_or_else(|| {
@@ -157,9 +141,9 @@ pub fn parse_exact(case: &Case) -> Result<Option<Exact>> {
                     )
                 })
             };
-            let f = constant("membrane.load", &case.membrane.load)?;
-            let phi = constant("obstacle.shape", &case.obstacle.shape)?;
-            let h = match &case.obstacle.stiffness {
+            let f = constant("membrane.load", &p.membrane.load)?;
+            let phi = constant("obstacle.shape", &p.obstacle.shape)?;
+            let h = match &p.obstacle.stiffness {
                 FieldStiffness::Rigid => None,
                 FieldStiffness::Elastic(h) => Some(constant("obstacle.stiffness", h)?),
             };
@@ -174,54 +158,28 @@ pub fn parse_exact(case: &Case) -> Result<Option<Exact>> {
                 phi,
             })))
         }
-        _ => {
-            if case.obstacle.stiffness.is_rigid() {
+        &ExactSpec::Manufactured { domain, amplitude } => {
+            if p.obstacle.stiffness.is_rigid() {
                 bail!(
                     "[exact] kind = \"manufactured\" needs a finite obstacle.stiffness h: its \
                      load f = −tΔu + h(u − φ)⁺ has no meaning for the rigid obstacle"
                 );
             }
-            let amplitude = match table.get("amplitude") {
-                Some(toml::Value::Float(a)) => *a,
-                Some(toml::Value::Integer(a)) => *a as f64,
-                Some(v) => bail!("[exact] amplitude must be a number, got {v}"),
-                None => bail!("[exact] kind = \"manufactured\" needs amplitude = A (u's scale)"),
-            };
-            if !(amplitude.is_finite() && amplitude != 0.0) {
-                bail!("[exact] amplitude must be a finite non-zero number, got {amplitude}");
-            }
-            let domain = match table.get("domain") {
-                Some(toml::Value::String(s)) => s.as_str(),
-                Some(v) => bail!("[exact] domain must be \"rectangle\" or \"disk\", got {v}"),
-                None => bail!(
-                    "[exact] kind = \"manufactured\" needs domain = \"rectangle\" or \"disk\""
-                ),
-            };
             let m = match domain {
-                "rectangle" => {
-                    if generator != Some("rectangle") {
-                        bail!(
-                            "[exact] domain = \"rectangle\" needs [mesh] generator = \
-                             \"rectangle\" (its x0, y0, x1, y1 define the domain); this case \
-                             uses {}",
-                            describe_mesh(case)
-                        );
+                ManufacturedDomain::Rectangle => match p.mesh.source {
+                    MeshSource::Rectangle { x0, y0, x1, y1, .. } => {
+                        Manufactured::rectangle(x0, y0, x1, y1, amplitude)
                     }
-                    let me = &case.mesh;
-                    Manufactured::rectangle(
-                        me.x0.unwrap_or(0.0),
-                        me.y0.unwrap_or(0.0),
-                        me.x1.unwrap_or(1.0),
-                        me.y1.unwrap_or(1.0),
-                        amplitude,
-                    )
-                }
-                "disk" => {
+                    _ => bail!(
+                        "[exact] domain = \"rectangle\" needs [mesh] generator = \
+                         \"rectangle\" (its x0, y0, x1, y1 define the domain); this case \
+                         uses {}",
+                        describe_mesh(case)
+                    ),
+                },
+                ManufacturedDomain::Disk => {
                     let (center, radius) = disc_geometry()?;
                     Manufactured::disk(center, radius, amplitude)
-                }
-                d => {
-                    bail!("[exact] domain = \"{d}\" is unknown (choose \"rectangle\" or \"disk\")")
                 }
             }
             .context("[exact] kind = \"manufactured\"")?;
@@ -231,42 +189,9 @@ pub fn parse_exact(case: &Case) -> Result<Option<Exact>> {
 }
 
 fn describe_mesh(case: &Case) -> String {
-    match (&case.mesh.file, &case.mesh.generator) {
-        (Some(f), _) => format!("the mesh file {}", f.display()),
-        (None, Some(g)) => format!("generator = \"{g}\""),
-        (None, None) => "no mesh".into(),
-    }
-}
-
-/// The case's fields bound to the mesh's regions, with the manufactured load when the
-/// exact solution is manufactured.
-struct Fields {
-    load: BoundField,
-    shape: BoundField,
-    stiffness: Option<BoundField>,
-}
-
-impl Fields {
-    fn bind(case: &Case, mesh: &Mesh) -> Result<Fields> {
-        let mut tags = mesh.regions.clone();
-        tags.sort_unstable();
-        tags.dedup();
-        let names = &mesh.region_names;
-        Ok(Fields {
-            load: case.membrane.load.bind("membrane.load", names, &tags)?,
-            shape: case.obstacle.shape.bind("obstacle.shape", names, &tags)?,
-            stiffness: match &case.obstacle.stiffness {
-                FieldStiffness::Rigid => None,
-                FieldStiffness::Elastic(h) => Some(h.bind("obstacle.stiffness", names, &tags)?),
-            },
-        })
-    }
-
-    fn stiffness(&self) -> Stiffness<'_> {
-        match &self.stiffness {
-            Some(h) => Stiffness::Elastic(h),
-            None => Stiffness::Rigid,
-        }
+    match &case.problem.mesh.source {
+        MeshSource::File(f) => format!("the mesh file {}", f.display()),
+        _ => format!("generator = \"{}\"", case.problem.mesh.kind()),
     }
 }
 
@@ -277,26 +202,16 @@ struct Variant {
     sampling: Sampling,
 }
 
-/// The sampling named in the case, and the mollified sampling with the case's ε (if any).
-fn sampling_variants(case: &Case) -> Result<(Sampling, Sampling)> {
-    let eps = case.obstacle.epsilon.map(|n| n.0);
-    if let Some(e) = eps {
-        if !(e.is_finite() && e > 0.0) {
-            bail!("obstacle.epsilon must be a finite number > 0, got {e}");
-        }
-    }
-    Ok((Sampling::Nodal, Sampling::Mollified { epsilon: eps }))
-}
-
-fn variants(case: &Case, compare: Option<Compare>) -> Result<Vec<Variant>> {
-    Ok(match compare {
+fn variants(case: &Case, compare: Option<Compare>) -> Vec<Variant> {
+    let o = &case.problem.obstacle;
+    match compare {
         None => vec![Variant {
             name: "",
-            foundation: case.foundation()?,
-            sampling: case.sampling()?,
+            foundation: o.foundation,
+            sampling: o.sampling(),
         }],
         Some(Compare::Foundation) => {
-            let sampling = case.sampling()?;
+            let sampling = o.sampling();
             vec![
                 Variant {
                     name: "consistent",
@@ -310,23 +225,19 @@ fn variants(case: &Case, compare: Option<Compare>) -> Result<Vec<Variant>> {
                 },
             ]
         }
-        Some(Compare::Sampling) => {
-            let foundation = case.foundation()?;
-            let (nodal, mollified) = sampling_variants(case)?;
-            vec![
-                Variant {
-                    name: "nodal",
-                    foundation,
-                    sampling: nodal,
-                },
-                Variant {
-                    name: "mollified",
-                    foundation,
-                    sampling: mollified,
-                },
-            ]
-        }
-    })
+        Some(Compare::Sampling) => vec![
+            Variant {
+                name: "nodal",
+                foundation: o.foundation,
+                sampling: Sampling::Nodal,
+            },
+            Variant {
+                name: "mollified",
+                foundation: o.foundation,
+                sampling: Sampling::Mollified { epsilon: o.epsilon },
+            },
+        ],
+    }
 }
 
 /// `memcontact convergence`.
@@ -334,21 +245,27 @@ pub fn run(args: &Args) -> Result<()> {
     if args.levels == 0 && !args.h_sweep {
         bail!("--levels must be at least 1 for a convergence study (K + 1 meshes are solved)");
     }
-    let case = case::load(&args.case, &args.sets)?;
+    let case = Case::load(&args.case, &args.sets)?;
+    let label = args.case.display().to_string();
+    let file_name = args
+        .case
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
     let exact = parse_exact(&case)?;
-    let settings = case.settings()?;
-    let t = case.tension()?;
+    let settings = case.settings.clone();
+    let t = case.problem.membrane.tension;
     if args.levels > MAX_LEVELS {
         bail!(
             "--levels {} is too large (at most {MAX_LEVELS}: each level multiplies the triangles by 4)",
             args.levels
         );
     }
-    let (mut hierarchy, warnings) = case.build_mesh()?;
+    let (mut hierarchy, warnings) = case.problem.mesh.build()?;
     for w in &warnings {
         eprintln!("warning: {w}");
     }
-    let fields = Fields::bind(&case, hierarchy.finest())?;
+    let fields = BoundData::new(&case.problem, hierarchy.finest())?;
     let manufactured_load;
     let load: &dyn memcontact::fem::Coefficient = match &exact {
         Some(Exact::Manufactured(m)) => {
@@ -367,21 +284,16 @@ pub fn run(args: &Args) -> Result<()> {
     };
     // The problem data of one variant (foundation, sampling) of the case.
     let data_for = |v: &Variant| ProblemData {
-        tension: t,
         load,
-        shape: &fields.shape,
-        stiffness: fields.stiffness(),
         foundation: v.foundation,
         sampling: v.sampling,
+        ..fields.data(&case.problem)
     };
-    std::fs::create_dir_all(&args.output).with_context(|| {
-        format!(
-            "cannot create the output directory {}",
-            args.output.display()
-        )
-    })?;
+    // Every file of the study is written into a staging directory and moved into place
+    // together at the end: a failed level leaves the previous study untouched.
+    let set = ResultSet::begin(&args.output, args.force)?;
     let mut out = String::new();
-    let _ = writeln!(out, "memcontact convergence: {}", case.path.display());
+    let _ = writeln!(out, "memcontact convergence: {label}");
     match &exact {
         Some(e) => {
             let _ = writeln!(out, "  exact        {}", e.solution().describe());
@@ -406,7 +318,7 @@ pub fn run(args: &Args) -> Result<()> {
         } else {
             args.h_values.clone()
         };
-        let v = &variants(&case, None)?[0];
+        let v = &variants(&case, None)[0];
         let data = data_for(v);
         if !args.quiet {
             eprintln!(
@@ -421,13 +333,19 @@ pub fn run(args: &Args) -> Result<()> {
             _ => None,
         };
         out.push_str(&sweep_report(
-            &case,
+            &file_name,
             &hierarchy,
             &sweep,
             disk,
             v,
-            &args.output,
+            set.dir(),
         )?);
+        set.commit()?;
+        let _ = writeln!(
+            out,
+            "  wrote        {}/{{h_sweep.csv, h_sweep.png}}",
+            args.output.display()
+        );
         print!("{out}");
         return Ok(());
     }
@@ -436,7 +354,7 @@ pub fn run(args: &Args) -> Result<()> {
         solver: settings,
     };
     let mut studies: Vec<(Variant, Study)> = Vec::new();
-    for v in variants(&case, args.compare)? {
+    for v in variants(&case, args.compare) {
         let data = data_for(&v);
         let target = match (&exact, studies.first()) {
             (Some(e), _) => Target::Exact(e.solution()),
@@ -495,7 +413,7 @@ pub fn run(args: &Args) -> Result<()> {
         } else {
             format!("convergence-{}.csv", v.name)
         };
-        write_csv(&args.output.join(&file), s)?;
+        write_csv(&set.dir().join(&file), s)?;
         written.push(file);
         let suffix = if v.name.is_empty() {
             String::new()
@@ -517,15 +435,9 @@ pub fn run(args: &Args) -> Result<()> {
             pts(&|r| r.errors.map(|e| e.h1_semi)),
         ));
     }
-    let title = format!(
-        "Convergence: {}",
-        case.path
-            .file_name()
-            .map(|n| n.to_string_lossy().into_owned())
-            .unwrap_or_default()
-    );
+    let title = format!("Convergence: {file_name}");
     plot::loglog_plot(
-        &args.output.join("convergence.png"),
+        &set.dir().join("convergence.png"),
         &title,
         "mesh size lₙ",
         if exact.is_some() {
@@ -537,6 +449,7 @@ pub fn run(args: &Args) -> Result<()> {
         &[1.0, 2.0],
     )?;
     written.push("convergence.png".into());
+    set.commit()?;
     let _ = writeln!(
         out,
         "  wrote        {}/{{{}}}",
@@ -578,14 +491,14 @@ fn table(case: &Case, v: &Variant, s: &Study, exact: bool, reference: Option<&st
         } else {
             format!("[{}] ", v.name)
         },
-        if case.obstacle.stiffness.is_rigid() {
+        if case.problem.obstacle.stiffness.is_rigid() {
             "rigid"
         } else {
             v.foundation.name()
         },
         sampling,
-        case.solver.method,
-        case.solver.tolerance.0,
+        case.settings.method.name(),
+        case.settings.tolerance,
         reference.map(|r| format!("; {r}")).unwrap_or_default()
     );
     let radius = exact && s.levels.iter().any(|r| r.contact_radius_error.is_some());
@@ -740,9 +653,9 @@ fn write_csv(path: &Path, s: &Study) -> Result<()> {
     write_csv_columns(path, &columns)
 }
 
-/// Prints the h sweep and writes h_sweep.csv and h_sweep.png.
+/// Prints the h sweep and writes h_sweep.csv and h_sweep.png into `dir`.
 fn sweep_report(
-    case: &Case,
+    file_name: &str,
     hierarchy: &Hierarchy,
     sweep: &Sweep,
     disk: Option<&DiskCase>,
@@ -856,22 +769,11 @@ fn sweep_report(
     }
     plot::loglog_plot(
         &dir.join("h_sweep.png"),
-        &format!(
-            "Rigid limit: {}",
-            case.path
-                .file_name()
-                .map(|n| n.to_string_lossy().into_owned())
-                .unwrap_or_default()
-        ),
+        &format!("Rigid limit: {file_name}"),
         "stiffness h",
         "distance to the rigid solution",
         &series,
         &[-0.5, -1.0],
     )?;
-    let _ = writeln!(
-        o,
-        "  wrote        {}/{{h_sweep.csv, h_sweep.png}}",
-        dir.display()
-    );
     Ok(o)
 }

@@ -13,7 +13,7 @@ struct Example {
 const EXAMPLES: &[Example] = &[
     Example {
         name: "disk",
-        about: "the axisymmetric disc of SPEC §4 on a flat elastic foundation (exact solution known)",
+        about: "the axisymmetric disc on a flat elastic foundation (exact solution known: Bessel functions)",
         files: &[("disk.toml", include_str!("../../../examples/disk.toml"))],
     },
     Example {
@@ -23,7 +23,7 @@ const EXAMPLES: &[Example] = &[
     },
     Example {
         name: "bench-square",
-        about: "the standard benchmark of issue 4 on the unit square (N × N structured mesh)",
+        about: "the standard benchmark on the unit square (N × N structured mesh)",
         files: &[(
             "bench-square.toml",
             include_str!("../../../examples/bench-square.toml"),
@@ -39,7 +39,7 @@ const EXAMPLES: &[Example] = &[
     },
     Example {
         name: "disk-rigid",
-        about: "the disc of SPEC §4 on a rigid obstacle (the classical obstacle problem; exact solution known)",
+        about: "the disc on a rigid obstacle (the classical obstacle problem; exact solution known)",
         files: &[("disk-rigid.toml", include_str!("../../../examples/disk-rigid.toml"))],
     },
     Example {

@@ -2,7 +2,6 @@
 //! prints a summary and writes the outputs. All the numerics live in the library.
 
 mod bench;
-mod case;
 mod commands;
 mod convergence;
 mod examples;
@@ -23,6 +22,9 @@ use std::process::ExitCode;
 #[derive(Parser)]
 #[command(name = "memcontact", version, about, long_about)]
 struct Cli {
+    /// Worker threads for the parallel parts (default: one per core).
+    #[arg(long, global = true, value_name = "N")]
+    threads: Option<usize>,
     #[command(subcommand)]
     command: Command,
 }
@@ -30,11 +32,15 @@ struct Cli {
 #[derive(Subcommand)]
 enum Command {
     /// Solve a case and write solution.vtu, nodes.csv and summary.json.
+    ///
+    /// The files are written as one set: the output directory is replaced as a whole when
+    /// all are complete, so it never mixes two runs. A solve that does not reach the
+    /// tolerance writes nothing and exits with status 1 (see --write-unconverged).
     #[command(after_long_help = help::CASE_KEYS)]
     Solve {
         /// The case file (TOML).
         case: PathBuf,
-        /// Output directory (created if needed).
+        /// Output directory (created if needed; a previous result there is replaced).
         #[arg(short, long, default_value = "out")]
         output: PathBuf,
         /// Override a case key, e.g. --set mesh.nx=128 --set obstacle.foundation=lumped.
@@ -43,6 +49,13 @@ enum Command {
         /// Print no progress lines.
         #[arg(short, long)]
         quiet: bool,
+        /// Replace the output directory even if it holds files that are not a result.
+        #[arg(long)]
+        force: bool,
+        /// Write the files of a solve that did not converge (summary.json says
+        /// "converged": false); the exit status is still 1.
+        #[arg(long)]
+        write_unconverged: bool,
     },
     /// Validate a case and report its mesh, without solving.
     #[command(after_long_help = help::CASE_KEYS)]
@@ -57,7 +70,7 @@ enum Command {
     /// against the case's [exact] solution, rates, convergence.csv and convergence.png
     /// (or, with --h-sweep, the distance to the rigid limit).
     Convergence(convergence::Args),
-    /// The standard benchmark (issue 4): TNNMG on the N × N unit square against one
+    /// The standard benchmark: TNNMG on the N × N unit square against one
     /// linear Poisson multigrid solve; prints unknowns, iterations (total and per level),
     /// mesh / assembly / solve seconds, peak memory and the final KKT certificate.
     Bench {
@@ -86,13 +99,33 @@ enum Command {
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
+    if let Some(n) = cli.threads {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(n)
+            .build_global();
+        if n == 0 || pool.is_err() {
+            eprintln!("error: --threads must be at least 1, got {n}");
+            return ExitCode::FAILURE;
+        }
+    }
     let result = match cli.command {
         Command::Solve {
             case,
             output,
             sets,
             quiet,
-        } => commands::solve(&case, &output, &sets, quiet),
+            force,
+            write_unconverged,
+        } => commands::solve(
+            &case,
+            &commands::SolveFlags {
+                out: &output,
+                sets: &sets,
+                quiet,
+                force,
+                write_unconverged,
+            },
+        ),
         Command::Check { case, sets } => commands::check(&case, &sets),
         Command::Convergence(args) => convergence::run(&args),
         Command::Example { name, dir, force } => examples::run(name.as_deref(), &dir, force),

@@ -1,18 +1,12 @@
-//! The outputs of `memcontact solve`: solution.vtu, nodes.csv, summary.json and the human
-//! summary. Every file is written atomically.
+//! What `memcontact solve` shows: the human summary on the terminal and the pictures it
+//! adds to the result set. The result files themselves are the library's
+//! (`memcontact::output`).
 
-use crate::case::Case;
-use crate::commands::Run;
-use anyhow::{bail, Result};
-use memcontact::io::csv::write_columns_csv;
-use memcontact::io::json::write_json;
-use memcontact::io::vtu::{write_vtu, DataArray, VtuEncoding};
 use memcontact::mesh::{Mesh, MeshQuality};
-use memcontact::results::{derive, Totals};
-use serde_json::json;
+use memcontact::results::NodalFields;
+use memcontact::{Case, Outcome, Summary};
 use std::fmt::Write as _;
 use std::path::Path;
-use std::time::Instant;
 
 /// Above this many triangles `deflection.png` is written only when asked for (it draws
 /// every triangle).
@@ -45,148 +39,46 @@ pub fn mesh_report(mesh: &Mesh, q: &MeshQuality, levels: usize) -> String {
     s
 }
 
-/// Writes the three output files and returns the human summary.
-pub fn write_all(case: &Case, run: &Run, out: &Path, t0: Instant) -> Result<String> {
-    let mesh = run.hierarchy.finest();
-    let t_out = Instant::now();
-    let (fields, totals) = derive(mesh, &run.model, &run.solution);
-    let encoding = match case.output.vtu.as_str() {
-        "binary" => VtuEncoding::Binary,
-        "ascii" => VtuEncoding::Ascii,
-        s => bail!("output.vtu must be \"binary\" or \"ascii\", not \"{s}\""),
-    };
-    let region: Vec<i32> = mesh.regions.iter().map(|&r| r as i32).collect();
-    let state: Vec<i32> = fields.state.iter().map(|&s| s as i32).collect();
-    write_vtu(
-        &out.join("solution.vtu"),
-        mesh,
-        &[
-            ("u", DataArray::F64(&fields.u)),
-            ("phi", DataArray::F64(&fields.phi)),
-            ("penetration", DataArray::F64(&fields.penetration)),
-            ("pressure", DataArray::F64(&fields.pressure)),
-            ("contact_force", DataArray::F64(&fields.contact_force)),
-            ("state", DataArray::I32(&state)),
-        ],
-        &[("region", DataArray::I32(&region))],
-        encoding,
-    )?;
-    let x: Vec<f64> = mesh.points.iter().map(|p| p[0]).collect();
-    let y: Vec<f64> = mesh.points.iter().map(|p| p[1]).collect();
-    write_columns_csv(
-        &out.join("nodes.csv"),
-        &[
-            ("x", DataArray::F64(&x)),
-            ("y", DataArray::F64(&y)),
-            ("u", DataArray::F64(&fields.u)),
-            ("phi", DataArray::F64(&fields.phi)),
-            ("penetration", DataArray::F64(&fields.penetration)),
-            ("pressure", DataArray::F64(&fields.pressure)),
-            ("contact_force", DataArray::F64(&fields.contact_force)),
-            ("state", DataArray::I32(&state)),
-        ],
-    )?;
-    let plotted = case
-        .output
-        .plot
-        .unwrap_or(mesh.n_triangles() <= PLOT_TRIANGLES);
-    if plotted {
+/// The pictures `solve` adds to the result set (see `[output] plot`): a function that
+/// draws them into the staging directory and returns their names.
+pub fn pictures<'a>(
+    case: &'a Case,
+    outcome: &'a Outcome,
+    label: &'a str,
+) -> impl FnMut(&Path, &NodalFields) -> memcontact::Result<Vec<String>> + 'a {
+    move |dir: &Path, fields: &NodalFields| {
+        let mesh = outcome.mesh();
+        let plotted = case
+            .output
+            .plot
+            .unwrap_or(mesh.n_triangles() <= PLOT_TRIANGLES);
+        if !plotted {
+            return Ok(Vec::new());
+        }
         crate::plot::field_plot(
-            &out.join("deflection.png"),
+            &dir.join("deflection.png"),
             &mesh.points,
             &mesh.triangles,
             &fields.u,
-            &format!("deflection u: {}", case.path.display()),
-        )?;
+            &format!("deflection u: {label}"),
+        )
+        .map_err(|e| memcontact::Error::Data(format!("deflection.png: {e:#}")))?;
+        Ok(vec!["deflection.png".into()])
     }
-    let t_write = t_out.elapsed().as_secs_f64();
-    let total = t0.elapsed().as_secs_f64();
+}
+
+/// The human summary of a run; with `written`, the summary.json values and where the files
+/// went.
+pub fn human(label: &str, outcome: &Outcome, written: Option<(&Summary, &Path)>) -> String {
+    let d = &outcome.discretization;
+    let r = &outcome.report;
+    let m = &d.model;
+    let mesh = d.mesh();
     let q = mesh.quality();
-    let summary = summary_json(case, run, &q, &totals, t_write, total);
-    write_json(&out.join("summary.json"), &summary)?;
-    let mut text = human(case, run, &q, &totals, t_write, total);
-    let _ = writeln!(
-        text,
-        "  wrote        {}/{{solution.vtu, nodes.csv, summary.json{}}}",
-        out.display(),
-        if plotted { ", deflection.png" } else { "" }
-    );
-    Ok(text)
-}
-
-fn time_of(run: &Run, name: &str) -> f64 {
-    run.timings
-        .iter()
-        .find(|t| t.0 == name)
-        .map_or(0.0, |t| t.1)
-}
-
-fn summary_json(
-    case: &Case,
-    run: &Run,
-    q: &MeshQuality,
-    t: &Totals,
-    t_write: f64,
-    total: f64,
-) -> serde_json::Value {
-    let s = &run.solution;
-    let m = &run.model;
-    let phases: serde_json::Map<String, serde_json::Value> = s
-        .phases
-        .iter()
-        .map(|(k, v)| (k.clone(), json!(v)))
-        .collect();
-    json!({
-        "case": case.path.display().to_string(),
-        "vertices": q.vertices,
-        "triangles": q.triangles,
-        "unknowns": q.unknowns,
-        "levels": run.hierarchy.depth(),
-        "l_n": q.l_n,
-        "s_n": q.s_n,
-        "min_angle_deg": q.min_angle_deg,
-        "area": q.area,
-        "solver": s.method.name(),
-        "foundation": if m.is_rigid() { "rigid" } else { m.foundation.name() },
-        "rigid": m.is_rigid(),
-        "sampling": case.obstacle.sampling,
-        "epsilon": m.epsilon,
-        "tension": m.tension,
-        "tolerance": case.solver.tolerance.0,
-        "iterations": s.iterations,
-        "energy": s.energy,
-        "kkt_residual": s.certificate.kkt(),
-        "residual_2e": s.certificate.residual_2e,
-        "residual_2f": s.certificate.residual_2f,
-        "force_scale": s.certificate.force_scale,
-        "can_touch_vertices": m.can_touch.iter().filter(|&&c| c).count(),
-        "contact_vertices": t.contact_vertices,
-        "touching_vertices": t.touching_vertices,
-        "penetrating_vertices": t.penetrating_vertices,
-        "clear_vertices": t.clear_vertices,
-        "contact_area": t.contact_area,
-        "total_load": t.total_load,
-        "total_contact_force": t.total_contact_force,
-        "max_deflection": t.max_deflection,
-        "min_u": t.min_u,
-        "max_u": t.max_u,
-        "history": s.history,
-        "solver_phases_s": phases,
-        "time_mesh_s": time_of(run, "mesh"),
-        "time_assembly_s": time_of(run, "assembly"),
-        "time_solve_s": time_of(run, "solve"),
-        "time_write_s": t_write,
-        "time_total_s": total,
-    })
-}
-
-fn human(case: &Case, run: &Run, q: &MeshQuality, t: &Totals, t_write: f64, total: f64) -> String {
-    let mesh = run.hierarchy.finest();
-    let s = &run.solution;
-    let m = &run.model;
+    let (_, t) = outcome.fields();
     let mut o = String::new();
-    let _ = writeln!(o, "memcontact: {}", case.path.display());
-    o.push_str(&mesh_report(mesh, q, run.hierarchy.depth()));
+    let _ = writeln!(o, "memcontact: {label}");
+    o.push_str(&mesh_report(mesh, &q, d.hierarchy.depth()));
     let _ = writeln!(
         o,
         "  model        t = {}, foundation {}, sampling {}{}",
@@ -196,24 +88,40 @@ fn human(case: &Case, run: &Run, q: &MeshQuality, t: &Totals, t_write: f64, tota
         } else {
             m.foundation.name()
         },
-        case.obstacle.sampling,
+        if m.epsilon.is_some() {
+            "mollified"
+        } else {
+            "nodal"
+        },
         m.epsilon
             .map(|e| format!(" (ε = {e:.4e})"))
             .unwrap_or_default()
     );
+    let why = match (&r.fallback, r.requested) {
+        (Some(f), _) => format!(
+            " (auto: {} {} at KKT {:.1e}, fell back)",
+            f.from.name(),
+            f.status.name().replace('_', " "),
+            f.residual
+        ),
+        (None, memcontact::Method::Auto) => format!(" (auto: {})", r.choice.reason()),
+        _ => String::new(),
+    };
     let _ = writeln!(
         o,
-        "  solver       {}: {} iterations, J(U) = {:.12e}",
-        s.method.name(),
-        s.iterations,
-        s.energy
+        "  solver       {}{why}: {} iterations, J(U) = {:.12e}, {}",
+        r.method.name(),
+        r.iterations,
+        r.energy,
+        r.status.name().replace('_', " ")
     );
     let _ = writeln!(
         o,
-        "  certificate  KKT {:.3e} (2e {:.3e}, 2f {:.3e})",
-        s.certificate.kkt(),
-        s.certificate.residual_2e,
-        s.certificate.residual_2f
+        "  certificate  KKT {:.3e} (2e {:.3e}, 2f {:.3e}), tolerance {:.1e}",
+        r.certificate.kkt(),
+        r.certificate.residual_2e,
+        r.certificate.residual_2f,
+        r.tolerance
     );
     let _ = writeln!(
         o,
@@ -230,22 +138,37 @@ fn human(case: &Case, run: &Run, q: &MeshQuality, t: &Totals, t_write: f64, tota
         "  deflection   max |u| = {:.6e} (u in [{:.6e}, {:.6e}])",
         t.max_deflection, t.min_u, t.max_u
     );
-    let _ = writeln!(
-        o,
-        "  time         mesh {:.3} s, assembly {:.3} s, solve {:.3} s, write {:.3} s, total {:.3} s",
-        time_of(run, "mesh"),
-        time_of(run, "assembly"),
-        time_of(run, "solve"),
-        t_write,
-        total
+    let mut times = format!(
+        "mesh {:.3} s, assembly {:.3} s, solve {:.3} s",
+        r.seconds("mesh"),
+        r.seconds("assembly"),
+        r.seconds("solve")
     );
-    if !s.phases.is_empty() {
-        let phases: Vec<String> = s
-            .phases
+    if let Some((s, _)) = written {
+        let _ = write!(
+            times,
+            ", write {:.3} s, total {:.3} s",
+            s.time_write_s, s.time_total_s
+        );
+    }
+    let _ = writeln!(o, "  time         {times}");
+    if !r.solver_phases.is_empty() {
+        let phases: Vec<String> = r
+            .solver_phases
             .iter()
-            .map(|(k, v)| format!("{k} {v:.3} s"))
+            .map(|p| format!("{} {:.3} s", p.name, p.seconds))
             .collect();
         let _ = writeln!(o, "  solver time  {}", phases.join(", "));
+    }
+    if let Some((s, dir)) = written {
+        let mut names: Vec<&str> = s.files.keys().map(String::as_str).collect();
+        names.push("summary.json");
+        let _ = writeln!(
+            o,
+            "  wrote        {}/{{{}}}",
+            dir.display(),
+            names.join(", ")
+        );
     }
     o
 }

@@ -228,7 +228,7 @@ fn bad_exact_sections_are_errors() {
     let out = dir.join("out");
     let cases: &[(&str, &str, &str)] = &[
         (DISC, "[exact]\nkind = \"bessel\"", "unknown"),
-        (DISC, "[exact]\ndomain = \"disk\"", "needs kind"),
+        (DISC, "[exact]\ndomain = \"disk\"", "missing field `kind`"),
         (DISC, "[exact]\nkind = \"disk\"\namplitude = 1", "amplitude"),
         (SQUARE, "[exact]\nkind = \"disk\"", "generator = \"disk\""),
         (

@@ -35,6 +35,18 @@ pub enum Error {
         /// What happened (iterations, residual reached, ...).
         message: String,
     },
+    /// A case (file, dict or value) refused: the key at fault, and where it is.
+    #[error("{}", case_message(file.as_deref(), *line, key, message))]
+    Case {
+        /// The case file, when the case came from one.
+        file: Option<PathBuf>,
+        /// The 1-based line in the file, when known.
+        line: Option<usize>,
+        /// The dotted key at fault (`membrane.tension`), empty when the whole case is.
+        key: String,
+        /// What is wrong.
+        message: String,
+    },
     /// An input/output failure while writing results.
     #[error("{path}: {source}")]
     Io {
@@ -43,6 +55,31 @@ pub enum Error {
         /// The underlying error.
         source: std::io::Error,
     },
+}
+
+/// `file:line: key: message`, leaving out what is not known.
+fn case_message(
+    file: Option<&std::path::Path>,
+    line: Option<usize>,
+    key: &str,
+    message: &str,
+) -> String {
+    let mut s = String::new();
+    if let Some(f) = file {
+        s.push_str(&f.display().to_string());
+        if let Some(l) = line {
+            s.push_str(&format!(":{l}"));
+        }
+        s.push_str(": ");
+    } else if let Some(l) = line {
+        s.push_str(&format!("line {l}: "));
+    }
+    if !key.is_empty() {
+        s.push_str(key);
+        s.push_str(": ");
+    }
+    s.push_str(message);
+    s
 }
 
 /// Shorthand for results of this library.

@@ -19,9 +19,17 @@ pub mod field;
 pub mod io;
 pub mod mesh;
 pub mod model;
+pub mod output;
+pub mod problem;
 pub mod quadrature;
 pub mod results;
+pub mod run;
 pub mod solve;
 pub mod sparse;
+pub mod summary;
 
 pub use error::{Error, Result};
+pub use problem::{Case, Problem};
+pub use run::{run, Discretization, Outcome, Report};
+pub use solve::{Method, Observer, Settings, Status};
+pub use summary::Summary;

@@ -420,7 +420,7 @@ impl Model {
 }
 
 /// The scaled optimality residuals of a candidate U: zero exactly at the solution.
-#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Certificate {
     /// Largest violation of Problem 2f's conditions, componentwise, divided by the force
     /// scale (`r ≤ 0`, `r + Lp ≥ 0`, `r + Lp = 0` where `U > φ`, `r = 0` where `U < φ`).

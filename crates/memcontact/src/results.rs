@@ -51,23 +51,28 @@ pub struct Totals {
 
 /// Computes the vertex fields and totals of `solution`.
 pub fn derive(mesh: &Mesh, model: &Model, solution: &Solution) -> (NodalFields, Totals) {
+    derive_from(mesh, model, &solution.u)
+}
+
+/// Computes the vertex fields and totals of the iterate `u` (over the unknowns).
+pub fn derive_from(mesh: &Mesh, model: &Model, u_dofs: &[f64]) -> (NodalFields, Totals) {
     let nv = mesh.n_vertices();
     let dofs = &model.dofs;
-    let u = dofs.to_vertices(&solution.u, 0.0);
-    let r = model.residual(&solution.u);
+    let u = dofs.to_vertices(u_dofs, 0.0);
+    let r = model.residual(u_dofs);
     let x1: Vec<f64> = r
         .iter()
         .zip(&model.can_touch)
         .map(|(ri, &c)| if c { -ri } else { 0.0 })
         .collect();
     let contact_force = dofs.to_vertices(&x1, 0.0);
-    let states = model.states(&solution.u);
+    let states = model.states(u_dofs);
     let mut state = vec![-1i8; nv];
     let mut penetration = vec![0.0; nv];
     for (i, &v) in dofs.vertex.iter().enumerate() {
         state[v as usize] = states[i];
         if model.can_touch[i] {
-            penetration[v as usize] = (solution.u[i] - model.phi[i]).max(0.0);
+            penetration[v as usize] = (u_dofs[i] - model.phi[i]).max(0.0);
         }
     }
     // Nodal areas |Q_i| / 3.

@@ -4,5 +4,6 @@ mod atomic;
 pub mod csv;
 pub mod gmsh;
 pub mod json;
+pub mod result_set;
 pub mod vtu;
 pub use atomic::write_atomic;

@@ -27,7 +27,7 @@ use crate::{Error, Result};
 use rayon::prelude::*;
 
 /// Default iteration limit.
-const MAX_ITERATIONS: usize = 500;
+pub(crate) const MAX_ITERATIONS: usize = 500;
 
 /// A starting point: zero, moved below φ where the obstacle is rigid.
 pub fn feasible_start(model: &Model) -> Vec<f64> {

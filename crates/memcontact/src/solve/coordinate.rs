@@ -9,7 +9,7 @@ use crate::model::Model;
 use crate::Result;
 
 /// Default limit on sweeps.
-const MAX_SWEEPS: usize = 1_000_000;
+pub(crate) const MAX_SWEEPS: usize = 1_000_000;
 
 /// Sweeps until the KKT residual is below the tolerance (checked every few sweeps).
 pub fn solve(model: &Model, settings: &Settings, observer: &mut dyn Observer) -> Result<Solution> {

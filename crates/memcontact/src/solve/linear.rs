@@ -6,15 +6,14 @@ use crate::model::Model;
 use crate::sparse::Cholesky;
 use crate::{Error, Result};
 
-/// Solves `S U = D` by sparse Cholesky; an error unless L = 0.
+/// Solves `S U = D` by sparse Cholesky; a bad-input error unless L = 0.
 pub fn solve(model: &Model, _settings: &Settings) -> Result<Solution> {
     if !model.is_linear() {
-        return Err(Error::Solver {
-            solver: "linear".into(),
-            message: "the obstacle can touch the membrane (h > 0 somewhere, or rigid): the \
-                      problem is not linear; choose another method"
+        return Err(Error::Data(
+            "solver.method = \"linear\" needs a problem without contact, but the obstacle \
+             can touch the membrane (h > 0 somewhere, or rigid): choose another method"
                 .into(),
-        });
+        ));
     }
     let mut timer = PhaseTimer::default();
     let chol = timer.time("factorisation", || Cholesky::new(&model.s))?;

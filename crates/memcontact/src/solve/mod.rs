@@ -34,6 +34,7 @@ pub enum Method {
     /// One linear solve (h ≡ 0 only).
     Linear,
     /// Semismooth Newton / primal-dual active set on Problem 2f.
+    #[serde(alias = "active_set")]
     ActiveSet,
     /// Problem 2c by an interior-point QP solver.
     Qp,
@@ -80,15 +81,49 @@ impl std::str::FromStr for Method {
     }
 }
 
-/// Solver settings.
-#[derive(Debug, Clone)]
+/// Solver settings (`[solver]` in a case file), with serde defaults; [`Settings::validate`]
+/// refuses values that cannot certify an answer.
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields, default)]
 pub struct Settings {
     /// The method.
     pub method: Method,
     /// Stop when the scaled KKT residual (max of 2e and 2f) is at most this.
     pub tolerance: f64,
     /// Iteration limit (`None`: the method's default).
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub max_iterations: Option<usize>,
+}
+
+/// Tolerances at or above this certify nothing: a residual of 1 % of the forces.
+pub const LOOSEST_TOLERANCE: f64 = 1e-2;
+
+impl Settings {
+    /// Checks the settings: `0 < tolerance <` [`LOOSEST_TOLERANCE`], `max_iterations ≥ 1`.
+    pub fn validate(&self) -> std::result::Result<(), crate::problem::Invalid> {
+        use crate::problem::Invalid;
+        let tol = self.tolerance;
+        if !(tol.is_finite() && tol > 0.0) {
+            return Err(Invalid::new(
+                "solver.tolerance",
+                format!("must be a finite number > 0, got {tol}"),
+            ));
+        }
+        if tol >= LOOSEST_TOLERANCE {
+            return Err(Invalid::new(
+                "solver.tolerance",
+                format!(
+                    "{tol} cannot certify an answer: the scaled KKT residual measures the \
+                     unbalanced force relative to the forces present, so a tolerance must be \
+                     below {LOOSEST_TOLERANCE:e} (1e-10 by default)"
+                ),
+            ));
+        }
+        if self.max_iterations == Some(0) {
+            return Err(Invalid::new("solver.max_iterations", "must be at least 1"));
+        }
+        Ok(())
+    }
 }
 
 impl Default for Settings {
@@ -102,7 +137,7 @@ impl Default for Settings {
 }
 
 /// One line of a solver's history.
-#[derive(Debug, Clone, Copy, serde::Serialize)]
+#[derive(Debug, Clone, Copy, serde::Serialize, serde::Deserialize)]
 pub struct IterationRecord {
     /// Iteration number (1-based).
     pub iteration: usize,
@@ -112,10 +147,14 @@ pub struct IterationRecord {
     pub residual: f64,
 }
 
-/// Receives progress from a running solver (the CLI draws it; the library never prints).
+/// Receives progress from a run (the CLI draws it; the library never prints).
 pub trait Observer {
     /// Called after every iteration.
     fn iteration(&mut self, _record: &IterationRecord) {}
+    /// A phase of the run (`mesh`, `assembly`, `solve`, ...) starts.
+    fn phase_started(&mut self, _name: &str) {}
+    /// A phase of the run ends after `seconds`.
+    fn phase_finished(&mut self, _name: &str, _seconds: f64) {}
 }
 
 /// An observer that ignores everything.
@@ -181,41 +220,137 @@ impl PhaseTimer {
     }
 }
 
-/// The method `auto` picks: linear when L = 0, multigrid when the mesh has a hierarchy,
-/// the active-set method otherwise.
-pub fn auto_method(model: &Model, hierarchy: Option<&Hierarchy>) -> Method {
-    if model.is_linear() {
-        Method::Linear
-    } else if hierarchy.is_some_and(|h| h.depth() >= 3) {
-        Method::Multigrid
-    } else {
-        Method::ActiveSet
+/// How a solve ended. A numerical outcome is never an `Err`: every status comes with the
+/// best iterate and its certificate.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Status {
+    /// The scaled KKT residual reached the tolerance.
+    Converged,
+    /// The iteration limit was reached first.
+    IterationLimit,
+    /// The iterate stopped changing before the tolerance was reached.
+    Stalled,
+    /// A factorisation or the arithmetic failed (non-finite values, a singular matrix).
+    NumericalFailure,
+}
+
+impl Status {
+    /// The name used in outputs.
+    pub fn name(self) -> &'static str {
+        match self {
+            Status::Converged => "converged",
+            Status::IterationLimit => "iteration_limit",
+            Status::Stalled => "stalled",
+            Status::NumericalFailure => "numerical_failure",
+        }
+    }
+
+    /// `true` for [`Status::Converged`].
+    pub fn is_converged(self) -> bool {
+        self == Status::Converged
     }
 }
 
-/// Solves the model with the chosen method. `hierarchy`, when given, must end with the
-/// mesh the model was assembled on (multigrid uses its coarser levels).
-pub fn solve(
+/// Why the method of a solve was used.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Choice {
+    /// The settings named the method.
+    Requested,
+    /// `auto`: h ≡ 0 (no body can touch), the problem is one linear solve.
+    LinearProblem,
+    /// `auto`: the mesh has a refinement hierarchy, so geometric multigrid.
+    GeometricHierarchy,
+    /// `auto`: no refinement hierarchy, so the active-set method with a direct solver.
+    NoHierarchy,
+}
+
+impl Choice {
+    /// A one-line reason.
+    pub fn reason(self) -> &'static str {
+        match self {
+            Choice::Requested => "requested",
+            Choice::LinearProblem => "no body can touch the membrane: one linear solve",
+            Choice::GeometricHierarchy => "the mesh has a refinement hierarchy: multigrid",
+            Choice::NoHierarchy => "no refinement hierarchy: active-set with a direct solver",
+        }
+    }
+}
+
+/// A method `auto` tried first and gave up on.
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct Fallback {
+    /// The method tried first.
+    pub from: Method,
+    /// How it ended.
+    pub status: Status,
+    /// Its scaled KKT residual at the end.
+    pub residual: f64,
+    /// What happened, when it failed.
+    pub message: Option<String>,
+}
+
+/// What one solve produced: the iterate and how the solve ended.
+#[derive(Debug, Clone)]
+pub struct Attempt {
+    /// The best iterate, its certificate and history.
+    pub solution: Solution,
+    /// How the solve ended.
+    pub status: Status,
+    /// The method the settings asked for (maybe `auto`).
+    pub requested: Method,
+    /// Why `solution.method` was used.
+    pub choice: Choice,
+    /// The method `auto` tried first, when it fell back.
+    pub fallback: Option<Fallback>,
+    /// What went wrong, for a numerical failure.
+    pub message: Option<String>,
+}
+
+/// The one `auto` policy: linear when no body can touch (L = 0), multigrid when the mesh
+/// has a refinement hierarchy, the active-set method otherwise; with the reason.
+pub fn auto_choice(model: &Model, hierarchy: Option<&Hierarchy>) -> (Method, Choice) {
+    if model.is_linear() {
+        (Method::Linear, Choice::LinearProblem)
+    } else if hierarchy.is_some_and(|h| h.depth() >= 3) {
+        (Method::Multigrid, Choice::GeometricHierarchy)
+    } else {
+        (Method::ActiveSet, Choice::NoHierarchy)
+    }
+}
+
+/// The method `auto` picks (see [`auto_choice`]).
+pub fn auto_method(model: &Model, hierarchy: Option<&Hierarchy>) -> Method {
+    auto_choice(model, hierarchy).0
+}
+
+impl Method {
+    /// The iteration limit when the settings give none.
+    pub fn default_max_iterations(self) -> usize {
+        match self {
+            Method::Auto | Method::Linear => 1,
+            Method::ActiveSet => active_set::MAX_ITERATIONS,
+            Method::Qp => qp::MAX_ITERATIONS as usize,
+            Method::Coordinate => coordinate::MAX_SWEEPS,
+            Method::Multigrid => multigrid::MAX_ITERATIONS,
+        }
+    }
+}
+
+/// Runs one method; a solver's numerical failure becomes a status with the start iterate.
+fn run_method(
+    method: Method,
     model: &Model,
     hierarchy: Option<&Hierarchy>,
     settings: &Settings,
     observer: &mut dyn Observer,
-) -> Result<Solution> {
-    if !(settings.tolerance.is_finite() && settings.tolerance > 0.0) {
-        return Err(Error::Data(format!(
-            "solver.tolerance must be a finite number > 0, got {}",
-            settings.tolerance
-        )));
-    }
-    let method = match settings.method {
-        Method::Auto => auto_method(model, hierarchy),
-        m => m,
-    };
-    let solution = match method {
-        Method::Linear => linear::solve(model, settings)?,
-        Method::ActiveSet => active_set::solve(model, settings, observer)?,
-        Method::Qp => qp::solve(model, settings)?,
-        Method::Coordinate => coordinate::solve(model, settings, observer)?,
+) -> Result<(Solution, Status, Option<String>)> {
+    let result = match method {
+        Method::Linear => linear::solve(model, settings),
+        Method::ActiveSet => active_set::solve(model, settings, observer),
+        Method::Qp => qp::solve(model, settings),
+        Method::Coordinate => coordinate::solve(model, settings, observer),
         Method::Multigrid => {
             let h = hierarchy.ok_or_else(|| Error::Solver {
                 solver: "multigrid".into(),
@@ -224,36 +359,136 @@ pub fn solve(
                           choose method = \"active-set\""
                     .into(),
             })?;
-            match multigrid::solve(model, h, settings, observer) {
-                // `auto` chose multigrid: if it cannot reach the tolerance, the exact
-                // active-set method (with a direct solver) is the robust fallback.
-                Ok(s)
-                    if settings.method == Method::Auto
-                        && (s.certificate.kkt().is_nan()
-                            || s.certificate.kkt() > settings.tolerance) =>
-                {
-                    active_set::solve(model, settings, observer)?
-                }
-                Err(_) if settings.method == Method::Auto => {
-                    active_set::solve(model, settings, observer)?
-                }
-                other => other?,
-            }
+            multigrid::solve(model, h, settings, observer)
         }
-        Method::Auto => unreachable!("resolved above"),
+        Method::Auto => unreachable!("resolved by the caller"),
     };
-    let kkt = solution.certificate.kkt();
-    if kkt.is_nan() || kkt > settings.tolerance {
-        return Err(Error::Solver {
-            solver: method.name().into(),
-            message: format!(
-                "stopped after {} iterations with scaled KKT residual {kkt:.3e} above the \
-                 tolerance {:.1e}",
-                solution.iterations, settings.tolerance
-            ),
-        });
+    match result {
+        Ok(solution) => {
+            let kkt = solution.certificate.kkt();
+            let limit = settings
+                .max_iterations
+                .unwrap_or(method.default_max_iterations());
+            let status = if kkt <= settings.tolerance {
+                Status::Converged
+            } else if !kkt.is_finite() || !solution.energy.is_finite() {
+                Status::NumericalFailure
+            } else if solution.iterations >= limit {
+                Status::IterationLimit
+            } else {
+                Status::Stalled
+            };
+            Ok((solution, status, None))
+        }
+        Err(Error::Solver { message, .. }) => {
+            let u = active_set::feasible_start(model);
+            let certificate = model.certificate(&u);
+            let solution = Solution {
+                energy: model.energy(&u),
+                u,
+                method,
+                iterations: 0,
+                certificate,
+                multipliers: None,
+                history: Vec::new(),
+                phases: Vec::new(),
+            };
+            Ok((solution, Status::NumericalFailure, Some(message)))
+        }
+        Err(e) => Err(e),
     }
-    Ok(solution)
+}
+
+/// Solves the model with the settings' method (resolving `auto` by [`auto_choice`], with
+/// its one fallback: when multigrid does not converge, the active-set method). `hierarchy`,
+/// when given, must end with the mesh the model was assembled on. `Err` is for input the
+/// method cannot take; every numerical outcome is an [`Attempt`] with a [`Status`].
+pub fn attempt(
+    model: &Model,
+    hierarchy: Option<&Hierarchy>,
+    settings: &Settings,
+    observer: &mut dyn Observer,
+) -> Result<Attempt> {
+    settings.validate().map_err(|e| e.into_error())?;
+    let (method, choice) = match settings.method {
+        Method::Auto => auto_choice(model, hierarchy),
+        m => (m, Choice::Requested),
+    };
+    let (mut solution, mut status, mut message) =
+        run_method(method, model, hierarchy, settings, observer)?;
+    let mut fallback = None;
+    if settings.method == Method::Auto && method == Method::Multigrid && !status.is_converged() {
+        fallback = Some(Fallback {
+            from: method,
+            status,
+            residual: solution.certificate.kkt(),
+            message: message.take(),
+        });
+        (solution, status, message) =
+            run_method(Method::ActiveSet, model, hierarchy, settings, observer)?;
+    }
+    Ok(Attempt {
+        solution,
+        status,
+        requested: settings.method,
+        choice,
+        fallback,
+        message,
+    })
+}
+
+/// [`attempt`], for callers that need a converged answer: any status but
+/// [`Status::Converged`] is an [`Error::Solver`] naming it.
+pub fn solve(
+    model: &Model,
+    hierarchy: Option<&Hierarchy>,
+    settings: &Settings,
+    observer: &mut dyn Observer,
+) -> Result<Solution> {
+    let a = attempt(model, hierarchy, settings, observer)?;
+    if a.status.is_converged() {
+        return Ok(a.solution);
+    }
+    Err(not_converged(&a, settings))
+}
+
+/// The error for an attempt that did not converge.
+pub fn not_converged(a: &Attempt, settings: &Settings) -> Error {
+    let s = &a.solution;
+    status_error(
+        a.status,
+        s.method,
+        s.iterations,
+        s.certificate.kkt(),
+        settings.tolerance,
+        a.message.as_deref(),
+    )
+}
+
+/// The error that names how a solve by `method` ended short of the tolerance.
+pub fn status_error(
+    status: Status,
+    method: Method,
+    iterations: usize,
+    kkt: f64,
+    tolerance: f64,
+    message: Option<&str>,
+) -> Error {
+    let what = match status {
+        Status::Converged => "converged".to_string(),
+        Status::IterationLimit => format!("reached the iteration limit ({iterations})"),
+        Status::Stalled => format!("stalled after {iterations} iterations"),
+        Status::NumericalFailure => format!(
+            "failed numerically{}",
+            message.map(|m| format!(": {m}")).unwrap_or_default()
+        ),
+    };
+    Error::Solver {
+        solver: method.name().into(),
+        message: format!(
+            "{what}, with scaled KKT residual {kkt:.3e} above the tolerance {tolerance:.1e}"
+        ),
+    }
 }
 
 #[cfg(test)]

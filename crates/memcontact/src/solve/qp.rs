@@ -74,7 +74,7 @@ use clarabel::solver::{
 };
 
 /// Default limit on interior-point iterations.
-const MAX_ITERATIONS: u32 = 200;
+pub(crate) const MAX_ITERATIONS: u32 = 200;
 
 /// Most polishing rounds (exact piece solves) after the interior point.
 pub const POLISH_ROUNDS: usize = 4;

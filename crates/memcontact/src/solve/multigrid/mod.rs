@@ -51,7 +51,7 @@ use rayon::prelude::*;
 use std::time::Instant;
 
 /// Default iteration limit on each level.
-const MAX_ITERATIONS: usize = 300;
+pub(crate) const MAX_ITERATIONS: usize = 300;
 
 /// Iterations without any change of the iterate after which the solver gives up.
 const STALL_LIMIT: usize = 3;

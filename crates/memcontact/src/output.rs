@@ -1,0 +1,142 @@
+//! The result files of a run, written as one atomic result set ([`ResultSet`]):
+//! `solution.vtu` (ParaView), `nodes.csv` (one row per vertex), any extra files of the
+//! caller (pictures), and `summary.json` (the [`Summary`], with the run id, the input's hash
+//! and the size and hash of every other file, so a mixed directory is detectable).
+
+use crate::io::csv::write_columns_csv;
+use crate::io::json::write_json;
+use crate::io::result_set::ResultSet;
+use crate::io::vtu::{write_vtu, DataArray, VtuEncoding};
+use crate::problem::{Case, VtuFormat};
+use crate::results::NodalFields;
+use crate::run::Outcome;
+use crate::summary::{FileRecord, Summary};
+use crate::{Error, Result};
+use std::path::Path;
+use std::time::Instant;
+
+/// The names of the per-vertex columns of `nodes.csv` (after `x`, `y`) and point fields of
+/// `solution.vtu`, in order.
+pub const NODAL_FIELDS: [&str; 6] = [
+    "u",
+    "phi",
+    "penetration",
+    "pressure",
+    "contact_force",
+    "state",
+];
+
+/// How a result set is written.
+#[derive(Debug, Clone)]
+pub struct WriteOptions {
+    /// The case's label in `summary.json` (its file path, or a name).
+    pub label: String,
+    /// The encoding of `solution.vtu`.
+    pub vtu: VtuFormat,
+    /// Replace a directory that holds files other than a memcontact result.
+    pub force: bool,
+    /// When the run started (for `time_total_s`).
+    pub started: Instant,
+}
+
+/// A fresh random run identifier (32 hex digits).
+pub fn new_run_id() -> String {
+    use std::hash::{BuildHasher, Hasher};
+    let nanos = std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .map(|d| d.as_nanos())
+        .unwrap_or(0);
+    let mut parts = [0u64; 2];
+    for (k, p) in parts.iter_mut().enumerate() {
+        let mut h = std::collections::hash_map::RandomState::new().build_hasher();
+        h.write_u128(nanos);
+        h.write_u32(std::process::id());
+        h.write_usize(k);
+        *p = h.finish();
+    }
+    format!("{:016x}{:016x}", parts[0], parts[1])
+}
+
+/// The hash of a case: XXH3-64 of its canonical JSON (16 hex digits).
+pub fn input_hash(case: &Case) -> String {
+    let json = serde_json::to_string(case).unwrap_or_default();
+    format!("{:016x}", xxhash_rust::xxh3::xxh3_64(json.as_bytes()))
+}
+
+/// The size and hash of a written file.
+pub fn file_record(path: &Path) -> Result<FileRecord> {
+    let bytes = std::fs::read(path).map_err(|source| Error::Io {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    Ok(FileRecord {
+        bytes: bytes.len() as u64,
+        xxh3: format!("{:016x}", xxhash_rust::xxh3::xxh3_64(&bytes)),
+    })
+}
+
+/// Writes `solution.vtu` and `nodes.csv` of `fields` on the outcome's mesh into `dir`.
+pub fn write_fields(
+    dir: &Path,
+    outcome: &Outcome,
+    fields: &NodalFields,
+    vtu: VtuFormat,
+) -> Result<()> {
+    let mesh = outcome.mesh();
+    let region: Vec<i32> = mesh.regions.iter().map(|&r| r as i32).collect();
+    let state: Vec<i32> = fields.state.iter().map(|&s| s as i32).collect();
+    let point_data = [
+        ("u", DataArray::F64(&fields.u)),
+        ("phi", DataArray::F64(&fields.phi)),
+        ("penetration", DataArray::F64(&fields.penetration)),
+        ("pressure", DataArray::F64(&fields.pressure)),
+        ("contact_force", DataArray::F64(&fields.contact_force)),
+        ("state", DataArray::I32(&state)),
+    ];
+    write_vtu(
+        &dir.join("solution.vtu"),
+        mesh,
+        &point_data,
+        &[("region", DataArray::I32(&region))],
+        match vtu {
+            VtuFormat::Binary => VtuEncoding::Binary,
+            VtuFormat::Ascii => VtuEncoding::Ascii,
+        },
+    )?;
+    let x: Vec<f64> = mesh.points.iter().map(|p| p[0]).collect();
+    let y: Vec<f64> = mesh.points.iter().map(|p| p[1]).collect();
+    let mut columns = vec![("x", DataArray::F64(&x)), ("y", DataArray::F64(&y))];
+    columns.extend(point_data);
+    write_columns_csv(&dir.join("nodes.csv"), &columns)
+}
+
+/// Writes the result set of `outcome` into `target` atomically: `solution.vtu`,
+/// `nodes.csv`, what `extra` writes into the staging directory it is given (it returns the
+/// names of its files), and `summary.json` last. Returns the summary written.
+pub fn write_result_set(
+    target: &Path,
+    outcome: &Outcome,
+    case: &Case,
+    options: &WriteOptions,
+    extra: &mut dyn FnMut(&Path, &NodalFields) -> Result<Vec<String>>,
+) -> Result<Summary> {
+    let t0 = Instant::now();
+    let set = ResultSet::begin(target, options.force)?;
+    let (fields, totals) = outcome.fields();
+    write_fields(set.dir(), outcome, &fields, options.vtu)?;
+    let mut names = vec!["solution.vtu".to_string(), "nodes.csv".to_string()];
+    names.extend(extra(set.dir(), &fields)?);
+    let quality = outcome.mesh().quality();
+    let mut summary = Summary::new(&options.label, outcome, &quality, &totals);
+    summary.run_id = new_run_id();
+    summary.input_hash = input_hash(case);
+    for name in names {
+        let record = file_record(&set.dir().join(&name))?;
+        summary.files.insert(name, record);
+    }
+    summary.time_write_s = t0.elapsed().as_secs_f64();
+    summary.time_total_s = options.started.elapsed().as_secs_f64();
+    write_json(&set.dir().join("summary.json"), &summary)?;
+    set.commit()?;
+    Ok(summary)
+}

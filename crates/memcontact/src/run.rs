@@ -1,0 +1,315 @@
+//! The library's front door: one [`run`] from a [`Problem`] and [`Settings`] to an
+//! [`Outcome`]. Data flows one way:
+//!
+//! ```text
+//! Problem ─► Discretization (mesh levels, data bound to regions, S, L, D, φₙ, M)
+//!         ─► solve (method, auto policy, fallback) ─► Outcome (U, Status, Report)
+//! ```
+//!
+//! Bad input is an `Err`; a numerical outcome (converged, iteration limit, stalled,
+//! numerical failure) is a [`Status`] inside the [`Report`], always with the best iterate
+//! and its certificate. The library prints nothing: progress reaches the caller through
+//! the [`Observer`].
+
+use crate::field::{BoundField, Stiffness as FieldStiffness};
+use crate::mesh::refine::Hierarchy;
+use crate::mesh::Mesh;
+use crate::model::{Certificate, Model, ProblemData, Stiffness};
+use crate::problem::{Invalid, Problem};
+use crate::results::{derive_from, NodalFields, Totals};
+use crate::solve::{
+    self, Choice, Fallback, IterationRecord, Method, Observer, Settings, Solution, Status,
+};
+use crate::Result;
+use std::time::Instant;
+
+/// The problem's data f, φ, h bound to a mesh's regions.
+#[derive(Debug, Clone)]
+pub struct BoundData {
+    /// The load f.
+    pub load: BoundField,
+    /// The obstacle's surface φ.
+    pub shape: BoundField,
+    /// The stiffness h (`None`: rigid).
+    pub stiffness: Option<BoundField>,
+}
+
+impl BoundData {
+    /// Binds the problem's f, φ and h to the regions of `mesh` (a region table must name
+    /// regions the mesh has, or give a default).
+    pub fn new(problem: &Problem, mesh: &Mesh) -> Result<BoundData> {
+        let mut tags: Vec<u32> = mesh.regions.clone();
+        tags.sort_unstable();
+        tags.dedup();
+        let names = &mesh.region_names;
+        Ok(BoundData {
+            load: problem.membrane.load.bind("membrane.load", names, &tags)?,
+            shape: problem
+                .obstacle
+                .shape
+                .bind("obstacle.shape", names, &tags)?,
+            stiffness: match &problem.obstacle.stiffness {
+                FieldStiffness::Rigid => None,
+                FieldStiffness::Elastic(h) => Some(h.bind("obstacle.stiffness", names, &tags)?),
+            },
+        })
+    }
+
+    /// The model's view of the data, with the problem's tension and choices.
+    pub fn data<'a>(&'a self, problem: &Problem) -> ProblemData<'a> {
+        ProblemData {
+            tension: problem.membrane.tension,
+            load: &self.load,
+            shape: &self.shape,
+            stiffness: match &self.stiffness {
+                Some(h) => Stiffness::Elastic(h),
+                None => Stiffness::Rigid,
+            },
+            foundation: problem.obstacle.foundation,
+            sampling: problem.obstacle.sampling(),
+        }
+    }
+}
+
+/// A named phase of a run and its wall-clock seconds.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct Phase {
+    /// `mesh`, `assembly`, `solve`, ...
+    pub name: String,
+    /// Wall-clock seconds.
+    pub seconds: f64,
+}
+
+/// The discrete problem: the mesh levels (the finest is solved on) and the assembled model
+/// of the paper's §2. Built once per problem; solves reuse it.
+#[derive(Debug, Clone)]
+pub struct Discretization {
+    /// The mesh levels; the finest is the solved mesh.
+    pub hierarchy: Hierarchy,
+    /// S, L, D, φₙ, M on the finest mesh.
+    pub model: Model,
+    /// Warnings from reading the mesh (skipped element types, ...).
+    pub warnings: Vec<String>,
+    /// Wall-clock seconds of `mesh` and `assembly`.
+    pub phases: Vec<Phase>,
+}
+
+impl Discretization {
+    /// Builds the mesh the problem describes and assembles the model on it.
+    pub fn new(problem: &Problem, observer: &mut dyn Observer) -> Result<Discretization> {
+        problem.validate().map_err(Invalid::into_error)?;
+        observer.phase_started("mesh");
+        let t0 = Instant::now();
+        let (hierarchy, warnings) = problem.mesh.build()?;
+        let t_mesh = t0.elapsed().as_secs_f64();
+        observer.phase_finished("mesh", t_mesh);
+        let mut d = Discretization::assemble(problem, hierarchy, observer)?;
+        d.warnings = warnings;
+        d.phases.insert(
+            0,
+            Phase {
+                name: "mesh".into(),
+                seconds: t_mesh,
+            },
+        );
+        Ok(d)
+    }
+
+    /// Assembles the problem's data on a given mesh hierarchy (the finest level is solved
+    /// on; its coarser levels serve multigrid). `problem.mesh` is not used.
+    pub fn assemble(
+        problem: &Problem,
+        hierarchy: Hierarchy,
+        observer: &mut dyn Observer,
+    ) -> Result<Discretization> {
+        observer.phase_started("assembly");
+        let t0 = Instant::now();
+        let mesh = hierarchy.finest();
+        let bound = BoundData::new(problem, mesh)?;
+        let model = Model::assemble(mesh, &bound.data(problem))?;
+        let seconds = t0.elapsed().as_secs_f64();
+        observer.phase_finished("assembly", seconds);
+        Ok(Discretization {
+            hierarchy,
+            model,
+            warnings: Vec::new(),
+            phases: vec![Phase {
+                name: "assembly".into(),
+                seconds,
+            }],
+        })
+    }
+
+    /// The solved mesh.
+    pub fn mesh(&self) -> &Mesh {
+        self.hierarchy.finest()
+    }
+
+    /// The mesh levels multigrid can use (`None` for a single level).
+    pub fn levels(&self) -> Option<&Hierarchy> {
+        (self.hierarchy.depth() > 1).then_some(&self.hierarchy)
+    }
+
+    /// The method `auto` would use, and why.
+    pub fn auto_choice(&self) -> (Method, Choice) {
+        solve::auto_choice(&self.model, self.levels())
+    }
+
+    /// Solves the discrete problem with `settings`.
+    pub fn solve(&self, settings: &Settings, observer: &mut dyn Observer) -> Result<Report> {
+        observer.phase_started("solve");
+        let t0 = Instant::now();
+        let a = solve::attempt(&self.model, self.levels(), settings, observer)?;
+        let seconds = t0.elapsed().as_secs_f64();
+        observer.phase_finished("solve", seconds);
+        let mut phases = self.phases.clone();
+        phases.push(Phase {
+            name: "solve".into(),
+            seconds,
+        });
+        let s = a.solution;
+        Ok(Report {
+            status: a.status,
+            requested: a.requested,
+            method: s.method,
+            choice: a.choice,
+            fallback: a.fallback,
+            message: a.message,
+            iterations: s.iterations,
+            energy: s.energy,
+            certificate: s.certificate,
+            tolerance: settings.tolerance,
+            history: s.history,
+            phases,
+            solver_phases: s
+                .phases
+                .into_iter()
+                .map(|(name, seconds)| Phase { name, seconds })
+                .collect(),
+            u: s.u,
+            multipliers: s.multipliers,
+        })
+    }
+}
+
+/// How a solve went, with its iterate: the status, the method used and why, iterations,
+/// J, the certificates of 2e and 2f, the history and the phase times.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct Report {
+    /// How the solve ended.
+    pub status: Status,
+    /// The method the settings asked for (maybe `auto`).
+    pub requested: Method,
+    /// The method that produced the iterate.
+    pub method: Method,
+    /// Why that method was used.
+    pub choice: Choice,
+    /// The method `auto` tried first and gave up on.
+    pub fallback: Option<Fallback>,
+    /// What went wrong, for a numerical failure.
+    pub message: Option<String>,
+    /// Iterations of the method that produced the iterate.
+    pub iterations: usize,
+    /// J(U) (Problem 2b).
+    pub energy: f64,
+    /// The scaled residuals of 2e and 2f at U.
+    pub certificate: Certificate,
+    /// The tolerance the certificate was held to.
+    pub tolerance: f64,
+    /// Energy and residual per iteration.
+    pub history: Vec<IterationRecord>,
+    /// `mesh`, `assembly`, `solve` wall-clock seconds.
+    pub phases: Vec<Phase>,
+    /// The solver's own phases (setup, factorisation, smoothing, ...).
+    pub solver_phases: Vec<Phase>,
+    /// U over the unknowns (the best iterate).
+    #[serde(skip)]
+    pub u: Vec<f64>,
+    /// The solver's multipliers of 2e, when it computes them (the QP does).
+    #[serde(skip)]
+    pub multipliers: Option<solve::Multipliers>,
+}
+
+impl Report {
+    /// Seconds of phase `name` (0 when it did not run).
+    pub fn seconds(&self, name: &str) -> f64 {
+        self.phases
+            .iter()
+            .filter(|p| p.name == name)
+            .map(|p| p.seconds)
+            .sum()
+    }
+
+    /// The error naming how the solve ended, when it did not converge.
+    pub fn error(&self) -> Option<crate::Error> {
+        (!self.status.is_converged()).then(|| {
+            solve::status_error(
+                self.status,
+                self.method,
+                self.iterations,
+                self.certificate.kkt(),
+                self.tolerance,
+                self.message.as_deref(),
+            )
+        })
+    }
+
+    /// The iterate as a [`Solution`] (for the functions that derive results from one).
+    pub fn solution(&self) -> Solution {
+        Solution {
+            u: self.u.clone(),
+            method: self.method,
+            iterations: self.iterations,
+            energy: self.energy,
+            certificate: self.certificate,
+            multipliers: self.multipliers.clone(),
+            history: self.history.clone(),
+            phases: self
+                .solver_phases
+                .iter()
+                .map(|p| (p.name.clone(), p.seconds))
+                .collect(),
+        }
+    }
+}
+
+/// What [`run`] produced: the discretisation and the report with the iterate.
+#[derive(Debug, Clone)]
+pub struct Outcome {
+    /// Mesh levels and model.
+    pub discretization: Discretization,
+    /// Status, method, certificate, history, times, and U.
+    pub report: Report,
+}
+
+impl Outcome {
+    /// How the solve ended.
+    pub fn status(&self) -> Status {
+        self.report.status
+    }
+
+    /// The solved mesh.
+    pub fn mesh(&self) -> &Mesh {
+        self.discretization.mesh()
+    }
+
+    /// The vertex fields (u, φ, penetration, pressure, contact forces, states) and totals.
+    pub fn fields(&self) -> (NodalFields, Totals) {
+        derive_from(
+            self.discretization.mesh(),
+            &self.discretization.model,
+            &self.report.u,
+        )
+    }
+}
+
+/// Runs a problem end to end: mesh, assembly, solve.
+pub fn run(problem: &Problem, settings: &Settings, observer: &mut dyn Observer) -> Result<Outcome> {
+    settings.validate().map_err(Invalid::into_error)?;
+    let discretization = Discretization::new(problem, observer)?;
+    let report = discretization.solve(settings, observer)?;
+    Ok(Outcome {
+        discretization,
+        report,
+    })
+}

@@ -1,0 +1,195 @@
+//! `summary.json`: the scalar results of a run, as one serde struct. Its keys are a
+//! contract with users (scripts read them): extend, never rename.
+
+use crate::mesh::MeshQuality;
+use crate::results::Totals;
+use crate::run::Outcome;
+use crate::solve::{Choice, Fallback, IterationRecord, Status};
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+
+/// One output file of a result set: its size and a hash of its bytes, so that a directory
+/// mixing the files of two runs can be detected.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+pub struct FileRecord {
+    /// Size in bytes.
+    pub bytes: u64,
+    /// XXH3-64 of the bytes, 16 hex digits.
+    pub xxh3: String,
+}
+
+/// Everything `summary.json` holds.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct Summary {
+    /// The case (file path, or a label for a case built in code).
+    pub case: String,
+    /// Mesh vertices.
+    pub vertices: usize,
+    /// Mesh triangles.
+    pub triangles: usize,
+    /// Unknowns m (interior vertices).
+    pub unknowns: usize,
+    /// Mesh levels (1 without a refinement hierarchy).
+    pub levels: usize,
+    /// The largest triangle diameter l_n.
+    pub l_n: f64,
+    /// The largest ratio diameter / inscribed-circle diameter s_n.
+    pub s_n: f64,
+    /// The smallest angle of the mesh, degrees.
+    pub min_angle_deg: f64,
+    /// The area of Ω_n.
+    pub area: f64,
+    /// The method that produced the answer.
+    pub solver: String,
+    /// `consistent`, `lumped` or `rigid`.
+    pub foundation: String,
+    /// Whether the obstacle is rigid.
+    pub rigid: bool,
+    /// `nodal` or `mollified`.
+    pub sampling: String,
+    /// The mollifier radius, for mollified sampling.
+    pub epsilon: Option<f64>,
+    /// The tension t.
+    pub tension: f64,
+    /// The tolerance on the scaled KKT residual.
+    pub tolerance: f64,
+    /// Iterations of the method.
+    pub iterations: usize,
+    /// J(U).
+    pub energy: f64,
+    /// The larger of the two residuals below.
+    pub kkt_residual: f64,
+    /// The scaled residual of the Kuhn-Tucker system 2e.
+    pub residual_2e: f64,
+    /// The scaled residual of the complementarity problem 2f.
+    pub residual_2f: f64,
+    /// The force the residuals are divided by.
+    pub force_scale: f64,
+    /// |M|: unknowns the obstacle can touch.
+    pub can_touch_vertices: usize,
+    /// Vertices in contact (touching or penetrating).
+    pub contact_vertices: usize,
+    /// Vertices exactly on φ.
+    pub touching_vertices: usize,
+    /// Vertices above φ.
+    pub penetrating_vertices: usize,
+    /// Unknowns clear of the obstacle.
+    pub clear_vertices: usize,
+    /// Σ |Qᵢ|/3 over the vertices in contact.
+    pub contact_area: f64,
+    /// ∫ f.
+    pub total_load: f64,
+    /// Σ X₁.
+    pub total_contact_force: f64,
+    /// max |u|.
+    pub max_deflection: f64,
+    /// min u.
+    pub min_u: f64,
+    /// max u.
+    pub max_u: f64,
+    /// Energy and residual per iteration.
+    pub history: Vec<IterationRecord>,
+    /// The solver's phases, seconds.
+    pub solver_phases_s: BTreeMap<String, f64>,
+    /// Seconds reading or generating the mesh.
+    pub time_mesh_s: f64,
+    /// Seconds assembling S, L, D, φₙ.
+    pub time_assembly_s: f64,
+    /// Seconds solving.
+    pub time_solve_s: f64,
+    /// Seconds writing the outputs.
+    pub time_write_s: f64,
+    /// Seconds from start to end.
+    pub time_total_s: f64,
+    /// How the solve ended (`converged`, `iteration_limit`, `stalled`,
+    /// `numerical_failure`).
+    pub status: Status,
+    /// `status == converged`: files written with `false` hold an unconverged iterate.
+    pub converged: bool,
+    /// The method the case asked for (maybe `auto`).
+    pub requested_solver: String,
+    /// Why `solver` was used.
+    pub solver_choice: Choice,
+    /// The method `auto` tried first and gave up on.
+    pub fallback: Option<Fallback>,
+    /// What went wrong, for a numerical failure.
+    pub message: Option<String>,
+    /// A random identifier of this run, shared by the files of its result set.
+    pub run_id: String,
+    /// A hash of the case (XXH3-64 of its canonical JSON), to tell inputs apart.
+    pub input_hash: String,
+    /// The other files of the result set, by name.
+    pub files: BTreeMap<String, FileRecord>,
+}
+
+impl Summary {
+    /// The summary of `outcome` (`totals` from its fields, `quality` of its mesh); the write
+    /// time, total time, run identity and files are filled in by the writer.
+    pub fn new(case: &str, outcome: &Outcome, quality: &MeshQuality, totals: &Totals) -> Summary {
+        let r = &outcome.report;
+        let m = &outcome.discretization.model;
+        Summary {
+            case: case.to_string(),
+            vertices: quality.vertices,
+            triangles: quality.triangles,
+            unknowns: quality.unknowns,
+            levels: outcome.discretization.hierarchy.depth(),
+            l_n: quality.l_n,
+            s_n: quality.s_n,
+            min_angle_deg: quality.min_angle_deg,
+            area: quality.area,
+            solver: r.method.name().into(),
+            foundation: if m.is_rigid() {
+                "rigid".into()
+            } else {
+                m.foundation.name().into()
+            },
+            rigid: m.is_rigid(),
+            sampling: if m.epsilon.is_some() {
+                "mollified".into()
+            } else {
+                "nodal".into()
+            },
+            epsilon: m.epsilon,
+            tension: m.tension,
+            tolerance: r.tolerance,
+            iterations: r.iterations,
+            energy: r.energy,
+            kkt_residual: r.certificate.kkt(),
+            residual_2e: r.certificate.residual_2e,
+            residual_2f: r.certificate.residual_2f,
+            force_scale: r.certificate.force_scale,
+            can_touch_vertices: m.can_touch.iter().filter(|&&c| c).count(),
+            contact_vertices: totals.contact_vertices,
+            touching_vertices: totals.touching_vertices,
+            penetrating_vertices: totals.penetrating_vertices,
+            clear_vertices: totals.clear_vertices,
+            contact_area: totals.contact_area,
+            total_load: totals.total_load,
+            total_contact_force: totals.total_contact_force,
+            max_deflection: totals.max_deflection,
+            min_u: totals.min_u,
+            max_u: totals.max_u,
+            history: r.history.clone(),
+            solver_phases_s: r
+                .solver_phases
+                .iter()
+                .map(|p| (p.name.clone(), p.seconds))
+                .collect(),
+            time_mesh_s: r.seconds("mesh"),
+            time_assembly_s: r.seconds("assembly"),
+            time_solve_s: r.seconds("solve"),
+            time_write_s: 0.0,
+            time_total_s: 0.0,
+            status: r.status,
+            converged: r.status.is_converged(),
+            requested_solver: r.requested.name().into(),
+            solver_choice: r.choice,
+            fallback: r.fallback.clone(),
+            message: r.message.clone(),
+            run_id: String::new(),
+            input_hash: String::new(),
+            files: BTreeMap::new(),
+        }
+    }
+}
