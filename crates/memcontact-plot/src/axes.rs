@@ -169,12 +169,13 @@ pub fn colorbar(
     canvas.stroke_rect(bar.grow(1), FRAME);
     let size = text::fit(label, LABEL_SIZE, 10.0, width);
     let label = text::ellipsize_front(label, size, width);
+    let (_, th) = text::measure(&label, size);
     boxes.push(text::draw(
         canvas,
         &label,
         Style::new(size),
         bar.x0 as f64,
-        (bar.y0 - 10) as f64,
+        (bar.y0 - 14 - th / 2) as f64,
         Anchor::Left,
     ));
     if !(hi > lo) {
@@ -289,7 +290,7 @@ pub fn legend(
 }
 
 /// Spacing of the hatch lines of the contact zone, pixels (along x).
-pub const HATCH_SPACING: i32 = 9;
+pub const HATCH_SPACING: i32 = 11;
 /// The light line of the hatching.
 pub const HATCH_LIGHT: Rgb = [255, 255, 255];
 /// The dark line of the hatching.

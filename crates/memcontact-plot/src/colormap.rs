@@ -76,14 +76,27 @@ pub fn yellow_red() -> &'static Colormap {
     })
 }
 
-/// A diverging blue-white-red map (ColorBrewer RdBu reversed): for a ratio around 1.
-pub fn blue_red() -> &'static Colormap {
+/// The map of pressure / allowable (with [`Norm::centered`] at 1): pale yellow to red up
+/// to the allowable, then purple to nearly black above it, so that the exceeded area
+/// stands out by hue, not only by shade.
+pub fn ratio() -> &'static Colormap {
     static M: OnceLock<Colormap> = OnceLock::new();
     M.get_or_init(|| {
-        Colormap::from_knots(&hex(&[
-            "#053061", "#2166ac", "#4393c3", "#92c5de", "#d1e5f0", "#f7f7f7", "#fddbc7",
-            "#f4a582", "#d6604d", "#b2182b", "#67001f",
-        ]))
+        let lower = Colormap::from_knots(&hex(&[
+            "#ffffcc", "#ffeda0", "#fed976", "#feb24c", "#fd8d3c", "#fc4e2a", "#e31a1c",
+        ]));
+        let upper = Colormap::from_knots(&hex(&["#c51b8a", "#7a0177", "#49006a", "#20002e"]));
+        let half = (LUT_SIZE - 1) / 2;
+        let lut = (0..LUT_SIZE)
+            .map(|k| {
+                if k < half {
+                    lower.lut[k * (LUT_SIZE - 1) / half]
+                } else {
+                    upper.lut[(k - half) * (LUT_SIZE - 1) / half]
+                }
+            })
+            .collect();
+        Colormap { lut }
     })
 }
 
@@ -175,7 +188,10 @@ mod tests {
         assert_eq!(viridis().at(1.0), [0xfd, 0xe7, 0x25]);
         assert_eq!(viridis().at(-3.0), viridis().at(0.0));
         assert_eq!(viridis().at(f64::NAN), NAN_COLOR);
-        assert_eq!(blue_red().at(0.5), [0xf7, 0xf7, 0xf7]);
+        assert_eq!(ratio().at(0.0), [0xff, 0xff, 0xcc]);
+        assert_eq!(ratio().at(0.5), [0xc5, 0x1b, 0x8a]);
+        let below = ratio().at(0.499);
+        assert!(below[0] > 220 && below[2] < 40, "{below:?}");
         let n = Norm::centered(0.0, 3.0, 1.0);
         assert_eq!((n.t(0.0), n.t(1.0), n.t(3.0)), (0.0, 0.5, 1.0));
         assert_eq!(n.t(2.0), 0.75);

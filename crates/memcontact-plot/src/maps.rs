@@ -32,14 +32,22 @@ const BAR: PixelRect = PixelRect {
 };
 /// Left edge and width of the right-hand column (colour bar labels, legend).
 const COLUMN: (i32, i32) = (1075, 215);
-/// Contact outline colour.
-const OUTLINE: Rgb = [220, 20, 60];
+/// Contact outline colour (deflection and lift-off maps).
+pub const OUTLINE: Rgb = [220, 20, 60];
+/// Contact outline colour on the pressure map.
+pub const PRESSURE_OUTLINE: Rgb = [0, 70, 160];
+/// Fill of a penetrating vertex's marker.
+const PEN_MARK: Rgb = [255, 120, 0];
+/// Light marker colour (not the hatching's pure white).
+const MARK_LIGHT: Rgb = [250, 250, 250];
+/// Dark marker colour (not the hatching's pure black).
+const MARK_DARK: Rgb = [15, 15, 15];
 /// Contour line colour.
 const CONTOUR: Rgb = [25, 25, 25];
 /// Mesh boundary colour.
 const BOUNDARY: Rgb = [70, 70, 70];
 /// Below this mean vertex spacing (pixels), vertices get no marker.
-const MARKER_SPACING: f64 = 10.0;
+const MARKER_SPACING: f64 = 20.0;
 
 /// What the three map pictures share: where the mesh lies on the canvas and which
 /// triangle covers each pixel.
@@ -78,6 +86,16 @@ impl MapLayout {
         }
     }
 
+    /// The triangle whose interior holds the centre of canvas pixel `(x, y)`, if any.
+    pub fn triangle_at(&self, x: i32, y: i32) -> Option<u32> {
+        self.frags.index(x, y).map(|i| self.frags.tri[i]).filter(|&t| t != EMPTY)
+    }
+
+    /// Vertex positions on the canvas (pixel coordinates).
+    pub fn vertex_pixels(&self) -> &[[f64; 2]] {
+        &self.pv
+    }
+
     /// True when vertex markers are drawn (the mesh is coarse enough on the canvas).
     pub fn markers(&self) -> bool {
         self.vertex_spacing >= MARKER_SPACING
@@ -97,8 +115,11 @@ pub struct Picture {
     pub text_boxes: Vec<PixelRect>,
     /// Vertex markers were drawn (penetrating and touching vertices of the deflection map).
     pub markers: bool,
-    /// The colour bar's range (the data range of the mapped field), if there is a bar.
+    /// The colour bar's range (the data range of the mapped field), if there is a bar; for
+    /// the profile, the range of u and φ along the line.
     pub range: Option<(f64, f64)>,
+    /// For the profile: its axes (arc length × value → pixels).
+    pub axes: Option<Axes>,
 }
 
 /// Minimum and maximum of the finite values in `v` over the vertices where `keep` holds.
@@ -184,11 +205,10 @@ fn contours(
     (lo, hi): (f64, f64),
     count: usize,
     avoid: &[PixelRect],
-    boxes: &mut Vec<PixelRect>,
-) {
+) -> Vec<Label> {
     let levels = ticks::levels(lo, hi, count);
     if levels.is_empty() {
-        return;
+        return Vec::new();
     }
     let step = if levels.len() > 1 { levels[1] - levels[0] } else { ticks::nice_step(lo, hi, count + 1) };
     let segs: Vec<Vec<[[f64; 2]; 2]>> = levels
@@ -204,7 +224,7 @@ fn contours(
     let inner = l.frame.grow(-6);
     let diag = ((l.frame.width().pow(2) + l.frame.height().pow(2)) as f64).sqrt();
     let mut labels: Vec<Label> = Vec::new();
-    let size = 13.0;
+    let size = LABEL_TEXT;
     for (k, &c) in levels.iter().enumerate() {
         let s = &segs[k];
         if s.is_empty() {
@@ -257,13 +277,21 @@ fn contours(
         mask.clear(lab.rect);
     }
     canvas.composite(&mask, CONTOUR, 0.8);
-    for lab in &labels {
-        canvas.fill_rect(lab.rect, WHITE, 0.55);
+    labels
+}
+
+/// Draws contour labels (last, over outlines and markers).
+fn draw_labels(canvas: &mut Canvas, labels: &[Label], boxes: &mut Vec<PixelRect>) {
+    for lab in labels {
+        canvas.fill_rect(lab.rect, WHITE, 0.6);
         let cx = (lab.rect.x0 + lab.rect.x1) as f64 / 2.0;
         let cy = (lab.rect.y0 + lab.rect.y1) as f64 / 2.0;
-        boxes.push(text::draw(canvas, &lab.text, Style::new(size).color([10, 10, 10]), cx, cy, Anchor::Center));
+        boxes.push(text::draw(canvas, &lab.text, Style::new(LABEL_TEXT).color([10, 10, 10]), cx, cy, Anchor::Center));
     }
 }
+
+/// Size of contour labels, pixels.
+const LABEL_TEXT: f32 = 13.0;
 
 /// The common furniture: title, axes, colour bar.
 #[allow(clippy::too_many_arguments)]
@@ -329,11 +357,11 @@ pub(crate) fn render(kind: PlotKind, l: &MapLayout, data: &PlotData, options: &P
                 map.at(norm.t(f.interp(k, tris, data.u)))
             });
             draw_boundary(&mut canvas, l);
-            contours(&mut canvas, l, data, data.u, (lo, hi), 8, &[], &mut boxes);
+            let labels = contours(&mut canvas, l, data, data.u, (lo, hi), 8, &[]);
             outline(&mut canvas, OUTLINE, 2.6);
             markers = l.markers();
             if markers {
-                for (st, fillc, ring) in [(1i8, OUTLINE, WHITE), (0, WHITE, [0, 0, 0])] {
+                for (st, fillc, ring) in [(1i8, PEN_MARK, MARK_LIGHT), (0, MARK_LIGHT, MARK_DARK)] {
                     let mut outer = Coverage::new(canvas.width, canvas.height, l.frame);
                     let mut inner = Coverage::new(canvas.width, canvas.height, l.frame);
                     for i in (0..n).filter(|&i| data.state[i] == st) {
@@ -344,6 +372,7 @@ pub(crate) fn render(kind: PlotKind, l: &MapLayout, data: &PlotData, options: &P
                     canvas.composite(&inner, fillc, 1.0);
                 }
             }
+            draw_labels(&mut canvas, &labels, &mut boxes);
             let unit = options.units.length_suffix();
             furniture(&mut canvas, l, options, "Deflection u", Some((map, &norm, (lo, hi), format!("u{unit}"))), &mut boxes);
             let mut entries = vec![
@@ -352,8 +381,8 @@ pub(crate) fn render(kind: PlotKind, l: &MapLayout, data: &PlotData, options: &P
                 (Swatch::Hatch(false), "touching (u = φ)".to_string()),
             ];
             if markers {
-                entries.push((Swatch::Disc(OUTLINE, WHITE), "penetrating vertex".into()));
-                entries.push((Swatch::Disc(WHITE, [0, 0, 0]), "touching vertex".into()));
+                entries.push((Swatch::Disc(PEN_MARK, MARK_LIGHT), "penetrating vertex".into()));
+                entries.push((Swatch::Disc(MARK_LIGHT, MARK_DARK), "touching vertex".into()));
             }
             entries.push((Swatch::Line(CONTOUR, 1.0), "contour of u".into()));
             entries.extend(range_entries("u", (lo, hi)));
@@ -367,7 +396,8 @@ pub(crate) fn render(kind: PlotKind, l: &MapLayout, data: &PlotData, options: &P
                 Some(a) => {
                     field = data.pressure.par_iter().map(|p| p / a).collect();
                     let (lo, hi) = range(&field, |_| true).unwrap_or((0.0, 0.0));
-                    map = colormap::blue_red();
+                    // The hue changes at the allowable (ratio 1).
+                    map = colormap::ratio();
                     norm = Norm::centered(lo, hi, 1.0);
                     label = "pressure / allowable".into();
                 }
@@ -383,16 +413,26 @@ pub(crate) fn render(kind: PlotKind, l: &MapLayout, data: &PlotData, options: &P
             bar_range = Some((lo, hi));
             fill(&mut canvas, l, |k, _, _| map.at(norm.t(f.interp(k, tris, &field))));
             draw_boundary(&mut canvas, l);
-            contours(&mut canvas, l, data, &field, (lo, hi), 6, &[], &mut boxes);
-            outline(&mut canvas, [0, 70, 160], 2.0);
-            let mut entries = vec![(Swatch::Line([0, 70, 160], 2.0), "contact zone outline".to_string())];
+            let labels = contours(&mut canvas, l, data, &field, (lo, hi), 6, &[]);
+            outline(&mut canvas, PRESSURE_OUTLINE, 2.0);
+            let mut entries = vec![(Swatch::Line(PRESSURE_OUTLINE, 2.0), "contact zone outline".to_string())];
             if let Some(a) = options.allowable_pressure {
                 let m = level_mask(&canvas, l, data, &field, 1.0, 3.0, false);
                 canvas.composite(&m, [0, 0, 0], 1.0);
                 entries.push((Swatch::Line([0, 0, 0], 3.0), "pressure = allowable".into()));
-                entries.push((Swatch::None, format!("allowable {}{unit}", ticks::format_sig(a, 5))));
+                entries.push((
+                    Swatch::None,
+                    format!("allowable {}{}", ticks::format_sig(a, 5), unit.replace(['[', ']'], "")),
+                ));
                 let above = data.pressure.iter().filter(|&&p| p > a).count();
-                entries.push((Swatch::None, format!("{above} vertices above allowable")));
+                entries.push((
+                    Swatch::None,
+                    if above == 0 {
+                        "all below the allowable".to_string()
+                    } else {
+                        format!("{above} vertices above allowable")
+                    },
+                ));
                 entries.extend(range_entries("ratio", (lo, hi)));
                 let (plo, phi) = range(data.pressure, |_| true).unwrap_or((0.0, 0.0));
                 entries.push((Swatch::None, format!("pressure max {}", ticks::format_sig(phi.max(plo), 5))));
@@ -400,6 +440,7 @@ pub(crate) fn render(kind: PlotKind, l: &MapLayout, data: &PlotData, options: &P
                 entries.push((Swatch::Line(CONTOUR, 1.0), "contour of pressure".into()));
                 entries.extend(range_entries("pressure", (lo, hi)));
             }
+            draw_labels(&mut canvas, &labels, &mut boxes);
             furniture(&mut canvas, l, options, "Contact pressure", Some((map, &norm, (lo, hi), label)), &mut boxes);
             axes::legend(&mut canvas, COLUMN.0, legend_y, COLUMN.1, &entries, &mut boxes);
         }
@@ -467,6 +508,7 @@ pub(crate) fn render(kind: PlotKind, l: &MapLayout, data: &PlotData, options: &P
         text_boxes: boxes,
         markers,
         range: bar_range,
+        axes: None,
     })
 }
 

@@ -219,6 +219,7 @@ pub(crate) fn render(data: &PlotData, options: &PlotOptions) -> Result<Picture> 
         text_boxes: boxes,
         markers: false,
         range: Some((lo, hi)),
+        axes: Some(ax),
     })
 }
 
