@@ -3,7 +3,7 @@
 //! rigid-limit sweep. The numerics are in `memcontact::convergence`.
 
 use crate::case::{self, Case};
-use crate::plot;
+use memcontact_plot as plot;
 use anyhow::{anyhow, bail, Context, Result};
 use memcontact::convergence::{
     self as study, LevelResult, ManufacturedLoad, Study, StudySettings, Sweep, Target,

@@ -9,6 +9,7 @@ mod examples;
 mod help;
 mod output;
 mod plot;
+mod plot_cmd;
 
 use clap::{Parser, Subcommand};
 use std::path::PathBuf;
@@ -71,6 +72,9 @@ enum Command {
         #[arg(long)]
         phases: bool,
     },
+    /// Redraw the pictures of a result directory (deflection.png, pressure.png,
+    /// liftoff.png, profile.png) from its solution.vtu and summary.json, without solving.
+    Plot(plot_cmd::Args),
     /// List the example cases, or write one (and any mesh it needs) to a directory.
     Example {
         /// The example to write; omit to list them.
@@ -95,6 +99,7 @@ fn main() -> ExitCode {
         } => commands::solve(&case, &output, &sets, quiet),
         Command::Check { case, sets } => commands::check(&case, &sets),
         Command::Convergence(args) => convergence::run(&args),
+        Command::Plot(args) => plot_cmd::run(&args),
         Command::Example { name, dir, force } => examples::run(name.as_deref(), &dir, force),
         Command::Bench {
             sizes,

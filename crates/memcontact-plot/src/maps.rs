@@ -12,8 +12,9 @@ use crate::colormap::{self, Colormap, Norm};
 use crate::raster::{self, Fragments, MapTransform, EMPTY};
 use crate::text::{self, Anchor, Style};
 use crate::ticks;
-use crate::{PlotData, PlotKind, PlotOptions, MAP_HEIGHT, MAP_WIDTH};
-use memcontact::Result;
+use crate::{PlotData, PlotKind, PlotOptions, Units, MAP_HEIGHT, MAP_WIDTH};
+use memcontact::{Error, Result};
+use std::path::Path;
 use rayon::prelude::*;
 
 /// The area the map frame is fitted into.
@@ -68,14 +69,20 @@ pub struct MapLayout {
 }
 
 impl MapLayout {
-    /// Fits the mesh into the map area and rasterises it.
+    /// Fits the mesh of `data` into the map area and rasterises it.
     pub fn new(data: &PlotData) -> MapLayout {
-        let (transform, frame) = MapTransform::fit(data.bbox(), MAP_AREA);
-        let pv: Vec<[f64; 2]> = data.points.par_iter().map(|&p| transform.to_pixel(p)).collect();
-        let frags = raster::rasterise(&pv, data.triangles, frame);
-        let boundary = raster::boundary_edges(data.points.len(), data.triangles);
+        MapLayout::of(data.points, data.triangles, data.bbox())
+    }
+
+    /// Fits the triangles (bounding box `bbox`, `[xmin, xmax, ymin, ymax]`) into the map
+    /// area and rasterises them.
+    pub fn of(points: &[[f64; 2]], triangles: &[[u32; 3]], bbox: [f64; 4]) -> MapLayout {
+        let (transform, frame) = MapTransform::fit(bbox, MAP_AREA);
+        let pv: Vec<[f64; 2]> = points.par_iter().map(|&p| transform.to_pixel(p)).collect();
+        let frags = raster::rasterise(&pv, triangles, frame);
+        let boundary = raster::boundary_edges(points.len(), triangles);
         let covered = frags.covered() as f64;
-        let vertex_spacing = (covered / data.points.len().max(1) as f64).sqrt();
+        let vertex_spacing = (covered / points.len().max(1) as f64).sqrt();
         MapLayout {
             transform,
             frame,
@@ -173,8 +180,16 @@ fn draw_boundary(canvas: &mut Canvas, l: &MapLayout) {
 }
 
 /// The level line `values = level` as a coverage mask.
-fn level_mask(canvas: &Canvas, l: &MapLayout, data: &PlotData, values: &[f64], level: f64, width: f64, dashed: bool) -> Coverage {
-    let segs = raster::level_segments(&l.pv, data.triangles, values, level);
+fn level_mask(
+    canvas: &Canvas,
+    l: &MapLayout,
+    tris: &[[u32; 3]],
+    values: &[f64],
+    level: f64,
+    width: f64,
+    dashed: bool,
+) -> Coverage {
+    let segs = raster::level_segments(&l.pv, tris, values, level);
     let mut m = Coverage::new(canvas.width, canvas.height, l.frame);
     if dashed {
         // Dashes need a continuous arc length: chain the segments into polylines.
@@ -200,7 +215,7 @@ struct Label {
 fn contours(
     canvas: &mut Canvas,
     l: &MapLayout,
-    data: &PlotData,
+    tris: &[[u32; 3]],
     values: &[f64],
     (lo, hi): (f64, f64),
     count: usize,
@@ -213,7 +228,7 @@ fn contours(
     let step = if levels.len() > 1 { levels[1] - levels[0] } else { ticks::nice_step(lo, hi, count + 1) };
     let segs: Vec<Vec<[[f64; 2]; 2]>> = levels
         .iter()
-        .map(|&c| raster::level_segments(&l.pv, data.triangles, values, c))
+        .map(|&c| raster::level_segments(&l.pv, tris, values, c))
         .collect();
     let mut mask = Coverage::new(canvas.width, canvas.height, l.frame);
     for s in segs.iter().flatten() {
@@ -298,19 +313,15 @@ const LABEL_TEXT: f32 = 13.0;
 fn furniture(
     canvas: &mut Canvas,
     l: &MapLayout,
-    options: &PlotOptions,
-    name: &str,
+    units: &Units,
+    title: &str,
     bar: Option<(&Colormap, &Norm, (f64, f64), String)>,
     boxes: &mut Vec<PixelRect>,
 ) {
-    let title = match &options.title {
-        Some(t) if !t.is_empty() => format!("{name}: {t}"),
-        _ => name.to_string(),
-    };
-    axes::title(canvas, &title, 30.0, boxes);
+    axes::title(canvas, title, 30.0, boxes);
     let xr = (l.transform.x0, l.transform.x0 + l.frame.width() as f64 / l.transform.scale);
     let yr = (l.transform.y0, l.transform.y0 + l.frame.height() as f64 / l.transform.scale);
-    let unit = options.units.length_suffix();
+    let unit = units.length_suffix();
     Axes { rect: l.frame, x: xr, y: yr }.frame(canvas, &format!("x{unit}"), &format!("y{unit}"), boxes);
     if let Some((map, norm, r, label)) = bar {
         axes::colorbar(canvas, BAR, map, norm, r, &label, COLUMN.1, boxes);
@@ -334,7 +345,7 @@ pub(crate) fn render(kind: PlotKind, l: &MapLayout, data: &PlotData, options: &P
     let f = &l.frags;
     let contact = indicator(n, |i| data.state[i] >= 0);
     let outline = |canvas: &mut Canvas, color: Rgb, width: f64| {
-        let m = level_mask(canvas, l, data, &contact, 0.5, width, false);
+        let m = level_mask(canvas, l, tris, &contact, 0.5, width, false);
         canvas.composite(&m, color, 1.0);
     };
     let legend_y = BAR.y1 + 60;
@@ -357,7 +368,7 @@ pub(crate) fn render(kind: PlotKind, l: &MapLayout, data: &PlotData, options: &P
                 map.at(norm.t(f.interp(k, tris, data.u)))
             });
             draw_boundary(&mut canvas, l);
-            let labels = contours(&mut canvas, l, data, data.u, (lo, hi), 8, &[]);
+            let labels = contours(&mut canvas, l, tris, data.u, (lo, hi), 8, &[]);
             outline(&mut canvas, OUTLINE, 2.6);
             markers = l.markers();
             if markers {
@@ -374,7 +385,7 @@ pub(crate) fn render(kind: PlotKind, l: &MapLayout, data: &PlotData, options: &P
             }
             draw_labels(&mut canvas, &labels, &mut boxes);
             let unit = options.units.length_suffix();
-            furniture(&mut canvas, l, options, "Deflection u", Some((map, &norm, (lo, hi), format!("u{unit}"))), &mut boxes);
+            furniture(&mut canvas, l, &options.units, &titled("Deflection u", options), Some((map, &norm, (lo, hi), format!("u{unit}"))), &mut boxes);
             let mut entries = vec![
                 (Swatch::Line(OUTLINE, 2.6), "contact zone outline".to_string()),
                 (Swatch::Hatch(true), "penetrating (u > φ)".to_string()),
@@ -413,11 +424,11 @@ pub(crate) fn render(kind: PlotKind, l: &MapLayout, data: &PlotData, options: &P
             bar_range = Some((lo, hi));
             fill(&mut canvas, l, |k, _, _| map.at(norm.t(f.interp(k, tris, &field))));
             draw_boundary(&mut canvas, l);
-            let labels = contours(&mut canvas, l, data, &field, (lo, hi), 6, &[]);
+            let labels = contours(&mut canvas, l, tris, &field, (lo, hi), 6, &[]);
             outline(&mut canvas, PRESSURE_OUTLINE, 2.0);
             let mut entries = vec![(Swatch::Line(PRESSURE_OUTLINE, 2.0), "contact zone outline".to_string())];
             if let Some(a) = options.allowable_pressure {
-                let m = level_mask(&canvas, l, data, &field, 1.0, 3.0, false);
+                let m = level_mask(&canvas, l, tris, &field, 1.0, 3.0, false);
                 canvas.composite(&m, [0, 0, 0], 1.0);
                 entries.push((Swatch::Line([0, 0, 0], 3.0), "pressure = allowable".into()));
                 entries.push((
@@ -441,7 +452,7 @@ pub(crate) fn render(kind: PlotKind, l: &MapLayout, data: &PlotData, options: &P
                 entries.extend(range_entries("pressure", (lo, hi)));
             }
             draw_labels(&mut canvas, &labels, &mut boxes);
-            furniture(&mut canvas, l, options, "Contact pressure", Some((map, &norm, (lo, hi), label)), &mut boxes);
+            furniture(&mut canvas, l, &options.units, &titled("Contact pressure", options), Some((map, &norm, (lo, hi), label)), &mut boxes);
             axes::legend(&mut canvas, COLUMN.0, legend_y, COLUMN.1, &entries, &mut boxes);
         }
         PlotKind::Liftoff => {
@@ -469,13 +480,13 @@ pub(crate) fn render(kind: PlotKind, l: &MapLayout, data: &PlotData, options: &P
                 }
             });
             draw_boundary(&mut canvas, l);
-            let m = level_mask(&canvas, l, data, &covered, 0.5, 1.6, true);
+            let m = level_mask(&canvas, l, tris, &covered, 0.5, 1.6, true);
             canvas.composite(&m, [60, 60, 60], 1.0);
             outline(&mut canvas, OUTLINE, 2.4);
             bar_range = gr.map(|_| (glo, ghi));
             let unit = options.units.length_suffix();
             let bar = gr.map(|_| (map, &norm, (glo, ghi), format!("gap φ − u{unit}")));
-            furniture(&mut canvas, l, options, "Lift-off", bar, &mut boxes);
+            furniture(&mut canvas, l, &options.units, &titled("Lift-off", options), bar, &mut boxes);
             let areas = Areas::of(data);
             let pct = |a: f64| if areas.covered > 0.0 { 100.0 * a / areas.covered } else { 0.0 };
             let aunit = match &options.units.length {
@@ -554,4 +565,70 @@ impl Areas {
         }
         r
     }
+}
+
+/// `"<name>: <case>"`, or the name alone without a case title.
+pub(crate) fn titled(name: &str, options: &PlotOptions) -> String {
+    match &options.title {
+        Some(t) if !t.is_empty() => format!("{name}: {t}"),
+        _ => name.to_string(),
+    }
+}
+
+/// Writes a colour map of any nodal field over a triangle mesh as a
+/// [`MAP_WIDTH`] × [`MAP_HEIGHT`] PNG: smooth (P1-interpolated) viridis colours, labelled
+/// contour lines, the mesh boundary, axes of equal scale and a colour bar over the data
+/// range, titled `title`. For a quick look at a field the four standard pictures do not
+/// show. Errors: `values` not one per point, a triangle referring to a missing point, no
+/// finite value.
+pub fn field_plot(
+    path: &Path,
+    points: &[[f64; 2]],
+    triangles: &[[u32; 3]],
+    values: &[f64],
+    title: &str,
+) -> Result<()> {
+    if values.len() != points.len() {
+        return Err(Error::Data(format!(
+            "field plot {}: {} values for {} points",
+            path.display(),
+            values.len(),
+            points.len()
+        )));
+    }
+    if let Some((k, t)) = triangles.iter().enumerate().find(|(_, t)| t.iter().any(|&v| v as usize >= points.len())) {
+        return Err(Error::Data(format!(
+            "field plot {}: triangle {k} {t:?} refers to a missing point",
+            path.display()
+        )));
+    }
+    let Some((lo, hi)) = range(values, |_| true) else {
+        return Err(Error::Data(format!("field plot {}: no finite value", path.display())));
+    };
+    if triangles.is_empty() || points.iter().any(|p| !(p[0].is_finite() && p[1].is_finite())) {
+        return Err(Error::Data(format!(
+            "field plot {}: the mesh has no triangle or a non-finite coordinate",
+            path.display()
+        )));
+    }
+    let mut b = [f64::INFINITY, f64::NEG_INFINITY, f64::INFINITY, f64::NEG_INFINITY];
+    for p in points {
+        b = [b[0].min(p[0]), b[1].max(p[0]), b[2].min(p[1]), b[3].max(p[1])];
+    }
+    let (bx, by) = (crate::colormap::widen(b[0], b[1]), crate::colormap::widen(b[2], b[3]));
+    let l = MapLayout::of(points, triangles, [bx.0, bx.1, by.0, by.1]);
+    let mut canvas = Canvas::new(MAP_WIDTH, MAP_HEIGHT);
+    let mut boxes = Vec::new();
+    let norm = Norm::linear(lo, hi);
+    let map = colormap::viridis();
+    let f = &l.frags;
+    fill(&mut canvas, &l, |k, _, _| map.at(norm.t(f.interp(k, triangles, values))));
+    draw_boundary(&mut canvas, &l);
+    let labels = contours(&mut canvas, &l, triangles, values, (lo, hi), 8, &[]);
+    draw_labels(&mut canvas, &labels, &mut boxes);
+    let units = Units::default();
+    furniture(&mut canvas, &l, &units, title, Some((map, &norm, (lo, hi), "value".into())), &mut boxes);
+    let entries = range_entries("value", (lo, hi));
+    axes::legend(&mut canvas, COLUMN.0, BAR.y1 + 60, COLUMN.1, &entries, &mut boxes);
+    canvas.write_png(path)
 }
