@@ -309,6 +309,17 @@ pub fn render(data: &PlotData, options: &PlotOptions) -> Result<Vec<Picture>> {
         .collect()
 }
 
+/// Draws one picture in memory on a layout made once by [`MapLayout::new`] (maps share it;
+/// the profile does not use it): for callers that time or reuse the pieces.
+pub fn render_kind(kind: PlotKind, layout: &MapLayout, data: &PlotData, options: &PlotOptions) -> Result<Picture> {
+    data.validate()?;
+    options.validate()?;
+    match kind {
+        PlotKind::Profile => profile::render(data, options),
+        k => maps::render(k, layout, data, options),
+    }
+}
+
 /// Draws the pictures `options.plots` into `dir` (`deflection.png`, `pressure.png`,
 /// `liftoff.png`, `profile.png`), each written atomically; returns the files written.
 pub fn draw_all(dir: &Path, data: &PlotData, options: &PlotOptions) -> Result<Vec<PathBuf>> {

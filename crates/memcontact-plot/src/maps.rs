@@ -226,10 +226,7 @@ fn contours(
         return Vec::new();
     }
     let step = if levels.len() > 1 { levels[1] - levels[0] } else { ticks::nice_step(lo, hi, count + 1) };
-    let segs: Vec<Vec<[[f64; 2]; 2]>> = levels
-        .iter()
-        .map(|&c| raster::level_segments(&l.pv, tris, values, c))
-        .collect();
+    let segs = raster::level_sets(&l.pv, tris, values, &levels);
     let mut mask = Coverage::new(canvas.width, canvas.height, l.frame);
     for s in segs.iter().flatten() {
         mask.segment(s[0], s[1], 1.0);

@@ -257,40 +257,56 @@ pub fn level_segments(
     values: &[f64],
     level: f64,
 ) -> Vec<[[f64; 2]; 2]> {
-    let chunks: Vec<Vec<[[f64; 2]; 2]>> = triangles
+    level_sets(pv, triangles, values, &[level]).pop().unwrap_or_default()
+}
+
+/// [`level_segments`] for several levels in one pass over the triangles: one list of
+/// segments per level.
+pub fn level_sets(
+    pv: &[[f64; 2]],
+    triangles: &[[u32; 3]],
+    values: &[f64],
+    levels: &[f64],
+) -> Vec<Vec<[[f64; 2]; 2]>> {
+    let chunks: Vec<Vec<Vec<[[f64; 2]; 2]>>> = triangles
         .par_chunks(1 << 15)
         .map(|chunk| {
-            let mut out = Vec::new();
+            let mut out = vec![Vec::new(); levels.len()];
             for t in chunk {
                 let f = t.map(|v| values[v as usize]);
                 if !f.iter().all(|x| x.is_finite()) {
                     continue;
                 }
-                let above = f.map(|x| x >= level);
-                if above[0] == above[1] && above[1] == above[2] {
-                    continue;
-                }
-                let mut pts = [[0.0; 2]; 2];
-                let mut k = 0;
-                for e in 0..3 {
-                    let (a, b) = (t[e], t[(e + 1) % 3]);
-                    if above[e] != above[(e + 1) % 3] {
-                        let (a, b) = if a < b { (a, b) } else { (b, a) };
-                        let (fa, fb) = (values[a as usize], values[b as usize]);
-                        let s = (level - fa) / (fb - fa);
-                        let (pa, pb) = (pv[a as usize], pv[b as usize]);
-                        if k < 2 {
-                            pts[k] = [pa[0] + s * (pb[0] - pa[0]), pa[1] + s * (pb[1] - pa[1])];
-                        }
-                        k += 1;
+                let lo = f[0].min(f[1]).min(f[2]);
+                let hi = f[0].max(f[1]).max(f[2]);
+                for (k, &level) in levels.iter().enumerate() {
+                    // Mixed iff some vertex is below and some at or above.
+                    if !(lo < level && hi >= level) {
+                        continue;
                     }
+                    let above = f.map(|x| x >= level);
+                    let mut pts = [[0.0; 2]; 2];
+                    let mut n = 0;
+                    for e in 0..3 {
+                        if above[e] != above[(e + 1) % 3] && n < 2 {
+                            let (a, b) = (t[e], t[(e + 1) % 3]);
+                            let (a, b) = if a < b { (a, b) } else { (b, a) };
+                            let (fa, fb) = (values[a as usize], values[b as usize]);
+                            let s = (level - fa) / (fb - fa);
+                            let (pa, pb) = (pv[a as usize], pv[b as usize]);
+                            pts[n] = [pa[0] + s * (pb[0] - pa[0]), pa[1] + s * (pb[1] - pa[1])];
+                            n += 1;
+                        }
+                    }
+                    out[k].push(pts);
                 }
-                out.push(pts);
             }
             out
         })
         .collect();
-    chunks.concat()
+    (0..levels.len())
+        .map(|k| chunks.iter().flat_map(|c| c[k].iter().copied()).collect())
+        .collect()
 }
 
 /// Chains segments that share end points (exactly, as [`level_segments`] makes them) into
@@ -336,8 +352,12 @@ pub fn chain(segs: &[[[f64; 2]; 2]]) -> Vec<Vec<[f64; 2]>> {
 
 /// The boundary edges of a triangle list (edges of exactly one triangle), in triangle
 /// order: the outer boundary and the holes.
+///
+/// Each vertex lists the far ends of the edges its triangles leave it by (`a → b` for the
+/// triangle edges in their own orientation); `a → b` is interior when `b → a` is listed
+/// at `b` (the neighbour, consistently oriented) or `a → b` twice at `a` (a neighbour of
+/// the opposite orientation).
 pub fn boundary_edges(n_vertices: usize, triangles: &[[u32; 3]]) -> Vec<[u32; 2]> {
-    // Vertex → triangles, compressed.
     let mut start = vec![0u32; n_vertices + 1];
     for t in triangles {
         for &v in t {
@@ -348,31 +368,30 @@ pub fn boundary_edges(n_vertices: usize, triangles: &[[u32; 3]]) -> Vec<[u32; 2]
         start[v + 1] += start[v];
     }
     let mut fill = start.clone();
-    let mut around = vec![0u32; start[n_vertices] as usize];
-    for (k, t) in triangles.iter().enumerate() {
-        for &v in t {
-            around[fill[v as usize] as usize] = k as u32;
-            fill[v as usize] += 1;
+    let mut next = vec![0u32; start[n_vertices] as usize];
+    for t in triangles {
+        for e in 0..3 {
+            let a = t[e] as usize;
+            next[fill[a] as usize] = t[(e + 1) % 3];
+            fill[a] += 1;
         }
     }
+    let out = |v: u32| &next[start[v as usize] as usize..start[v as usize + 1] as usize];
     let chunks: Vec<Vec<[u32; 2]>> = triangles
         .par_chunks(1 << 15)
-        .enumerate()
-        .map(|(c, chunk)| {
-            let mut out = Vec::new();
-            for (k, t) in chunk.iter().enumerate() {
-                let k = (c << 15) + k;
+        .map(|chunk| {
+            let mut found = Vec::new();
+            for t in chunk {
                 for e in 0..3 {
                     let (a, b) = (t[e], t[(e + 1) % 3]);
-                    let shared = around[start[a as usize] as usize..start[a as usize + 1] as usize]
-                        .iter()
-                        .any(|&o| o as usize != k && triangles[o as usize].contains(&b));
-                    if !shared {
-                        out.push([a, b]);
+                    let interior =
+                        out(b).contains(&a) || out(a).iter().filter(|&&x| x == b).count() > 1;
+                    if !interior {
+                        found.push([a, b]);
                     }
                 }
             }
-            out
+            found
         })
         .collect();
     chunks.concat()
