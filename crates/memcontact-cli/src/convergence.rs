@@ -3,7 +3,6 @@
 //! rigid-limit sweep. The numerics are in `memcontact::convergence`.
 
 use crate::case::{self, Case};
-use memcontact_plot as plot;
 use anyhow::{anyhow, bail, Context, Result};
 use memcontact::convergence::{
     self as study, LevelResult, ManufacturedLoad, Study, StudySettings, Sweep, Target,
@@ -15,6 +14,7 @@ use memcontact::io::vtu::DataArray;
 use memcontact::mesh::refine::Hierarchy;
 use memcontact::mesh::Mesh;
 use memcontact::model::{Foundation, ProblemData, Sampling, Stiffness};
+use memcontact_plot as plot;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 

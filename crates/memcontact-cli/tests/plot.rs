@@ -16,7 +16,13 @@ fn png_size(path: &std::path::Path) -> (u32, u32) {
 fn plot_redraws_a_result_directory() {
     let dir = tmp_in("plot", "disk");
     let case = examples().join("disk.toml");
-    let o = run(&["solve", case.to_str().unwrap(), "-o", dir.to_str().unwrap(), "-q"]);
+    let o = run(&[
+        "solve",
+        case.to_str().unwrap(),
+        "-o",
+        dir.to_str().unwrap(),
+        "-q",
+    ]);
     assert!(o.status.success(), "{}", text(&o));
     let _ = std::fs::remove_file(dir.join("deflection.png"));
     let o = run(&["plot", dir.to_str().unwrap()]);
@@ -24,7 +30,10 @@ fn plot_redraws_a_result_directory() {
     for name in ["deflection", "pressure", "liftoff", "profile"] {
         let f = dir.join(format!("{name}.png"));
         let want = if name == "profile" {
-            (memcontact_plot::PROFILE_WIDTH, memcontact_plot::PROFILE_HEIGHT)
+            (
+                memcontact_plot::PROFILE_WIDTH,
+                memcontact_plot::PROFILE_HEIGHT,
+            )
         } else {
             (memcontact_plot::MAP_WIDTH, memcontact_plot::MAP_HEIGHT)
         };
@@ -37,11 +46,24 @@ fn plot_redraws_a_result_directory() {
     std::fs::remove_file(dir.join("profile.png")).unwrap();
     let o = run(&["plot", dir.to_str().unwrap(), "--plots", "pressure"]);
     assert!(o.status.success(), "{}", text(&o));
-    assert_eq!(std::fs::read(dir.join("pressure.png")).unwrap(), first, "same picture again");
+    assert_eq!(
+        std::fs::read(dir.join("pressure.png")).unwrap(),
+        first,
+        "same picture again"
+    );
     assert!(!dir.join("profile.png").exists());
-    let o = run(&["plot", dir.to_str().unwrap(), "--plots", "pressure,contours"]);
+    let o = run(&[
+        "plot",
+        dir.to_str().unwrap(),
+        "--plots",
+        "pressure,contours",
+    ]);
     assert!(!o.status.success());
-    assert!(text(&o).contains("unknown plot \"contours\""), "{}", text(&o));
+    assert!(
+        text(&o).contains("unknown plot \"contours\""),
+        "{}",
+        text(&o)
+    );
     // Not a result directory: the missing file is named.
     let empty = tmp_in("plot", "empty");
     let o = run(&["plot", empty.to_str().unwrap()]);

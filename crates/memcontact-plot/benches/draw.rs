@@ -11,20 +11,50 @@ use memcontact_plot::{draw_all, render_kind, MapLayout, PlotData, PlotKind, Plot
 use std::time::Instant;
 
 fn main() {
-    let n: usize = std::env::var("MEMCONTACT_PLOT_N").ok().and_then(|v| v.parse().ok()).unwrap_or(1024);
-    let spec = RectangleSpec { x0: 0.0, y0: 0.0, x1: 1.0, y1: 1.0, nx: n, ny: n, diagonal: Diagonal::Right };
+    let n: usize = std::env::var("MEMCONTACT_PLOT_N")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(1024);
+    let spec = RectangleSpec {
+        x0: 0.0,
+        y0: 0.0,
+        x1: 1.0,
+        y1: 1.0,
+        nx: n,
+        ny: n,
+        diagonal: Diagonal::Right,
+    };
     let mesh = rectangle(&spec).expect("mesh").finest().clone();
     let pts = &mesh.points;
-    let u: Vec<f64> = pts.iter().map(|p| 8.0 * p[0] * (1.0 - p[0]) * p[1] * (1.0 - p[1]) * (1.0 + 0.3 * p[0])).collect();
-    let phi: Vec<f64> = pts.iter().map(|p| 0.35 + 0.1 * p[0] * p[1] + 0.02 * (9.0 * p[0]).sin()).collect();
+    let u: Vec<f64> = pts
+        .iter()
+        .map(|p| 8.0 * p[0] * (1.0 - p[0]) * p[1] * (1.0 - p[1]) * (1.0 + 0.3 * p[0]))
+        .collect();
+    let phi: Vec<f64> = pts
+        .iter()
+        .map(|p| 0.35 + 0.1 * p[0] * p[1] + 0.02 * (9.0 * p[0]).sin())
+        .collect();
     let covered: Vec<bool> = pts.iter().map(|p| p[0] < 0.92).collect();
     let state: Vec<i8> = u
         .iter()
         .zip(&phi)
         .zip(&covered)
-        .map(|((u, f), &c)| if !c || u < f { -1 } else if u == f { 0 } else { 1 })
+        .map(|((u, f), &c)| {
+            if !c || u < f {
+                -1
+            } else if u == f {
+                0
+            } else {
+                1
+            }
+        })
         .collect();
-    let pressure: Vec<f64> = u.iter().zip(&phi).zip(&covered).map(|((u, f), &c)| if c { 300.0 * (u - f).max(0.0) } else { 0.0 }).collect();
+    let pressure: Vec<f64> = u
+        .iter()
+        .zip(&phi)
+        .zip(&covered)
+        .map(|((u, f), &c)| if c { 300.0 * (u - f).max(0.0) } else { 0.0 })
+        .collect();
     let data = PlotData {
         points: pts,
         triangles: &mesh.triangles,
@@ -37,7 +67,10 @@ fn main() {
     let options = PlotOptions {
         title: Some(format!("synthetic square N = {n}")),
         allowable_pressure: Some(12.0),
-        units: Units { length: Some("m".into()), force: Some("kN".into()) },
+        units: Units {
+            length: Some("m".into()),
+            force: Some("kN".into()),
+        },
         ..PlotOptions::default()
     };
     println!(
@@ -64,19 +97,35 @@ fn main() {
         use memcontact_plot::raster;
         let pv = layout.vertex_pixels().to_vec();
         let frame = layout.frame;
-        println!("{:<28} {:>8.3} s", "  rasterise", best(&mut || {
-            std::hint::black_box(raster::rasterise(&pv, data.triangles, frame));
-        }));
-        println!("{:<28} {:>8.3} s", "  boundary edges", best(&mut || {
-            std::hint::black_box(raster::boundary_edges(pts.len(), data.triangles));
-        }));
-        println!("{:<28} {:>8.3} s", "  one level line of u", best(&mut || {
-            std::hint::black_box(raster::level_segments(&pv, data.triangles, &u, 0.3));
-        }));
+        println!(
+            "{:<28} {:>8.3} s",
+            "  rasterise",
+            best(&mut || {
+                std::hint::black_box(raster::rasterise(&pv, data.triangles, frame));
+            })
+        );
+        println!(
+            "{:<28} {:>8.3} s",
+            "  boundary edges",
+            best(&mut || {
+                std::hint::black_box(raster::boundary_edges(pts.len(), data.triangles));
+            })
+        );
+        println!(
+            "{:<28} {:>8.3} s",
+            "  one level line of u",
+            best(&mut || {
+                std::hint::black_box(raster::level_segments(&pv, data.triangles, &u, 0.3));
+            })
+        );
     }
-    println!("{:<28} {:>8.3} s", "layout (raster + boundary)", best(&mut || {
-        std::hint::black_box(MapLayout::new(&data));
-    }));
+    println!(
+        "{:<28} {:>8.3} s",
+        "layout (raster + boundary)",
+        best(&mut || {
+            std::hint::black_box(MapLayout::new(&data));
+        })
+    );
     let mut total = 0.0;
     for kind in PlotKind::ALL {
         let t = best(&mut || {
@@ -87,7 +136,13 @@ fn main() {
             std::hint::black_box(pic.canvas.encode_png().expect("png"));
         });
         let size = pic.canvas.encode_png().expect("png").len();
-        println!("{:<28} {:>8.3} s   PNG {:.3} s, {:.0} kB", format!("{}.png", kind.name()), t, e, size as f64 / 1e3);
+        println!(
+            "{:<28} {:>8.3} s   PNG {:.3} s, {:.0} kB",
+            format!("{}.png", kind.name()),
+            t,
+            e,
+            size as f64 / 1e3
+        );
         total += t + e;
     }
     println!("{:<28} {:>8.3} s", "sum (sequential)", total);
@@ -106,7 +161,10 @@ fn main() {
     );
     if let Ok(keep) = std::env::var("MEMCONTACT_KEEP_PLOTS") {
         for f in files {
-            let to = std::path::Path::new(&keep).join(format!("bench-{}", f.file_name().unwrap().to_string_lossy()));
+            let to = std::path::Path::new(&keep).join(format!(
+                "bench-{}",
+                f.file_name().unwrap().to_string_lossy()
+            ));
             std::fs::copy(&f, to).expect("copy");
         }
     }
@@ -114,7 +172,9 @@ fn main() {
 
 /// User + system CPU seconds of this process (Linux `/proc/self/stat`; 0 elsewhere).
 fn cpu_seconds() -> f64 {
-    let Ok(stat) = std::fs::read_to_string("/proc/self/stat") else { return 0.0 };
+    let Ok(stat) = std::fs::read_to_string("/proc/self/stat") else {
+        return 0.0;
+    };
     let after = stat.rsplit(')').next().unwrap_or("");
     let f: Vec<&str> = after.split_whitespace().collect();
     let tick = |i: usize| f.get(i).and_then(|v| v.parse::<f64>().ok()).unwrap_or(0.0);

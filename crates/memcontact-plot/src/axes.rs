@@ -42,7 +42,8 @@ impl Axes {
         let mut count = (self.rect.width() / 80).max(2) as usize;
         loop {
             let (t, step) = ticks::ticks(self.x.0, self.x.1, count);
-            let labels: Vec<(f64, String)> = t.iter().map(|&v| (v, ticks::format(v, step))).collect();
+            let labels: Vec<(f64, String)> =
+                t.iter().map(|&v| (v, ticks::format(v, step))).collect();
             let boxes: Vec<PixelRect> = labels
                 .iter()
                 .map(|(v, s)| text::text_box(s, TICK_SIZE, self.px(*v), 0.0, Anchor::Top).grow(6))
@@ -60,7 +61,8 @@ impl Axes {
         let mut count = (self.rect.height() / 55).max(2) as usize;
         loop {
             let (t, step) = ticks::ticks(self.y.0, self.y.1, count);
-            let labels: Vec<(f64, String)> = t.iter().map(|&v| (v, ticks::format(v, step))).collect();
+            let labels: Vec<(f64, String)> =
+                t.iter().map(|&v| (v, ticks::format(v, step))).collect();
             let boxes: Vec<PixelRect> = labels
                 .iter()
                 .map(|(v, s)| text::text_box(s, TICK_SIZE, 0.0, self.py(*v), Anchor::Right).grow(4))
@@ -77,16 +79,30 @@ impl Axes {
     pub fn grid(&self, canvas: &mut Canvas) {
         for (v, _) in self.x_ticks() {
             let x = self.px(v).floor() as i32;
-            canvas.fill_rect(PixelRect::new(x, self.rect.y0, 1, self.rect.height()), GRID, 1.0);
+            canvas.fill_rect(
+                PixelRect::new(x, self.rect.y0, 1, self.rect.height()),
+                GRID,
+                1.0,
+            );
         }
         for (v, _) in self.y_ticks() {
             let y = self.py(v).floor() as i32;
-            canvas.fill_rect(PixelRect::new(self.rect.x0, y, self.rect.width(), 1), GRID, 1.0);
+            canvas.fill_rect(
+                PixelRect::new(self.rect.x0, y, self.rect.width(), 1),
+                GRID,
+                1.0,
+            );
         }
     }
 
     /// The frame, ticks, tick labels and axis titles; every text box is added to `boxes`.
-    pub fn frame(&self, canvas: &mut Canvas, x_label: &str, y_label: &str, boxes: &mut Vec<PixelRect>) {
+    pub fn frame(
+        &self,
+        canvas: &mut Canvas,
+        x_label: &str,
+        y_label: &str,
+        boxes: &mut Vec<PixelRect>,
+    ) {
         let r = self.rect;
         canvas.stroke_rect(r.grow(1), FRAME);
         let style = Style::new(TICK_SIZE);
@@ -94,7 +110,14 @@ impl Axes {
         for (v, s) in self.x_ticks() {
             let x = self.px(v).floor() as i32;
             canvas.fill_rect(PixelRect::new(x, r.y1 + 1, 1, 6), FRAME, 1.0);
-            let b = text::draw(canvas, &s, style, x as f64 + 0.5, (r.y1 + 9) as f64, Anchor::Top);
+            let b = text::draw(
+                canvas,
+                &s,
+                style,
+                x as f64 + 0.5,
+                (r.y1 + 9) as f64,
+                Anchor::Top,
+            );
             bottom = bottom.max(b.y1);
             boxes.push(b);
         }
@@ -102,7 +125,14 @@ impl Axes {
         for (v, s) in self.y_ticks() {
             let y = self.py(v).floor() as i32;
             canvas.fill_rect(PixelRect::new(r.x0 - 7, y, 6, 1), FRAME, 1.0);
-            let b = text::draw(canvas, &s, style, (r.x0 - 10) as f64, y as f64 + 0.5, Anchor::Right);
+            let b = text::draw(
+                canvas,
+                &s,
+                style,
+                (r.x0 - 10) as f64,
+                y as f64 + 0.5,
+                Anchor::Right,
+            );
             left = left.min(b.x0);
             boxes.push(b);
         }
@@ -178,7 +208,7 @@ pub fn colorbar(
         (bar.y0 - 14 - th / 2) as f64,
         Anchor::Left,
     ));
-    if !(hi > lo) {
+    if hi.partial_cmp(&lo) != Some(std::cmp::Ordering::Greater) {
         return;
     }
     let py = |v: f64| bar.y1 as f64 - (v - lo) / (hi - lo) * h as f64;
@@ -245,7 +275,10 @@ pub fn legend(
         match *sw {
             Swatch::Line(c, w) | Swatch::Dashed(c, w) => {
                 let mut m = Coverage::new(canvas.width, canvas.height, sr.grow(2));
-                let pts = [[sx as f64, cy as f64 + 0.5], [(sx + 26) as f64, cy as f64 + 0.5]];
+                let pts = [
+                    [sx as f64, cy as f64 + 0.5],
+                    [(sx + 26) as f64, cy as f64 + 0.5],
+                ];
                 if matches!(sw, Swatch::Dashed(..)) {
                     m.dashed(&pts, w, 6.0, 4.0);
                 } else {
@@ -279,11 +312,22 @@ pub fn legend(
             }
             Swatch::None => {}
         }
-        let tx = if matches!(sw, Swatch::None) { x } else { x + 34 };
+        let tx = if matches!(sw, Swatch::None) {
+            x
+        } else {
+            x + 34
+        };
         let avail = width - (tx - x);
         let s = text::fit(label, size, 10.0, avail);
         let label = text::ellipsize_front(label, s, avail);
-        boxes.push(text::draw(canvas, &label, Style::new(s), tx as f64, cy as f64, Anchor::Left));
+        boxes.push(text::draw(
+            canvas,
+            &label,
+            Style::new(s),
+            tx as f64,
+            cy as f64,
+            Anchor::Left,
+        ));
         y += line_h;
     }
     y

@@ -295,7 +295,12 @@ impl Coverage {
                 };
                 let b = (a + left).min(len);
                 if on {
-                    let at = |t: f64| [p[0] + (q[0] - p[0]) * t / len, p[1] + (q[1] - p[1]) * t / len];
+                    let at = |t: f64| {
+                        [
+                            p[0] + (q[0] - p[0]) * t / len,
+                            p[1] + (q[1] - p[1]) * t / len,
+                        ]
+                    };
                     self.segment(at(a), at(b), width);
                 }
                 a = b;

@@ -58,8 +58,8 @@ pub fn viridis() -> &'static Colormap {
     static M: OnceLock<Colormap> = OnceLock::new();
     M.get_or_init(|| {
         Colormap::from_knots(&hex(&[
-            "#440154", "#482475", "#414487", "#355f8d", "#2a788e", "#21918c", "#22a884",
-            "#44bf70", "#7ad151", "#bddf26", "#fde725",
+            "#440154", "#482475", "#414487", "#355f8d", "#2a788e", "#21918c", "#22a884", "#44bf70",
+            "#7ad151", "#bddf26", "#fde725",
         ]))
     })
 }
@@ -70,8 +70,8 @@ pub fn yellow_red() -> &'static Colormap {
     static M: OnceLock<Colormap> = OnceLock::new();
     M.get_or_init(|| {
         Colormap::from_knots(&hex(&[
-            "#ffffcc", "#ffeda0", "#fed976", "#feb24c", "#fd8d3c", "#fc4e2a", "#e31a1c",
-            "#bd0026", "#800026",
+            "#ffffcc", "#ffeda0", "#fed976", "#feb24c", "#fd8d3c", "#fc4e2a", "#e31a1c", "#bd0026",
+            "#800026",
         ]))
     })
 }
@@ -106,8 +106,7 @@ pub fn blues() -> &'static Colormap {
     static M: OnceLock<Colormap> = OnceLock::new();
     M.get_or_init(|| {
         Colormap::from_knots(&hex(&[
-            "#deebf7", "#c6dbef", "#9ecae1", "#6baed6", "#4292c6", "#2171b5", "#08519c",
-            "#08306b",
+            "#deebf7", "#c6dbef", "#9ecae1", "#6baed6", "#4292c6", "#2171b5", "#08519c", "#08306b",
         ]))
     })
 }

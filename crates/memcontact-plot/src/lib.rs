@@ -34,10 +34,10 @@ pub mod text;
 pub mod ticks;
 pub mod vtu;
 
+pub use axes::{hatch_color, HATCH_SPACING};
 pub use canvas::{Canvas, PixelRect};
 pub use lines::{line_plot, LinePlot, Series};
 pub use loglog::loglog_plot;
-pub use axes::{hatch_color, HATCH_SPACING};
 pub use maps::{field_plot, MapLayout, Picture, CONTACT, NOT_COVERED, OUTLINE, PRESSURE_OUTLINE};
 pub use raster::MapTransform;
 
@@ -260,8 +260,14 @@ impl PlotData<'_> {
                 "plot: triangle {k} {t:?} refers to a vertex beyond the {n} vertices"
             )));
         }
-        if let Some(i) = self.points.iter().position(|p| !(p[0].is_finite() && p[1].is_finite())) {
-            return Err(Error::Data(format!("plot: vertex {i} has a non-finite coordinate")));
+        if let Some(i) = self
+            .points
+            .iter()
+            .position(|p| !(p[0].is_finite() && p[1].is_finite()))
+        {
+            return Err(Error::Data(format!(
+                "plot: vertex {i} has a non-finite coordinate"
+            )));
         }
         if let Some(i) = self.state.iter().position(|s| !(-1..=1).contains(s)) {
             return Err(Error::Data(format!(
@@ -277,15 +283,25 @@ impl PlotData<'_> {
 
     /// The bounding box `[xmin, xmax, ymin, ymax]` of the triangles' vertices.
     pub fn bbox(&self) -> [f64; 4] {
-        let mut b = [f64::INFINITY, f64::NEG_INFINITY, f64::INFINITY, f64::NEG_INFINITY];
+        let mut b = [
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+        ];
         for p in self.points {
-            b = [b[0].min(p[0]), b[1].max(p[0]), b[2].min(p[1]), b[3].max(p[1])];
+            b = [
+                b[0].min(p[0]),
+                b[1].max(p[0]),
+                b[2].min(p[1]),
+                b[3].max(p[1]),
+            ];
         }
-        if !(b[1] > b[0]) {
+        if b[1].partial_cmp(&b[0]) != Some(std::cmp::Ordering::Greater) {
             b[0] -= 0.5;
             b[1] += 0.5;
         }
-        if !(b[3] > b[2]) {
+        if b[3].partial_cmp(&b[2]) != Some(std::cmp::Ordering::Greater) {
             b[2] -= 0.5;
             b[3] += 0.5;
         }
@@ -311,7 +327,12 @@ pub fn render(data: &PlotData, options: &PlotOptions) -> Result<Vec<Picture>> {
 
 /// Draws one picture in memory on a layout made once by [`MapLayout::new`] (maps share it;
 /// the profile does not use it): for callers that time or reuse the pieces.
-pub fn render_kind(kind: PlotKind, layout: &MapLayout, data: &PlotData, options: &PlotOptions) -> Result<Picture> {
+pub fn render_kind(
+    kind: PlotKind,
+    layout: &MapLayout,
+    data: &PlotData,
+    options: &PlotOptions,
+) -> Result<Picture> {
     data.validate()?;
     options.validate()?;
     match kind {

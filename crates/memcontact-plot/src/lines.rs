@@ -64,7 +64,11 @@ fn marker(m: &mut Coverage, kind: Marker, c: [f64; 2], r: f64) {
             let y0 = (c[1] - r).round() as i32;
             let s = (2.0 * r).round() as i32;
             for y in y0..y0 + s {
-                m.segment([x0 as f64, y as f64 + 0.5], [(x0 + s) as f64, y as f64 + 0.5], 1.0);
+                m.segment(
+                    [x0 as f64, y as f64 + 0.5],
+                    [(x0 + s) as f64, y as f64 + 0.5],
+                    1.0,
+                );
             }
         }
         Marker::Diamond => {
@@ -96,7 +100,11 @@ pub fn render_line_plot(plot: &LinePlot) -> Result<Canvas> {
         )));
     }
     let fold = |f: fn(&(f64, f64)) -> f64| {
-        pts.iter().map(f).fold((f64::INFINITY, f64::NEG_INFINITY), |a, v| (a.0.min(v), a.1.max(v)))
+        pts.iter()
+            .map(f)
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |a, v| {
+                (a.0.min(v), a.1.max(v))
+            })
     };
     let pad = |(lo, hi): (f64, f64)| {
         let (lo, hi) = crate::colormap::widen(lo, hi);
@@ -106,7 +114,12 @@ pub fn render_line_plot(plot: &LinePlot) -> Result<Canvas> {
     let mut canvas = Canvas::new(LINE_WIDTH, LINE_HEIGHT);
     let mut boxes = Vec::new();
     let ax = Axes {
-        rect: PixelRect { x0: 110, y0: 60, x1: LINE_WIDTH as i32 - 30, y1: LINE_HEIGHT as i32 - 85 },
+        rect: PixelRect {
+            x0: 110,
+            y0: 60,
+            x1: LINE_WIDTH as i32 - 30,
+            y1: LINE_HEIGHT as i32 - 85,
+        },
         x: pad(fold(|p| p.0)),
         y: pad(fold(|p| p.1)),
     };
@@ -154,11 +167,22 @@ pub fn render_line_plot(plot: &LinePlot) -> Result<Canvas> {
             .filter(|p| r.grow(10).contains(ax.px(p.0) as i32, ax.py(p.1) as i32))
             .count()
     };
-    let best = corners.iter().min_by_key(|r| crowd(r)).copied().unwrap_or(corners[0]);
+    let best = corners
+        .iter()
+        .min_by_key(|r| crowd(r))
+        .copied()
+        .unwrap_or(corners[0]);
     if !legend.is_empty() {
         canvas.fill_rect(best, WHITE, 0.9);
         canvas.stroke_rect(best, [170, 170, 170]);
-        axes::legend(&mut canvas, best.x0 + 8, best.y0 + 6, w - 14, &legend, &mut boxes);
+        axes::legend(
+            &mut canvas,
+            best.x0 + 8,
+            best.y0 + 6,
+            w - 14,
+            &legend,
+            &mut boxes,
+        );
     }
     Ok(canvas)
 }

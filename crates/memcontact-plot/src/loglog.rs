@@ -49,9 +49,7 @@ fn ensure_font() -> Result<()> {
 }
 
 /// Renders into a fresh white `WIDTH × HEIGHT` RGB buffer.
-fn render(
-    draw: impl FnOnce(&DrawingArea<BitMapBackend, Shift>) -> DrawResult,
-) -> Result<Vec<u8>> {
+fn render(draw: impl FnOnce(&DrawingArea<BitMapBackend, Shift>) -> DrawResult) -> Result<Vec<u8>> {
     let mut rgb = vec![255u8; (WIDTH * HEIGHT * 3) as usize];
     {
         let root = BitMapBackend::with_buffer(&mut rgb, (WIDTH, HEIGHT)).into_drawing_area();

@@ -14,8 +14,8 @@ use crate::text::{self, Anchor, Style};
 use crate::ticks;
 use crate::{PlotData, PlotKind, PlotOptions, Units, MAP_HEIGHT, MAP_WIDTH};
 use memcontact::{Error, Result};
-use std::path::Path;
 use rayon::prelude::*;
+use std::path::Path;
 
 /// The area the map frame is fitted into.
 const MAP_AREA: PixelRect = PixelRect {
@@ -95,7 +95,10 @@ impl MapLayout {
 
     /// The triangle whose interior holds the centre of canvas pixel `(x, y)`, if any.
     pub fn triangle_at(&self, x: i32, y: i32) -> Option<u32> {
-        self.frags.index(x, y).map(|i| self.frags.tri[i]).filter(|&t| t != EMPTY)
+        self.frags
+            .index(x, y)
+            .map(|i| self.frags.tri[i])
+            .filter(|&t| t != EMPTY)
     }
 
     /// Vertex positions on the canvas (pixel coordinates).
@@ -136,13 +139,19 @@ fn range(v: &[f64], keep: impl Fn(usize) -> bool + Sync) -> Option<(f64, f64)> {
         .enumerate()
         .filter(|(i, x)| x.is_finite() && keep(*i))
         .map(|(_, &x)| (x, x))
-        .reduce(|| (f64::INFINITY, f64::NEG_INFINITY), |a, b| (a.0.min(b.0), a.1.max(b.1)));
+        .reduce(
+            || (f64::INFINITY, f64::NEG_INFINITY),
+            |a, b| (a.0.min(b.0), a.1.max(b.1)),
+        );
     (lo <= hi).then_some((lo, hi))
 }
 
 /// A 0/1 indicator as a P1 field.
 fn indicator(n: usize, f: impl Fn(usize) -> bool + Sync + Send) -> Vec<f64> {
-    (0..n).into_par_iter().map(|i| if f(i) { 1.0 } else { 0.0 }).collect()
+    (0..n)
+        .into_par_iter()
+        .map(|i| if f(i) { 1.0 } else { 0.0 })
+        .collect()
 }
 
 /// Fills the frame: `color(fragment index)` for covered pixels, white elsewhere.
@@ -225,7 +234,11 @@ fn contours(
     if levels.is_empty() {
         return Vec::new();
     }
-    let step = if levels.len() > 1 { levels[1] - levels[0] } else { ticks::nice_step(lo, hi, count + 1) };
+    let step = if levels.len() > 1 {
+        levels[1] - levels[0]
+    } else {
+        ticks::nice_step(lo, hi, count + 1)
+    };
     let segs = raster::level_sets(&l.pv, tris, values, &levels);
     let mut mask = Coverage::new(canvas.width, canvas.height, l.frame);
     for s in segs.iter().flatten() {
@@ -264,7 +277,10 @@ fn contours(
                 let near = labels
                     .iter()
                     .map(|o| {
-                        let oc = [(o.rect.x0 + o.rect.x1) as f64 / 2.0, (o.rect.y0 + o.rect.y1) as f64 / 2.0];
+                        let oc = [
+                            (o.rect.x0 + o.rect.x1) as f64 / 2.0,
+                            (o.rect.y0 + o.rect.y1) as f64 / 2.0,
+                        ];
                         ((oc[0] - p[0]).powi(2) + (oc[1] - p[1]).powi(2)).sqrt()
                     })
                     .fold(diag, f64::min);
@@ -282,7 +298,10 @@ fn contours(
                 }
             }
             mine.push(p);
-            labels.push(Label { rect: r, text: txt.clone() });
+            labels.push(Label {
+                rect: r,
+                text: txt.clone(),
+            });
         }
     }
     for lab in &labels {
@@ -298,7 +317,14 @@ fn draw_labels(canvas: &mut Canvas, labels: &[Label], boxes: &mut Vec<PixelRect>
         canvas.fill_rect(lab.rect, WHITE, 0.6);
         let cx = (lab.rect.x0 + lab.rect.x1) as f64 / 2.0;
         let cy = (lab.rect.y0 + lab.rect.y1) as f64 / 2.0;
-        boxes.push(text::draw(canvas, &lab.text, Style::new(LABEL_TEXT).color([10, 10, 10]), cx, cy, Anchor::Center));
+        boxes.push(text::draw(
+            canvas,
+            &lab.text,
+            Style::new(LABEL_TEXT).color([10, 10, 10]),
+            cx,
+            cy,
+            Anchor::Center,
+        ));
     }
 }
 
@@ -316,10 +342,21 @@ fn furniture(
     boxes: &mut Vec<PixelRect>,
 ) {
     axes::title(canvas, title, 30.0, boxes);
-    let xr = (l.transform.x0, l.transform.x0 + l.frame.width() as f64 / l.transform.scale);
-    let yr = (l.transform.y0, l.transform.y0 + l.frame.height() as f64 / l.transform.scale);
+    let xr = (
+        l.transform.x0,
+        l.transform.x0 + l.frame.width() as f64 / l.transform.scale,
+    );
+    let yr = (
+        l.transform.y0,
+        l.transform.y0 + l.frame.height() as f64 / l.transform.scale,
+    );
     let unit = units.length_suffix();
-    Axes { rect: l.frame, x: xr, y: yr }.frame(canvas, &format!("x{unit}"), &format!("y{unit}"), boxes);
+    Axes {
+        rect: l.frame,
+        x: xr,
+        y: yr,
+    }
+    .frame(canvas, &format!("x{unit}"), &format!("y{unit}"), boxes);
     if let Some((map, norm, r, label)) = bar {
         axes::colorbar(canvas, BAR, map, norm, r, &label, COLUMN.1, boxes);
     }
@@ -328,13 +365,24 @@ fn furniture(
 /// The range lines of a legend.
 fn range_entries(name: &str, (lo, hi): (f64, f64)) -> Vec<(Swatch, String)> {
     vec![
-        (Swatch::None, format!("{name} min {}", ticks::format_sig(lo, 5))),
-        (Swatch::None, format!("{name} max {}", ticks::format_sig(hi, 5))),
+        (
+            Swatch::None,
+            format!("{name} min {}", ticks::format_sig(lo, 5)),
+        ),
+        (
+            Swatch::None,
+            format!("{name} max {}", ticks::format_sig(hi, 5)),
+        ),
     ]
 }
 
 /// Draws one of the map pictures.
-pub(crate) fn render(kind: PlotKind, l: &MapLayout, data: &PlotData, options: &PlotOptions) -> Result<Picture> {
+pub(crate) fn render(
+    kind: PlotKind,
+    l: &MapLayout,
+    data: &PlotData,
+    options: &PlotOptions,
+) -> Result<Picture> {
     let mut canvas = Canvas::new(MAP_WIDTH, MAP_HEIGHT);
     let mut boxes = Vec::new();
     let n = data.points.len();
@@ -382,20 +430,43 @@ pub(crate) fn render(kind: PlotKind, l: &MapLayout, data: &PlotData, options: &P
             }
             draw_labels(&mut canvas, &labels, &mut boxes);
             let unit = options.units.length_suffix();
-            furniture(&mut canvas, l, &options.units, &titled("Deflection u", options), Some((map, &norm, (lo, hi), format!("u{unit}"))), &mut boxes);
+            furniture(
+                &mut canvas,
+                l,
+                &options.units,
+                &titled("Deflection u", options),
+                Some((map, &norm, (lo, hi), format!("u{unit}"))),
+                &mut boxes,
+            );
             let mut entries = vec![
-                (Swatch::Line(OUTLINE, 2.6), "contact zone outline".to_string()),
+                (
+                    Swatch::Line(OUTLINE, 2.6),
+                    "contact zone outline".to_string(),
+                ),
                 (Swatch::Hatch(true), "penetrating (u > φ)".to_string()),
                 (Swatch::Hatch(false), "touching (u = φ)".to_string()),
             ];
             if markers {
-                entries.push((Swatch::Disc(PEN_MARK, MARK_LIGHT), "penetrating vertex".into()));
-                entries.push((Swatch::Disc(MARK_LIGHT, MARK_DARK), "touching vertex".into()));
+                entries.push((
+                    Swatch::Disc(PEN_MARK, MARK_LIGHT),
+                    "penetrating vertex".into(),
+                ));
+                entries.push((
+                    Swatch::Disc(MARK_LIGHT, MARK_DARK),
+                    "touching vertex".into(),
+                ));
             }
             entries.push((Swatch::Line(CONTOUR, 1.0), "contour of u".into()));
             entries.extend(range_entries("u", (lo, hi)));
             entries.push((Swatch::None, counts(data)));
-            axes::legend(&mut canvas, COLUMN.0, legend_y, COLUMN.1, &entries, &mut boxes);
+            axes::legend(
+                &mut canvas,
+                COLUMN.0,
+                legend_y,
+                COLUMN.1,
+                &entries,
+                &mut boxes,
+            );
         }
         PlotKind::Pressure => {
             let unit = options.units.pressure_suffix();
@@ -419,18 +490,27 @@ pub(crate) fn render(kind: PlotKind, l: &MapLayout, data: &PlotData, options: &P
             }
             let (lo, hi) = range(&field, |_| true).unwrap_or((0.0, 0.0));
             bar_range = Some((lo, hi));
-            fill(&mut canvas, l, |k, _, _| map.at(norm.t(f.interp(k, tris, &field))));
+            fill(&mut canvas, l, |k, _, _| {
+                map.at(norm.t(f.interp(k, tris, &field)))
+            });
             draw_boundary(&mut canvas, l);
             let labels = contours(&mut canvas, l, tris, &field, (lo, hi), 6, &[]);
             outline(&mut canvas, PRESSURE_OUTLINE, 2.0);
-            let mut entries = vec![(Swatch::Line(PRESSURE_OUTLINE, 2.0), "contact zone outline".to_string())];
+            let mut entries = vec![(
+                Swatch::Line(PRESSURE_OUTLINE, 2.0),
+                "contact zone outline".to_string(),
+            )];
             if let Some(a) = options.allowable_pressure {
                 let m = level_mask(&canvas, l, tris, &field, 1.0, 3.0, false);
                 canvas.composite(&m, [0, 0, 0], 1.0);
                 entries.push((Swatch::Line([0, 0, 0], 3.0), "pressure = allowable".into()));
                 entries.push((
                     Swatch::None,
-                    format!("allowable {}{}", ticks::format_sig(a, 5), unit.replace(['[', ']'], "")),
+                    format!(
+                        "allowable {}{}",
+                        ticks::format_sig(a, 5),
+                        unit.replace(['[', ']'], "")
+                    ),
                 ));
                 let above = data.pressure.iter().filter(|&&p| p > a).count();
                 entries.push((
@@ -443,23 +523,48 @@ pub(crate) fn render(kind: PlotKind, l: &MapLayout, data: &PlotData, options: &P
                 ));
                 entries.extend(range_entries("ratio", (lo, hi)));
                 let (plo, phi) = range(data.pressure, |_| true).unwrap_or((0.0, 0.0));
-                entries.push((Swatch::None, format!("pressure max {}", ticks::format_sig(phi.max(plo), 5))));
+                entries.push((
+                    Swatch::None,
+                    format!("pressure max {}", ticks::format_sig(phi.max(plo), 5)),
+                ));
             } else {
                 entries.push((Swatch::Line(CONTOUR, 1.0), "contour of pressure".into()));
                 entries.extend(range_entries("pressure", (lo, hi)));
             }
             draw_labels(&mut canvas, &labels, &mut boxes);
-            furniture(&mut canvas, l, &options.units, &titled("Contact pressure", options), Some((map, &norm, (lo, hi), label)), &mut boxes);
-            axes::legend(&mut canvas, COLUMN.0, legend_y, COLUMN.1, &entries, &mut boxes);
+            furniture(
+                &mut canvas,
+                l,
+                &options.units,
+                &titled("Contact pressure", options),
+                Some((map, &norm, (lo, hi), label)),
+                &mut boxes,
+            );
+            axes::legend(
+                &mut canvas,
+                COLUMN.0,
+                legend_y,
+                COLUMN.1,
+                &entries,
+                &mut boxes,
+            );
         }
         PlotKind::Liftoff => {
             let covered = indicator(n, |i| data.covered[i]);
             let gap: Vec<f64> = (0..n)
                 .into_par_iter()
-                .map(|i| if data.covered[i] { data.phi[i] - data.u[i] } else { f64::NAN })
+                .map(|i| {
+                    if data.covered[i] {
+                        data.phi[i] - data.u[i]
+                    } else {
+                        f64::NAN
+                    }
+                })
                 .collect();
             let gr = range(&gap, |i| data.covered[i] && data.state[i] < 0);
-            let (glo, ghi) = gr.map(|(a, b)| (a.max(0.0), b.max(0.0))).unwrap_or((0.0, 0.0));
+            let (glo, ghi) = gr
+                .map(|(a, b)| (a.max(0.0), b.max(0.0)))
+                .unwrap_or((0.0, 0.0));
             let norm = Norm::linear(glo, ghi);
             let map = colormap::blues();
             fill(&mut canvas, l, |k, _, _| {
@@ -483,21 +588,52 @@ pub(crate) fn render(kind: PlotKind, l: &MapLayout, data: &PlotData, options: &P
             bar_range = gr.map(|_| (glo, ghi));
             let unit = options.units.length_suffix();
             let bar = gr.map(|_| (map, &norm, (glo, ghi), format!("gap φ − u{unit}")));
-            furniture(&mut canvas, l, &options.units, &titled("Lift-off", options), bar, &mut boxes);
+            furniture(
+                &mut canvas,
+                l,
+                &options.units,
+                &titled("Lift-off", options),
+                bar,
+                &mut boxes,
+            );
             let areas = Areas::of(data);
-            let pct = |a: f64| if areas.covered > 0.0 { 100.0 * a / areas.covered } else { 0.0 };
+            let pct = |a: f64| {
+                if areas.covered > 0.0 {
+                    100.0 * a / areas.covered
+                } else {
+                    0.0
+                }
+            };
             let aunit = match &options.units.length {
                 Some(u) if !u.trim().is_empty() => format!(" {}²", u.trim()),
                 _ => String::new(),
             };
             let mut entries = vec![
-                (Swatch::Patch(CONTACT), format!("contact (u ≥ φ) {:.1} %", pct(areas.contact))),
-                (Swatch::Patch(colormap::blues().at(0.6)), format!("lift-off (u < φ) {:.1} %", pct(areas.liftoff))),
+                (
+                    Swatch::Patch(CONTACT),
+                    format!("contact (u ≥ φ) {:.1} %", pct(areas.contact)),
+                ),
+                (
+                    Swatch::Patch(colormap::blues().at(0.6)),
+                    format!("lift-off (u < φ) {:.1} %", pct(areas.liftoff)),
+                ),
                 (Swatch::Patch(NOT_COVERED), "body cannot touch".into()),
                 (Swatch::Line(OUTLINE, 2.4), "contact zone outline".into()),
                 (Swatch::Dashed([60, 60, 60], 1.6), "edge of the body".into()),
-                (Swatch::None, format!("lift-off area {}{aunit}", ticks::format_sig(areas.liftoff, 4))),
-                (Swatch::None, format!("covered area {}{aunit}", ticks::format_sig(areas.covered, 4))),
+                (
+                    Swatch::None,
+                    format!(
+                        "lift-off area {}{aunit}",
+                        ticks::format_sig(areas.liftoff, 4)
+                    ),
+                ),
+                (
+                    Swatch::None,
+                    format!(
+                        "covered area {}{aunit}",
+                        ticks::format_sig(areas.covered, 4)
+                    ),
+                ),
             ];
             if gr.is_none() {
                 entries.push((Swatch::None, "no lift-off".into()));
@@ -549,7 +685,11 @@ impl Areas {
                 nodal[v as usize] += area / 3.0;
             }
         }
-        let mut r = Areas { covered: 0.0, contact: 0.0, liftoff: 0.0 };
+        let mut r = Areas {
+            covered: 0.0,
+            contact: 0.0,
+            liftoff: 0.0,
+        };
         for (i, a) in nodal.iter().enumerate() {
             if data.covered[i] {
                 r.covered += a;
@@ -593,39 +733,79 @@ pub fn field_plot(
             points.len()
         )));
     }
-    if let Some((k, t)) = triangles.iter().enumerate().find(|(_, t)| t.iter().any(|&v| v as usize >= points.len())) {
+    if let Some((k, t)) = triangles
+        .iter()
+        .enumerate()
+        .find(|(_, t)| t.iter().any(|&v| v as usize >= points.len()))
+    {
         return Err(Error::Data(format!(
             "field plot {}: triangle {k} {t:?} refers to a missing point",
             path.display()
         )));
     }
     let Some((lo, hi)) = range(values, |_| true) else {
-        return Err(Error::Data(format!("field plot {}: no finite value", path.display())));
+        return Err(Error::Data(format!(
+            "field plot {}: no finite value",
+            path.display()
+        )));
     };
-    if triangles.is_empty() || points.iter().any(|p| !(p[0].is_finite() && p[1].is_finite())) {
+    if triangles.is_empty()
+        || points
+            .iter()
+            .any(|p| !(p[0].is_finite() && p[1].is_finite()))
+    {
         return Err(Error::Data(format!(
             "field plot {}: the mesh has no triangle or a non-finite coordinate",
             path.display()
         )));
     }
-    let mut b = [f64::INFINITY, f64::NEG_INFINITY, f64::INFINITY, f64::NEG_INFINITY];
+    let mut b = [
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+    ];
     for p in points {
-        b = [b[0].min(p[0]), b[1].max(p[0]), b[2].min(p[1]), b[3].max(p[1])];
+        b = [
+            b[0].min(p[0]),
+            b[1].max(p[0]),
+            b[2].min(p[1]),
+            b[3].max(p[1]),
+        ];
     }
-    let (bx, by) = (crate::colormap::widen(b[0], b[1]), crate::colormap::widen(b[2], b[3]));
+    let (bx, by) = (
+        crate::colormap::widen(b[0], b[1]),
+        crate::colormap::widen(b[2], b[3]),
+    );
     let l = MapLayout::of(points, triangles, [bx.0, bx.1, by.0, by.1]);
     let mut canvas = Canvas::new(MAP_WIDTH, MAP_HEIGHT);
     let mut boxes = Vec::new();
     let norm = Norm::linear(lo, hi);
     let map = colormap::viridis();
     let f = &l.frags;
-    fill(&mut canvas, &l, |k, _, _| map.at(norm.t(f.interp(k, triangles, values))));
+    fill(&mut canvas, &l, |k, _, _| {
+        map.at(norm.t(f.interp(k, triangles, values)))
+    });
     draw_boundary(&mut canvas, &l);
     let labels = contours(&mut canvas, &l, triangles, values, (lo, hi), 8, &[]);
     draw_labels(&mut canvas, &labels, &mut boxes);
     let units = Units::default();
-    furniture(&mut canvas, &l, &units, title, Some((map, &norm, (lo, hi), "value".into())), &mut boxes);
+    furniture(
+        &mut canvas,
+        &l,
+        &units,
+        title,
+        Some((map, &norm, (lo, hi), "value".into())),
+        &mut boxes,
+    );
     let entries = range_entries("value", (lo, hi));
-    axes::legend(&mut canvas, COLUMN.0, BAR.y1 + 60, COLUMN.1, &entries, &mut boxes);
+    axes::legend(
+        &mut canvas,
+        COLUMN.0,
+        BAR.y1 + 60,
+        COLUMN.1,
+        &entries,
+        &mut boxes,
+    );
     canvas.write_png(path)
 }

@@ -49,12 +49,19 @@ fn pieces(data: &PlotData, a: [f64; 2], b: [f64; 2]) -> Vec<Piece> {
             let mut out = Vec::new();
             for t in chunk {
                 let p = t.map(|v| data.points[v as usize]);
-                let (xmin, xmax) = (p[0][0].min(p[1][0]).min(p[2][0]), p[0][0].max(p[1][0]).max(p[2][0]));
-                let (ymin, ymax) = (p[0][1].min(p[1][1]).min(p[2][1]), p[0][1].max(p[1][1]).max(p[2][1]));
+                let (xmin, xmax) = (
+                    p[0][0].min(p[1][0]).min(p[2][0]),
+                    p[0][0].max(p[1][0]).max(p[2][0]),
+                );
+                let (ymin, ymax) = (
+                    p[0][1].min(p[1][1]).min(p[2][1]),
+                    p[0][1].max(p[1][1]).max(p[2][1]),
+                );
                 if xmax < bx0 || xmin > bx1 || ymax < by0 || ymin > by1 {
                     continue;
                 }
-                let area = (p[1][0] - p[0][0]) * (p[2][1] - p[0][1]) - (p[1][1] - p[0][1]) * (p[2][0] - p[0][0]);
+                let area = (p[1][0] - p[0][0]) * (p[2][1] - p[0][1])
+                    - (p[1][1] - p[0][1]) * (p[2][0] - p[0][0]);
                 if area == 0.0 {
                     continue;
                 }
@@ -64,7 +71,8 @@ fn pieces(data: &PlotData, a: [f64; 2], b: [f64; 2]) -> Vec<Piece> {
                 let mut ab = [[0.0; 2]; 3];
                 for k in 0..3 {
                     let (q, r) = (p[(k + 1) % 3], p[(k + 2) % 3]);
-                    let e = |x: [f64; 2]| (r[0] - q[0]) * (x[1] - q[1]) - (r[1] - q[1]) * (x[0] - q[0]);
+                    let e =
+                        |x: [f64; 2]| (r[0] - q[0]) * (x[1] - q[1]) - (r[1] - q[1]) * (x[0] - q[0]);
                     let alpha = e(a) / area;
                     let beta = ((r[0] - q[0]) * d[1] - (r[1] - q[1]) * d[0]) / area;
                     ab[k] = [alpha, beta];
@@ -81,7 +89,9 @@ fn pieces(data: &PlotData, a: [f64; 2], b: [f64; 2]) -> Vec<Piece> {
                     continue;
                 }
                 let eval = |f: &dyn Fn(usize) -> f64, s: f64| {
-                    (0..3).map(|k| (ab[k][0] + ab[k][1] * s) * f(t[k] as usize)).sum::<f64>()
+                    (0..3)
+                        .map(|k| (ab[k][0] + ab[k][1] * s) * f(t[k] as usize))
+                        .sum::<f64>()
                 };
                 let at = |f: &dyn Fn(usize) -> f64| [eval(f, lo), eval(f, hi)];
                 out.push(Piece {
@@ -154,7 +164,7 @@ pub(crate) fn render(data: &PlotData, options: &PlotOptions) -> Result<Picture> 
     let [a, b] = line_of(data, options);
     let len = ((b[0] - a[0]).powi(2) + (b[1] - a[1]).powi(2)).sqrt();
     let ps = pieces(data, a, b);
-    if ps.is_empty() || !(len > 0.0) {
+    if ps.is_empty() || len.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
         return Err(Error::Data(format!(
             "profile: the line from ({}, {}) to ({}, {}) does not cross the mesh",
             a[0], a[1], b[0], b[1]
@@ -164,14 +174,21 @@ pub(crate) fn render(data: &PlotData, options: &PlotOptions) -> Result<Picture> 
     let phi_lines = polylines(&ps, len, |p| p.phi);
     let stretches = contact_stretches(&ps, len);
     let vals = u_lines.iter().chain(&phi_lines).flatten().map(|p| p.1);
-    let (lo, hi) = vals.fold((f64::INFINITY, f64::NEG_INFINITY), |r, v| (r.0.min(v), r.1.max(v)));
+    let (lo, hi) = vals.fold((f64::INFINITY, f64::NEG_INFINITY), |r, v| {
+        (r.0.min(v), r.1.max(v))
+    });
     let (lo, hi) = crate::colormap::widen(lo, hi);
     let pad = 0.06 * (hi - lo);
 
     let mut canvas = Canvas::new(PROFILE_WIDTH, PROFILE_HEIGHT);
     let mut boxes = Vec::new();
     let ax = Axes {
-        rect: PixelRect { x0: 110, y0: 62, x1: 1040, y1: PROFILE_HEIGHT as i32 - 85 },
+        rect: PixelRect {
+            x0: 110,
+            y0: 62,
+            x1: 1040,
+            y1: PROFILE_HEIGHT as i32 - 85,
+        },
         x: (0.0, len),
         y: (lo - pad, hi + pad),
     };
@@ -183,10 +200,23 @@ pub(crate) fn render(data: &PlotData, options: &PlotOptions) -> Result<Picture> 
     for &(s0, s1) in &stretches {
         let x0 = ax.px(s0).round() as i32;
         let x1 = (ax.px(s1).round() as i32).max(x0 + 1);
-        canvas.fill_rect(PixelRect { x0, y0: ax.rect.y0, x1, y1: ax.rect.y1 }, CONTACT_SHADE, 1.0);
+        canvas.fill_rect(
+            PixelRect {
+                x0,
+                y0: ax.rect.y0,
+                x1,
+                y1: ax.rect.y1,
+            },
+            CONTACT_SHADE,
+            1.0,
+        );
     }
     ax.grid(&mut canvas);
-    let px = |l: &Vec<(f64, f64)>| l.iter().map(|&(s, v)| [ax.px(s), ax.py(v)]).collect::<Vec<_>>();
+    let px = |l: &Vec<(f64, f64)>| {
+        l.iter()
+            .map(|&(s, v)| [ax.px(s), ax.py(v)])
+            .collect::<Vec<_>>()
+    };
     let mut m = Coverage::new(canvas.width, canvas.height, ax.rect);
     for l in &phi_lines {
         m.dashed(&px(l), 2.0, 9.0, 5.0);
@@ -198,7 +228,12 @@ pub(crate) fn render(data: &PlotData, options: &PlotOptions) -> Result<Picture> 
     }
     canvas.composite(&m, U_COLOR, 1.0);
     let unit = options.units.length_suffix();
-    ax.frame(&mut canvas, &format!("arc length s{unit}"), &format!("u, φ{unit}"), &mut boxes);
+    ax.frame(
+        &mut canvas,
+        &format!("arc length s{unit}"),
+        &format!("u, φ{unit}"),
+        &mut boxes,
+    );
     let f = |v: f64| ticks::format_sig(v, 4);
     let mut entries = vec![
         (Swatch::Line(U_COLOR, 2.2), "deflection u".to_string()),

@@ -104,9 +104,9 @@ impl Fragments {
     /// Index into [`Fragments::tri`] of the canvas pixel `(x, y)`, if inside the rectangle.
     #[inline]
     pub fn index(&self, x: i32, y: i32) -> Option<usize> {
-        self.rect
-            .contains(x, y)
-            .then(|| (y - self.rect.y0) as usize * self.rect.width() as usize + (x - self.rect.x0) as usize)
+        self.rect.contains(x, y).then(|| {
+            (y - self.rect.y0) as usize * self.rect.width() as usize + (x - self.rect.x0) as usize
+        })
     }
 
     /// The P1 interpolant of `values` at fragment `i` (NaN where no triangle covers it).
@@ -257,7 +257,9 @@ pub fn level_segments(
     values: &[f64],
     level: f64,
 ) -> Vec<[[f64; 2]; 2]> {
-    level_sets(pv, triangles, values, &[level]).pop().unwrap_or_default()
+    level_sets(pv, triangles, values, &[level])
+        .pop()
+        .unwrap_or_default()
 }
 
 /// [`level_segments`] for several levels in one pass over the triangles: one list of
@@ -330,7 +332,11 @@ pub fn chain(segs: &[[[f64; 2]; 2]]) -> Vec<Vec<[f64; 2]>> {
         // Extend forwards from the last point, then backwards from the first.
         for dir in 0..2 {
             loop {
-                let end = if dir == 0 { *line.back().unwrap_or(&[0.0; 2]) } else { line[0] };
+                let end = if dir == 0 {
+                    *line.back().unwrap_or(&[0.0; 2])
+                } else {
+                    line[0]
+                };
                 let next = at
                     .get(&key(end))
                     .and_then(|v| v.iter().copied().find(|&j| !used[j]));
@@ -424,7 +430,10 @@ mod tests {
         // A grid whose vertices fall exactly on pixel centres and edges: ties everywhere.
         let (pts, tris) = grid(8);
         let rect = PixelRect::new(0, 0, 64, 64);
-        let pv: Vec<[f64; 2]> = pts.iter().map(|p| [0.5 + 62.0 * p[0], 63.5 - 62.0 * p[1]]).collect();
+        let pv: Vec<[f64; 2]> = pts
+            .iter()
+            .map(|p| [0.5 + 62.0 * p[0], 63.5 - 62.0 * p[1]])
+            .collect();
         let f = rasterise(&pv, &tris, rect);
         // Pixels whose centres lie inside the closed square [0.5, 62.5]²: covered once.
         for y in 0..64 {
@@ -483,7 +492,10 @@ mod tests {
                 assert_eq!(*x, n - 1 - *y);
             }
         }
-        let pool = rayon::ThreadPoolBuilder::new().num_threads(1).build().unwrap();
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(1)
+            .build()
+            .unwrap();
         let c = pool.install(|| rasterise(&pv, &tris, rect));
         assert_eq!(a.tri, c.tri);
         assert_eq!(a.bary, c.bary);
@@ -491,14 +503,18 @@ mod tests {
 
     #[test]
     fn transform_round_trips_and_keeps_equal_scales() {
-        let (t, frame) = MapTransform::fit([0.0, 12.0, 0.0, 8.0], PixelRect::new(100, 50, 900, 800));
+        let (t, frame) =
+            MapTransform::fit([0.0, 12.0, 0.0, 8.0], PixelRect::new(100, 50, 900, 800));
         assert!(frame.width() <= 900 && frame.height() <= 800);
         let p = t.to_pixel([3.0, 2.0]);
         let q = t.to_world(p);
         assert!((q[0] - 3.0).abs() < 1e-12 && (q[1] - 2.0).abs() < 1e-12);
         let a = t.to_pixel([0.0, 0.0]);
         let b = t.to_pixel([1.0, 1.0]);
-        assert!(((b[0] - a[0]) + (b[1] - a[1])).abs() < 1e-9, "equal scales, y up");
+        assert!(
+            ((b[0] - a[0]) + (b[1] - a[1])).abs() < 1e-9,
+            "equal scales, y up"
+        );
     }
 
     #[test]

@@ -64,7 +64,11 @@ pub fn load(dir: &Path) -> Result<Loaded> {
     let field = |name: &str| -> Result<Vec<f64>> {
         mesh.point_array(name)
             .map(|a| a.values.clone())
-            .ok_or_else(|| file_err(format!("no point field `{name}` (is this a memcontact result?)")))
+            .ok_or_else(|| {
+                file_err(format!(
+                    "no point field `{name}` (is this a memcontact result?)"
+                ))
+            })
     };
     let mut notes = Vec::new();
     let u = field("u")?;
@@ -77,7 +81,9 @@ pub fn load(dir: &Path) -> Result<Loaded> {
             -1.0 => Ok(-1),
             0.0 => Ok(0),
             1.0 => Ok(1),
-            _ => Err(file_err(format!("point field `state` is {s} at vertex {i} (expected -1, 0 or 1)"))),
+            _ => Err(file_err(format!(
+                "point field `state` is {s} at vertex {i} (expected -1, 0 or 1)"
+            ))),
         })
         .collect::<Result<_>>()?;
     let covered = match mesh.point_array("covered") {
@@ -100,7 +106,10 @@ pub fn load(dir: &Path) -> Result<Loaded> {
                 path: summary_path.clone(),
                 message: format!("not valid JSON: {e}"),
             })?;
-            case = json.get("case").and_then(|c| c.as_str()).map(str::to_string);
+            case = json
+                .get("case")
+                .and_then(|c| c.as_str())
+                .map(str::to_string);
             match json.get("plot_options") {
                 Some(o) => {
                     options = serde_json::from_value(o.clone()).map_err(|e| Error::File {

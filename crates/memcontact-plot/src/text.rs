@@ -123,7 +123,14 @@ pub fn text_box(text: &str, size: f32, x: f64, y: f64, anchor: Anchor) -> PixelR
 }
 
 /// Draws `text` horizontally at `(x, y)` with `anchor`; returns the box it occupies.
-pub fn draw(canvas: &mut Canvas, text: &str, style: Style, x: f64, y: f64, anchor: Anchor) -> PixelRect {
+pub fn draw(
+    canvas: &mut Canvas,
+    text: &str,
+    style: Style,
+    x: f64,
+    y: f64,
+    anchor: Anchor,
+) -> PixelRect {
     let r = text_box(text, style.size, x, y, anchor);
     let (w, h, cov) = rasterise(text, style.size);
     for j in 0..h {
@@ -172,7 +179,9 @@ pub fn ellipsize_front(text: &str, size: f32, width: i32) -> String {
     }
     let chars: Vec<char> = text.chars().collect();
     for k in 1..chars.len() {
-        let s: String = std::iter::once('…').chain(chars[k..].iter().copied()).collect();
+        let s: String = std::iter::once('…')
+            .chain(chars[k..].iter().copied())
+            .collect();
         if measure(&s, size).0 <= width {
             return s;
         }
@@ -190,7 +199,14 @@ mod tests {
         assert!(w > 20 && w < 80 && h > 12 && h < 30, "{w} × {h}");
         assert!(measure("long text here", 16.0).0 > measure("short", 16.0).0);
         let mut c = Canvas::new(100, 40);
-        let r = draw(&mut c, "φ ≤ u²", Style::new(18.0), 50.0, 20.0, Anchor::Center);
+        let r = draw(
+            &mut c,
+            "φ ≤ u²",
+            Style::new(18.0),
+            50.0,
+            20.0,
+            Anchor::Center,
+        );
         assert!(r.width() > 20);
         let ink = c.rgb.chunks(3).filter(|p| p[0] < 128).count();
         assert!(ink > 30, "{ink} dark pixels");

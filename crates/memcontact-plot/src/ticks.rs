@@ -4,7 +4,7 @@
 /// about `count` intervals.
 pub fn nice_step(lo: f64, hi: f64, count: usize) -> f64 {
     let span = (hi - lo).abs();
-    if !(span > 0.0) || !span.is_finite() {
+    if span.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) || !span.is_finite() {
         return 1.0;
     }
     let raw = span / count.max(1) as f64;
@@ -19,7 +19,11 @@ pub fn nice_step(lo: f64, hi: f64, count: usize) -> f64 {
 
 /// Multiples of `step` inside `[lo, hi]` (ends included up to rounding).
 pub fn multiples(lo: f64, hi: f64, step: f64) -> Vec<f64> {
-    if !(step > 0.0) || !lo.is_finite() || !hi.is_finite() || hi < lo {
+    if step.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater)
+        || !lo.is_finite()
+        || !hi.is_finite()
+        || hi < lo
+    {
         return Vec::new();
     }
     let eps = 1e-9 * step;
@@ -48,7 +52,7 @@ pub fn ticks(lo: f64, hi: f64, count: usize) -> (Vec<f64>, f64) {
 
 /// Contour levels: nice values strictly inside `(lo, hi)`, about `count` of them.
 pub fn levels(lo: f64, hi: f64, count: usize) -> Vec<f64> {
-    if !(hi > lo) {
+    if hi.partial_cmp(&lo) != Some(std::cmp::Ordering::Greater) {
         return Vec::new();
     }
     let step = nice_step(lo, hi, count + 1);
@@ -80,7 +84,10 @@ pub fn format(v: f64, step: f64) -> String {
     }
     let d = d.min(10);
     let s = format!("{v:.d$}");
-    if s.trim_start_matches('-').chars().all(|c| c == '0' || c == '.') {
+    if s.trim_start_matches('-')
+        .chars()
+        .all(|c| c == '0' || c == '.')
+    {
         "0".into()
     } else {
         s
@@ -90,7 +97,11 @@ pub fn format(v: f64, step: f64) -> String {
 /// A value with about `sig` significant digits (for range labels such as "max 2.0312").
 pub fn format_sig(v: f64, sig: usize) -> String {
     if v == 0.0 || !v.is_finite() {
-        return if v.is_finite() { "0".into() } else { format!("{v}") };
+        return if v.is_finite() {
+            "0".into()
+        } else {
+            format!("{v}")
+        };
     }
     let e = v.abs().log10().floor() as i32;
     if !(-4..6).contains(&e) {

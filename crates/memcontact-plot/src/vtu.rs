@@ -115,7 +115,8 @@ fn parse_ascii(text: &str, name: &str) -> std::result::Result<Vec<f64>, String> 
 fn parse(bytes: &[u8]) -> std::result::Result<VtuMesh, String> {
     let appended_at = find(bytes, b"<AppendedData");
     let header_bytes = &bytes[..appended_at.unwrap_or(bytes.len())];
-    let header = std::str::from_utf8(header_bytes).map_err(|_| "the XML part is not UTF-8 text".to_string())?;
+    let header = std::str::from_utf8(header_bytes)
+        .map_err(|_| "the XML part is not UTF-8 text".to_string())?;
     let vtk = header
         .find("<VTKFile")
         .map(|i| &header[i..i + header[i..].find('>').unwrap_or(0)])
@@ -168,14 +169,20 @@ fn parse(bytes: &[u8]) -> std::result::Result<VtuMesh, String> {
             continue;
         }
         let name = unescape(attr(tag, "Name").unwrap_or(""));
-        let vtk_type = attr(tag, "type").ok_or_else(|| format!("array `{name}` has no type"))?.to_string();
+        let vtk_type = attr(tag, "type")
+            .ok_or_else(|| format!("array `{name}` has no type"))?
+            .to_string();
         if type_size(&vtk_type).is_none() {
             return Err(format!("array `{name}`: unsupported type {vtk_type}"));
         }
-        let components = attr(tag, "NumberOfComponents").and_then(|c| c.parse().ok()).unwrap_or(1);
+        let components = attr(tag, "NumberOfComponents")
+            .and_then(|c| c.parse().ok())
+            .unwrap_or(1);
         let source = match attr(tag, "format") {
             Some("ascii") => {
-                let close = header[pos..].find("</DataArray>").ok_or_else(|| format!("array `{name}` is not closed"))?;
+                let close = header[pos..]
+                    .find("</DataArray>")
+                    .ok_or_else(|| format!("array `{name}` is not closed"))?;
                 let text = header[pos..pos + close].to_string();
                 pos += close;
                 Source::Ascii(text)
@@ -185,7 +192,11 @@ fn parse(bytes: &[u8]) -> std::result::Result<VtuMesh, String> {
                     .and_then(|o| o.trim().parse().ok())
                     .ok_or_else(|| format!("array `{name}` has no valid offset"))?,
             ),
-            Some(f) => return Err(format!("array `{name}`: format \"{f}\" is not supported (ascii or raw appended)")),
+            Some(f) => {
+                return Err(format!(
+                    "array `{name}`: format \"{f}\" is not supported (ascii or raw appended)"
+                ))
+            }
             None => return Err(format!("array `{name}` has no format")),
         };
         arrays.push((
@@ -207,7 +218,8 @@ fn parse(bytes: &[u8]) -> std::result::Result<VtuMesh, String> {
             if attr(tag, "encoding") != Some("raw") {
                 return Err("only raw appended data is supported (not base64)".into());
             }
-            let u = tag_end + find(&bytes[tag_end..], b"_").ok_or("appended data without '_' marker")?;
+            let u = tag_end
+                + find(&bytes[tag_end..], b"_").ok_or("appended data without '_' marker")?;
             Some(u + 1)
         }
         None => None,
@@ -216,11 +228,16 @@ fn parse(bytes: &[u8]) -> std::result::Result<VtuMesh, String> {
         a.values = match src {
             Source::Ascii(text) => parse_ascii(text, &a.name)?,
             Source::Appended(off) => {
-                let base = base.ok_or_else(|| format!("array `{}` is appended but the file has no appended data", a.name))?;
+                let base = base.ok_or_else(|| {
+                    format!(
+                        "array `{}` is appended but the file has no appended data",
+                        a.name
+                    )
+                })?;
                 let at = base + *off;
-                let hdr = bytes
-                    .get(at..at + header_size)
-                    .ok_or_else(|| format!("array `{}`: offset beyond the end of the file", a.name))?;
+                let hdr = bytes.get(at..at + header_size).ok_or_else(|| {
+                    format!("array `{}`: offset beyond the end of the file", a.name)
+                })?;
                 let nbytes = if header_size == 8 {
                     u64::from_le_bytes(hdr.try_into().unwrap_or([0; 8])) as usize
                 } else {
@@ -229,11 +246,18 @@ fn parse(bytes: &[u8]) -> std::result::Result<VtuMesh, String> {
                 let size = type_size(&a.vtk_type).unwrap_or(1);
                 let data = bytes
                     .get(at + header_size..at + header_size + nbytes)
-                    .ok_or_else(|| format!("array `{}`: data runs past the end of the file", a.name))?;
+                    .ok_or_else(|| {
+                        format!("array `{}`: data runs past the end of the file", a.name)
+                    })?;
                 if nbytes % size != 0 {
-                    return Err(format!("array `{}`: {nbytes} bytes is not a whole number of values", a.name));
+                    return Err(format!(
+                        "array `{}`: {nbytes} bytes is not a whole number of values",
+                        a.name
+                    ));
                 }
-                data.chunks_exact(size).map(|b| decode(&a.vtk_type, b)).collect()
+                data.chunks_exact(size)
+                    .map(|b| decode(&a.vtk_type, b))
+                    .collect()
             }
         };
     }
@@ -251,16 +275,27 @@ fn parse(bytes: &[u8]) -> std::result::Result<VtuMesh, String> {
             pts.components
         ));
     }
-    let points = pts.values.chunks_exact(pts.components).map(|c| [c[0], c[1]]).collect();
+    let points = pts
+        .values
+        .chunks_exact(pts.components)
+        .map(|c| [c[0], c[1]])
+        .collect();
     let conn = take("Cells", "connectivity").ok_or("no connectivity array")?;
     let offsets = take("Cells", "offsets").ok_or("no offsets array")?;
     let types = take("Cells", "types").ok_or("no types array")?;
-    if offsets.values.len() != n_cells || types.values.len() != n_cells || conn.values.len() != 3 * n_cells {
-        return Err(format!("the cell arrays do not describe {n_cells} triangles"));
+    if offsets.values.len() != n_cells
+        || types.values.len() != n_cells
+        || conn.values.len() != 3 * n_cells
+    {
+        return Err(format!(
+            "the cell arrays do not describe {n_cells} triangles"
+        ));
     }
     for (i, (&o, &t)) in offsets.values.iter().zip(&types.values).enumerate() {
         if t != 5.0 || o != 3.0 * (i + 1) as f64 {
-            return Err(format!("cell {i} is not a triangle (only triangle meshes are read)"));
+            return Err(format!(
+                "cell {i} is not a triangle (only triangle meshes are read)"
+            ));
         }
     }
     let mut triangles = Vec::with_capacity(n_cells);
@@ -269,7 +304,9 @@ fn parse(bytes: &[u8]) -> std::result::Result<VtuMesh, String> {
         for k in 0..3 {
             let v = c[k];
             if !(v >= 0.0 && v < n_points as f64 && v.fract() == 0.0) {
-                return Err(format!("triangle {i} refers to vertex {v}, not one of the {n_points} points"));
+                return Err(format!(
+                    "triangle {i} refers to vertex {v}, not one of the {n_points} points"
+                ));
             }
             t[k] = v as u32;
         }
@@ -345,7 +382,10 @@ mod tests {
             assert_eq!(r.points, mesh.points);
             assert_eq!(r.triangles, mesh.triangles);
             let get = |n: &str| r.point_array(n).unwrap().values.clone();
-            assert_eq!(get("u").iter().map(|v| v.to_bits()).collect::<Vec<_>>(), u.map(f64::to_bits).to_vec());
+            assert_eq!(
+                get("u").iter().map(|v| v.to_bits()).collect::<Vec<_>>(),
+                u.map(f64::to_bits).to_vec()
+            );
             let odd = get("odd <name>");
             assert!(odd[0].is_nan() && odd[1] == f64::INFINITY && odd[2] == f64::NEG_INFINITY);
             assert_eq!(get("state"), vec![-1.0, 0.0, 1.0, 1.0, -1.0]);
@@ -368,7 +408,9 @@ mod tests {
         .unwrap();
         let e = read_vtu(&p).unwrap_err().to_string();
         assert!(e.contains("not supported"), "{e}");
-        let e = read_vtu(&dir.path().join("missing.vtu")).unwrap_err().to_string();
+        let e = read_vtu(&dir.path().join("missing.vtu"))
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("missing.vtu"), "{e}");
     }
 }

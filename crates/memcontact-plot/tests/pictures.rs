@@ -53,7 +53,13 @@ fn check_common(s: &Solved, pics: &[Picture]) {
             PlotKind::Profile => (PROFILE_WIDTH, PROFILE_HEIGHT),
             _ => (MAP_WIDTH, MAP_HEIGHT),
         };
-        assert_eq!((p.canvas.width, p.canvas.height), (w, h), "{} {:?}", s.name, p.kind);
+        assert_eq!(
+            (p.canvas.width, p.canvas.height),
+            (w, h),
+            "{} {:?}",
+            s.name,
+            p.kind
+        );
         // Texts lie on the canvas and never overlap.
         for (i, a) in p.text_boxes.iter().enumerate() {
             assert!(
@@ -63,10 +69,20 @@ fn check_common(s: &Solved, pics: &[Picture]) {
                 p.kind
             );
             for b in &p.text_boxes[..i] {
-                assert!(!a.overlaps(b), "{} {:?}: texts {a:?} and {b:?} overlap", s.name, p.kind);
+                assert!(
+                    !a.overlaps(b),
+                    "{} {:?}: texts {a:?} and {b:?} overlap",
+                    s.name,
+                    p.kind
+                );
             }
         }
-        assert!(p.text_boxes.len() > 10, "{} {:?}: axes, title, legend", s.name, p.kind);
+        assert!(
+            p.text_boxes.len() > 10,
+            "{} {:?}: axes, title, legend",
+            s.name,
+            p.kind
+        );
         // Not blank: many colours where the data is drawn.
         let area = match (&p.map, &p.axes) {
             (Some((_, frame)), _) => *frame,
@@ -74,7 +90,11 @@ fn check_common(s: &Solved, pics: &[Picture]) {
             _ => panic!("no drawing area"),
         };
         let n = distinct(p, area);
-        let want = if p.kind == PlotKind::Liftoff || p.kind == PlotKind::Profile { 20 } else { 100 };
+        let want = if p.kind == PlotKind::Liftoff || p.kind == PlotKind::Profile {
+            20
+        } else {
+            100
+        };
         assert!(n > want, "{} {:?}: {n} distinct colours", s.name, p.kind);
     }
     // The colour bar of u spans the data range of u.
@@ -83,8 +103,16 @@ fn check_common(s: &Solved, pics: &[Picture]) {
     assert_eq!(pics[0].range, Some((lo, hi)), "{}", s.name);
     // The pressure bar spans the pressure (or ratio) range.
     let a = options(s).allowable_pressure.unwrap_or(1.0);
-    let plo = d.pressure.iter().map(|p| p / a).fold(f64::INFINITY, f64::min);
-    let phi = d.pressure.iter().map(|p| p / a).fold(f64::NEG_INFINITY, f64::max);
+    let plo = d
+        .pressure
+        .iter()
+        .map(|p| p / a)
+        .fold(f64::INFINITY, f64::min);
+    let phi = d
+        .pressure
+        .iter()
+        .map(|p| p / a)
+        .fold(f64::NEG_INFINITY, f64::max);
     assert_eq!(pics[1].range, Some((plo, phi)), "{}", s.name);
 }
 
@@ -102,7 +130,9 @@ fn check_deflection(s: &Solved, p: &Picture, layout: &MapLayout) {
             if c == OUTLINE {
                 outline_px.push((x, y));
             }
-            let Some(t) = layout.triangle_at(x, y) else { continue };
+            let Some(t) = layout.triangle_at(x, y) else {
+                continue;
+            };
             let tri = d.triangles[t as usize];
             let cls: Vec<u8> = tri.iter().map(|&v| class(&d, v)).collect();
             if cls.iter().any(|&k| k != cls[0]) {
@@ -112,7 +142,11 @@ fn check_deflection(s: &Solved, p: &Picture, layout: &MapLayout) {
             let hatch = c == [255, 255, 255] || c == [0, 0, 0];
             if cls[0] == 0 {
                 // Clear triangles: no hatching at all.
-                assert!(!hatch, "{}: hatch colour at ({x}, {y}) in a clear triangle", s.name);
+                assert!(
+                    !hatch,
+                    "{}: hatch colour at ({x}, {y}) in a clear triangle",
+                    s.name
+                );
                 continue;
             }
             let states: Vec<i8> = tri.iter().map(|&v| d.state[v as usize]).collect();
@@ -130,16 +164,34 @@ fn check_deflection(s: &Solved, p: &Picture, layout: &MapLayout) {
         }
     }
     if d.state.iter().any(|&k| k >= 0) {
-        assert!(lattice_in > 50, "{}: {lattice_in} hatch pixels in the contact zone", s.name);
+        assert!(
+            lattice_in > 50,
+            "{}: {lattice_in} hatch pixels in the contact zone",
+            s.name
+        );
         // Contour lines, labels and markers may cover some of them.
-        assert!(hit_in as f64 >= 0.75 * lattice_in as f64, "{}: {hit_in} of {lattice_in} hatch pixels", s.name);
+        assert!(
+            hit_in as f64 >= 0.75 * lattice_in as f64,
+            "{}: {hit_in} of {lattice_in} hatch pixels",
+            s.name
+        );
     }
-    assert!(stray <= lattice_in / 50, "{}: {stray} hatch-coloured pixels off the pattern", s.name);
+    assert!(
+        stray <= lattice_in / 50,
+        "{}: {stray} hatch-coloured pixels off the pattern",
+        s.name
+    );
     // The outline passes only through triangles with contact and clear vertices (within
     // its width).
-    let near = |x: i32, y: i32| (-3..=3).any(|dy| (-3..=3).any(|dx| mixed_px.contains(&(x + dx, y + dy))));
+    let near =
+        |x: i32, y: i32| (-3..=3).any(|dy| (-3..=3).any(|dx| mixed_px.contains(&(x + dx, y + dy))));
     let far: Vec<_> = outline_px.iter().filter(|&&(x, y)| !near(x, y)).collect();
-    assert!(far.is_empty(), "{}: outline pixels away from the contact edge: {:?}", s.name, &far[..far.len().min(5)]);
+    assert!(
+        far.is_empty(),
+        "{}: outline pixels away from the contact edge: {:?}",
+        s.name,
+        &far[..far.len().min(5)]
+    );
     if d.state.iter().any(|&k| k >= 0) && d.state.iter().any(|&k| k < 0) {
         assert!(outline_px.len() > 20, "{}: the outline is drawn", s.name);
     }
@@ -153,7 +205,9 @@ fn check_liftoff(s: &Solved, p: &Picture, layout: &MapLayout) {
     let (mut n_contact, mut ok_contact, mut n_nc, mut ok_nc) = (0, 0, 0, 0);
     for y in frame.y0..frame.y1 {
         for x in frame.x0..frame.x1 {
-            let Some(t) = layout.triangle_at(x, y) else { continue };
+            let Some(t) = layout.triangle_at(x, y) else {
+                continue;
+            };
             let c: Rgb = p.canvas.get(x as u32, y as u32);
             let tri = d.triangles[t as usize];
             let cov = tri.iter().filter(|&&v| d.covered[v as usize]).count();
@@ -161,19 +215,39 @@ fn check_liftoff(s: &Solved, p: &Picture, layout: &MapLayout) {
             if cov == 0 {
                 n_nc += 1;
                 ok_nc += (c == NOT_COVERED) as usize;
-                assert_ne!(c, CONTACT, "{}: contact colour where the body cannot touch", s.name);
+                assert_ne!(
+                    c, CONTACT,
+                    "{}: contact colour where the body cannot touch",
+                    s.name
+                );
             } else if cov == 3 && con == 3 {
                 n_contact += 1;
                 ok_contact += (c == CONTACT) as usize;
             } else if cov == 3 && con == 0 {
-                assert_ne!(c, CONTACT, "{}: contact colour over lift-off at ({x}, {y})", s.name);
-                assert_ne!(c, NOT_COVERED, "{}: grey over lift-off at ({x}, {y})", s.name);
+                assert_ne!(
+                    c, CONTACT,
+                    "{}: contact colour over lift-off at ({x}, {y})",
+                    s.name
+                );
+                assert_ne!(
+                    c, NOT_COVERED,
+                    "{}: grey over lift-off at ({x}, {y})",
+                    s.name
+                );
             }
         }
     }
-    assert!(ok_contact as f64 >= 0.85 * n_contact as f64, "{}: {ok_contact}/{n_contact}", s.name);
+    assert!(
+        ok_contact as f64 >= 0.85 * n_contact as f64,
+        "{}: {ok_contact}/{n_contact}",
+        s.name
+    );
     if n_nc >= 500 {
-        assert!(ok_nc as f64 >= 0.85 * n_nc as f64, "{}: {ok_nc}/{n_nc}", s.name);
+        assert!(
+            ok_nc as f64 >= 0.85 * n_nc as f64,
+            "{}: {ok_nc}/{n_nc}",
+            s.name
+        );
     }
 }
 
@@ -184,7 +258,9 @@ fn check_profile(s: &Solved, p: &Picture) {
     let stretches = memcontact_plot::profile::contact_along(&d, &options(s));
     let shade = memcontact_plot::profile::CONTACT_SHADE;
     let col_shaded = |x: i32| {
-        let n = (ax.rect.y0..ax.rect.y1).filter(|&y| p.canvas.get(x as u32, y as u32) == shade).count();
+        let n = (ax.rect.y0..ax.rect.y1)
+            .filter(|&y| p.canvas.get(x as u32, y as u32) == shade)
+            .count();
         n as f64 / ax.rect.height() as f64
     };
     for &(a, b) in &stretches {
@@ -192,15 +268,27 @@ fn check_profile(s: &Solved, p: &Picture) {
         if xb - xa > 6.0 {
             let m = ((xa + xb) / 2.0) as i32;
             let f = (m - 3..=m + 3).map(col_shaded).fold(0.0, f64::max);
-            assert!(f > 0.7, "{}: contact stretch [{a}, {b}] shaded on {f}", s.name);
+            assert!(
+                f > 0.7,
+                "{}: contact stretch [{a}, {b}] shaded on {f}",
+                s.name
+            );
         }
     }
     // Columns well away from every stretch are not shaded.
     for x in ax.rect.x0 + 2..ax.rect.x1 - 2 {
         let s_mid = (x as f64 + 0.5 - ax.rect.x0 as f64) / ax.rect.width() as f64 * ax.x.1;
         let margin = 3.0 / ax.rect.width() as f64 * ax.x.1;
-        if stretches.iter().all(|&(a, b)| s_mid < a - margin || s_mid > b + margin) {
-            assert_eq!(col_shaded(x), 0.0, "{}: column {x} shaded outside contact", s.name);
+        if stretches
+            .iter()
+            .all(|&(a, b)| s_mid < a - margin || s_mid > b + margin)
+        {
+            assert_eq!(
+                col_shaded(x),
+                0.0,
+                "{}: column {x} shaded outside contact",
+                s.name
+            );
         }
     }
 }
@@ -217,9 +305,18 @@ fn check_case(s: Solved) {
         common::keep(f, s.name);
         assert_eq!(f.file_name().unwrap().to_string_lossy(), p.kind.file_name());
         let back = decode_png(&std::fs::read(f).unwrap()).unwrap();
-        assert!(back == p.canvas, "{}: {} differs from the rendered picture", s.name, f.display());
+        assert!(
+            back == p.canvas,
+            "{}: {} differs from the rendered picture",
+            s.name,
+            f.display()
+        );
     }
-    assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 4, "only the four PNGs");
+    assert_eq!(
+        std::fs::read_dir(dir.path()).unwrap().count(),
+        4,
+        "only the four PNGs"
+    );
     check_common(&s, &pics);
     let layout = MapLayout::new(&d);
     check_deflection(&s, &pics[0], &layout);

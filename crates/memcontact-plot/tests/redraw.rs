@@ -12,7 +12,13 @@ use std::path::Path;
 
 /// Writes a result directory the way the CLI does (plus `covered` and `plot_options`
 /// when asked).
-fn write_result(dir: &Path, d: &ResultData, opts: Option<&PlotOptions>, covered: bool, enc: VtuEncoding) {
+fn write_result(
+    dir: &Path,
+    d: &ResultData,
+    opts: Option<&PlotOptions>,
+    covered: bool,
+    enc: VtuEncoding,
+) {
     let mesh = Mesh {
         points: d.points.clone(),
         triangles: d.triangles.clone(),
@@ -20,7 +26,11 @@ fn write_result(dir: &Path, d: &ResultData, opts: Option<&PlotOptions>, covered:
     };
     let state: Vec<i32> = d.state.iter().map(|&s| s as i32).collect();
     let cov: Vec<i32> = d.covered.iter().map(|&c| c as i32).collect();
-    let pen: Vec<f64> = d.u.iter().zip(&d.phi).map(|(u, p)| (u - p).max(0.0)).collect();
+    let pen: Vec<f64> =
+        d.u.iter()
+            .zip(&d.phi)
+            .map(|(u, p)| (u - p).max(0.0))
+            .collect();
     let mut point_data = vec![
         ("u", DataArray::F64(&d.u)),
         ("phi", DataArray::F64(&d.phi)),
@@ -32,7 +42,14 @@ fn write_result(dir: &Path, d: &ResultData, opts: Option<&PlotOptions>, covered:
         point_data.push(("covered", DataArray::I32(&cov)));
     }
     let region = vec![0i32; d.triangles.len()];
-    write_vtu(&dir.join("solution.vtu"), &mesh, &point_data, &[("region", DataArray::I32(&region))], enc).unwrap();
+    write_vtu(
+        &dir.join("solution.vtu"),
+        &mesh,
+        &point_data,
+        &[("region", DataArray::I32(&region))],
+        enc,
+    )
+    .unwrap();
     let mut summary = serde_json::json!({ "case": "examples/roof.toml", "iterations": 12 });
     if let Some(o) = opts {
         summary["plot_options"] = serde_json::to_value(o).unwrap();
@@ -67,7 +84,11 @@ fn redrawn_pictures_are_byte_identical() {
         for (a, b) in at_solve.iter().zip(&redrawn) {
             assert_eq!(a.file_name(), b.file_name());
             let (x, y) = (std::fs::read(a).unwrap(), std::fs::read(b).unwrap());
-            assert!(x == y, "{:?} ({enc:?}): the redrawn picture differs", a.file_name());
+            assert!(
+                x == y,
+                "{:?} ({enc:?}): the redrawn picture differs",
+                a.file_name()
+            );
         }
     }
 }
@@ -92,7 +113,10 @@ fn missing_optional_fields_are_assumed_and_said() {
     let summary = serde_json::json!({ "case": "x", "plot_options": { "plots": ["contour"] } });
     write_json(&dir.path().join("summary.json"), &summary).unwrap();
     let e = load(dir.path()).unwrap_err().to_string();
-    assert!(e.contains("summary.json") && e.contains("plot_options"), "{e}");
+    assert!(
+        e.contains("summary.json") && e.contains("plot_options"),
+        "{e}"
+    );
     // No solution.vtu: an error naming it.
     let e = load(&dir.path().join("nowhere")).unwrap_err().to_string();
     assert!(e.contains("solution.vtu"), "{e}");
@@ -104,11 +128,32 @@ fn bad_options_are_named() {
     let d = solved.data.view();
     let dir = tempfile::tempdir().unwrap();
     let bad = [
-        (PlotOptions { allowable_pressure: Some(-1.0), ..Default::default() }, "allowable_pressure"),
-        (PlotOptions { profile: Some([[0.0, 0.0], [0.0, 0.0]]), ..Default::default() }, "profile"),
-        (PlotOptions { profile: Some([[5.0, 5.0], [6.0, 5.0]]), ..Default::default() }, "does not cross"),
         (
-            PlotOptions { plots: vec![PlotKind::Pressure, PlotKind::Pressure], ..Default::default() },
+            PlotOptions {
+                allowable_pressure: Some(-1.0),
+                ..Default::default()
+            },
+            "allowable_pressure",
+        ),
+        (
+            PlotOptions {
+                profile: Some([[0.0, 0.0], [0.0, 0.0]]),
+                ..Default::default()
+            },
+            "profile",
+        ),
+        (
+            PlotOptions {
+                profile: Some([[5.0, 5.0], [6.0, 5.0]]),
+                ..Default::default()
+            },
+            "does not cross",
+        ),
+        (
+            PlotOptions {
+                plots: vec![PlotKind::Pressure, PlotKind::Pressure],
+                ..Default::default()
+            },
             "twice",
         ),
     ];
@@ -116,26 +161,44 @@ fn bad_options_are_named() {
         let e = draw_all(dir.path(), &d, &o).unwrap_err().to_string();
         assert!(e.contains(want), "{e}");
     }
-    assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0, "no file left behind");
+    assert_eq!(
+        std::fs::read_dir(dir.path()).unwrap().count(),
+        0,
+        "no file left behind"
+    );
     let e = "contours".parse::<PlotKind>().unwrap_err().to_string();
-    assert!(e.contains("deflection, pressure, liftoff or profile"), "{e}");
+    assert!(
+        e.contains("deflection, pressure, liftoff or profile"),
+        "{e}"
+    );
     // Fields of the wrong length.
     let short = &d.u[1..];
-    let e = draw_all(dir.path(), &memcontact_plot::PlotData { u: short, ..d }, &PlotOptions::default())
-        .unwrap_err()
-        .to_string();
+    let e = draw_all(
+        dir.path(),
+        &memcontact_plot::PlotData { u: short, ..d },
+        &PlotOptions::default(),
+    )
+    .unwrap_err()
+    .to_string();
     assert!(e.contains("`u`"), "{e}");
     // Only the asked pictures are drawn; none with an empty list.
-    let o = PlotOptions { plots: vec![PlotKind::Profile], ..Default::default() };
+    let o = PlotOptions {
+        plots: vec![PlotKind::Profile],
+        ..Default::default()
+    };
     let files = draw_all(dir.path(), &d, &o).unwrap();
     assert_eq!(files, vec![dir.path().join("profile.png")]);
-    let o = PlotOptions { plots: vec![], ..Default::default() };
+    let o = PlotOptions {
+        plots: vec![],
+        ..Default::default()
+    };
     assert!(draw_all(dir.path(), &d, &o).unwrap().is_empty());
 }
 
 #[test]
 fn options_round_trip_through_json_with_defaults() {
-    let o: PlotOptions = serde_json::from_str(r#"{"allowable_pressure": 150, "units": {"length": "m"}}"#).unwrap();
+    let o: PlotOptions =
+        serde_json::from_str(r#"{"allowable_pressure": 150, "units": {"length": "m"}}"#).unwrap();
     assert_eq!(o.plots, PlotKind::ALL.to_vec());
     assert_eq!(o.allowable_pressure, Some(150.0));
     assert_eq!(o.units.length.as_deref(), Some("m"));

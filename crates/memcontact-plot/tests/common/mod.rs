@@ -30,7 +30,14 @@ pub enum H {
 }
 
 /// Solves a case on `hierarchy`'s finest mesh.
-pub fn solve_case(name: &'static str, hierarchy: Hierarchy, t: f64, f: &str, phi: &str, h: H) -> Solved {
+pub fn solve_case(
+    name: &'static str,
+    hierarchy: Hierarchy,
+    t: f64,
+    f: &str,
+    phi: &str,
+    h: H,
+) -> Solved {
     let mesh = hierarchy.finest();
     let mut tags = mesh.regions.clone();
     tags.sort_unstable();
@@ -77,7 +84,14 @@ pub fn solve_case(name: &'static str, hierarchy: Hierarchy, t: f64, f: &str, phi
 /// `examples/disk.toml`: the elastic disc.
 pub fn disk() -> Solved {
     let mesh = generate::disk([0.0, 0.0], 1.0, 0.1).unwrap();
-    solve_case("disk", Hierarchy::single(mesh), 1.0, "8", "1.0", H::Field(Field::Constant(100.0)))
+    solve_case(
+        "disk",
+        Hierarchy::single(mesh),
+        1.0,
+        "8",
+        "1.0",
+        H::Field(Field::Constant(100.0)),
+    )
 }
 
 /// `examples/disk-step.toml`: the disc on a stepped obstacle.
@@ -121,7 +135,10 @@ pub fn roof() -> Solved {
     let spec = PolygonSpec {
         outer: vec![[0.0, 0.0], [12.0, 0.0], [12.0, 8.0], [0.0, 8.0]],
         holes: vec![vec![[7.0, 3.0], [9.0, 3.0], [9.0, 5.0], [7.0, 5.0]]],
-        regions: vec![("block".into(), vec![[1.5, 2.5], [5.0, 2.5], [5.0, 5.5], [1.5, 5.5]])],
+        regions: vec![(
+            "block".into(),
+            vec![[1.5, 2.5], [5.0, 2.5], [5.0, 5.5], [1.5, 5.5]],
+        )],
         size: 0.25,
         min_angle: 28.0,
     };
