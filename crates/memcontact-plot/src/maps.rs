@@ -438,19 +438,25 @@ pub(crate) fn render(
                 Some((map, &norm, (lo, hi), format!("u{unit}"))),
                 &mut boxes,
             );
-            let mut entries = vec![
-                (
-                    Swatch::Line(OUTLINE, 2.6),
-                    "contact zone outline".to_string(),
-                ),
-                (Swatch::Hatch(true), "penetrating (u > φ)".to_string()),
-                (Swatch::Hatch(false), "touching (u = φ)".to_string()),
-            ];
-            if markers {
+            let n_pen = data.state.iter().filter(|&&st| st == 1).count();
+            let n_touch = data.state.iter().filter(|&&st| st == 0).count();
+            let mut entries = vec![(
+                Swatch::Line(OUTLINE, 2.6),
+                "contact zone outline".to_string(),
+            )];
+            if n_pen > 0 {
+                entries.push((Swatch::Hatch(true), "penetrating (u > φ)".into()));
+            }
+            if n_touch > 0 {
+                entries.push((Swatch::Hatch(false), "touching (u = φ)".into()));
+            }
+            if markers && n_pen > 0 {
                 entries.push((
                     Swatch::Disc(PEN_MARK, MARK_LIGHT),
                     "penetrating vertex".into(),
                 ));
+            }
+            if markers && n_touch > 0 {
                 entries.push((
                     Swatch::Disc(MARK_LIGHT, MARK_DARK),
                     "touching vertex".into(),
@@ -617,9 +623,7 @@ pub(crate) fn render(
                     Swatch::Patch(colormap::blues().at(0.6)),
                     format!("lift-off (u < φ) {:.1} %", pct(areas.liftoff)),
                 ),
-                (Swatch::Patch(NOT_COVERED), "body cannot touch".into()),
                 (Swatch::Line(OUTLINE, 2.4), "contact zone outline".into()),
-                (Swatch::Dashed([60, 60, 60], 1.6), "edge of the body".into()),
                 (
                     Swatch::None,
                     format!(
@@ -635,6 +639,13 @@ pub(crate) fn render(
                     ),
                 ),
             ];
+            if data.covered.iter().any(|&c| !c) {
+                entries.insert(2, (Swatch::Patch(NOT_COVERED), "body cannot touch".into()));
+                entries.insert(
+                    4,
+                    (Swatch::Dashed([60, 60, 60], 1.6), "edge of the body".into()),
+                );
+            }
             if gr.is_none() {
                 entries.push((Swatch::None, "no lift-off".into()));
             } else {

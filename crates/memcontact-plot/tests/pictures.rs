@@ -353,3 +353,30 @@ fn gmsh_disk_pictures() {
 fn half_covered_pictures() {
     check_case(common::half_covered());
 }
+
+#[test]
+fn disk_rigid_pictures() {
+    check_case(common::disk_rigid());
+}
+
+#[test]
+fn manufactured_square_pictures() {
+    let s = common::manufactured_square();
+    let d = s.data.view();
+    // Coarse: the markers are drawn, and the pixel under each contact vertex shows its
+    // state's marker colour (orange penetrating, light touching).
+    let pics = render(&d, &options(&s)).unwrap();
+    assert!(pics[0].markers);
+    let layout = MapLayout::new(&d);
+    for (v, &st) in d.state.iter().enumerate() {
+        let (x, y) = layout.transform.pixel_of(d.points[v]);
+        let c = pics[0].canvas.get(x as u32, y as u32);
+        match st {
+            1 => assert_eq!(c, [255, 120, 0], "vertex {v}"),
+            0 => assert_eq!(c, [250, 250, 250], "vertex {v}"),
+            _ => assert!(c != [255, 120, 0] && c != [250, 250, 250], "vertex {v}"),
+        }
+    }
+    assert!(d.state.iter().any(|&st| st >= 0), "the case has contact");
+    check_case(s);
+}

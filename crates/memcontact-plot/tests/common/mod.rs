@@ -200,6 +200,41 @@ pub fn half_covered() -> Solved {
     )
 }
 
+/// `examples/disk-rigid.toml`: the disc on a rigid flat obstacle.
+pub fn disk_rigid() -> Solved {
+    let mesh = generate::disk([0.0, 0.0], 1.0, 0.1).unwrap();
+    solve_case(
+        "disk-rigid",
+        Hierarchy::single(mesh),
+        1.0,
+        "8",
+        "1.0",
+        H::Rigid,
+    )
+}
+
+/// `examples/manufactured-square.toml` (the case's own load): an 8 × 8 mesh, coarse
+/// enough that vertex markers are drawn.
+pub fn manufactured_square() -> Solved {
+    let spec = RectangleSpec {
+        x0: 0.0,
+        y0: 0.0,
+        x1: 1.0,
+        y1: 1.0,
+        nx: 8,
+        ny: 8,
+        diagonal: Diagonal::Right,
+    };
+    solve_case(
+        "manufactured-square",
+        generate::rectangle(&spec).unwrap(),
+        1.5,
+        "30",
+        "0.55 + 0.3*(x - 0.5)^2 + 0.1*y",
+        H::Field(Field::parse("50*(1 + y)").unwrap()),
+    )
+}
+
 /// The repository's `examples/` folder.
 pub fn examples() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples")
