@@ -191,3 +191,59 @@ pub fn render_line_plot(plot: &LinePlot) -> Result<Canvas> {
 pub fn line_plot(path: &Path, plot: &LinePlot) -> Result<()> {
     render_line_plot(plot)?.write_png(path)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn force_deflection_curves_are_drawn_with_legend_and_gaps() {
+        let load: Vec<f64> = (0..10).map(|k| 0.2 * (k + 1) as f64).collect();
+        let plot = LinePlot {
+            title: "Force-deflection: examples/roof.toml".into(),
+            x_label: "load factor".into(),
+            y_label: "max deflection [m]".into(),
+            series: vec![
+                Series {
+                    name: "warm start".into(),
+                    points: load.iter().map(|&l| (l, 0.3 * l.powf(0.8))).collect(),
+                },
+                Series {
+                    name: "cold start".into(),
+                    // a failed step leaves a gap
+                    points: load
+                        .iter()
+                        .map(|&l| (l, if l == 1.0 { f64::NAN } else { 0.25 * l }))
+                        .collect(),
+                },
+            ],
+        };
+        let c = render_line_plot(&plot).unwrap();
+        assert_eq!((c.width, c.height), (LINE_WIDTH, LINE_HEIGHT));
+        for col in &COLORS[..2] {
+            let n = c.rgb.chunks_exact(3).filter(|p| p == col).count();
+            assert!(n > 300, "series colour {col:?}: {n} pixels");
+        }
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("force-deflection.png");
+        line_plot(&path, &plot).unwrap();
+        let back = crate::canvas::decode_png(&std::fs::read(&path).unwrap()).unwrap();
+        assert_eq!(back, c);
+        if let Ok(keep) = std::env::var("MEMCONTACT_KEEP_PLOTS") {
+            std::fs::copy(
+                &path,
+                std::path::Path::new(&keep).join("force-deflection.png"),
+            )
+            .unwrap();
+        }
+        let empty = LinePlot {
+            series: vec![Series {
+                name: "none".into(),
+                points: vec![(f64::NAN, 1.0)],
+            }],
+            ..plot
+        };
+        let e = render_line_plot(&empty).unwrap_err().to_string();
+        assert!(e.contains("no point"), "{e}");
+    }
+}
