@@ -150,6 +150,11 @@ fn main() {
         draw_all(dir.path(), &data, &options).expect("draw");
     });
     println!("{:<28} {:>8.3} s", "draw_all (all four, files)", t);
+    let path = dir.path().join("field.png");
+    let t = best(&mut || {
+        memcontact_plot::field_plot(&path, pts, &mesh.triangles, &u, "u").expect("field plot");
+    });
+    println!("{:<28} {:>8.3} s", "field_plot (u only, file)", t);
     let c0 = cpu_seconds();
     let t0 = Instant::now();
     let files = draw_all(dir.path(), &data, &options).expect("draw");
