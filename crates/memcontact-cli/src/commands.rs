@@ -68,14 +68,17 @@ pub fn solve(case_path: &Path, flags: &SolveFlags) -> Result<()> {
                 .unwrap_or_default()
         );
     }
+    let label = case_path.display().to_string();
+    let plots = output::plot_options(&case, &label);
     let options = WriteOptions {
-        label: case_path.display().to_string(),
+        label,
         vtu: case.output.vtu,
         force: flags.force,
         started,
+        plot_options: serde_json::to_value(&plots).ok(),
     };
     let summary = {
-        let mut pictures = output::pictures(&case, &outcome, &options.label);
+        let mut pictures = output::pictures(&outcome, &plots);
         write_result_set(flags.out, &outcome, &case, &options, &mut pictures)?
     };
     print!(

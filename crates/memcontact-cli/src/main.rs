@@ -7,7 +7,7 @@ mod convergence;
 mod examples;
 mod help;
 mod output;
-mod plot;
+mod plot_cmd;
 
 use clap::{Parser, Subcommand};
 use std::path::PathBuf;
@@ -84,6 +84,9 @@ enum Command {
         #[arg(long)]
         phases: bool,
     },
+    /// Redraw the pictures of a result directory (deflection.png, pressure.png,
+    /// liftoff.png, profile.png) from its solution.vtu and summary.json, without solving.
+    Plot(plot_cmd::Args),
     /// List the example cases, or write one (and any mesh it needs) to a directory.
     Example {
         /// The example to write; omit to list them.
@@ -128,6 +131,7 @@ fn main() -> ExitCode {
         ),
         Command::Check { case, sets } => commands::check(&case, &sets),
         Command::Convergence(args) => convergence::run(&args),
+        Command::Plot(args) => plot_cmd::run(&args),
         Command::Example { name, dir, force } => examples::run(name.as_deref(), &dir, force),
         Command::Bench {
             sizes,
