@@ -8,6 +8,7 @@ mod examples;
 mod help;
 mod output;
 mod plot_cmd;
+mod progress;
 
 use clap::{Parser, Subcommand};
 use std::path::PathBuf;
@@ -46,9 +47,12 @@ enum Command {
         /// Override a case key, e.g. --set mesh.nx=128 --set obstacle.foundation=lumped.
         #[arg(long = "set", value_name = "KEY=VALUE")]
         sets: Vec<String>,
-        /// Print no progress lines.
+        /// Show no progress.
         #[arg(short, long)]
         quiet: bool,
+        /// Print every phase and iteration (energy J and the KKT residual).
+        #[arg(short, long, conflicts_with = "quiet")]
+        verbose: bool,
         /// Replace the output directory even if it holds files that are not a result.
         #[arg(long)]
         force: bool,
@@ -117,6 +121,7 @@ fn main() -> ExitCode {
             output,
             sets,
             quiet,
+            verbose,
             force,
             write_unconverged,
         } => commands::solve(
@@ -124,7 +129,7 @@ fn main() -> ExitCode {
             &commands::SolveFlags {
                 out: &output,
                 sets: &sets,
-                quiet,
+                verbosity: progress::Verbosity::of(quiet, verbose),
                 force,
                 write_unconverged,
             },
