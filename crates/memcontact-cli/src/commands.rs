@@ -1,9 +1,10 @@
 //! The `solve` and `check` commands: thin shells over the library's run.
 
 use crate::output;
-use anyhow::{bail, Result};
-use memcontact::output::{write_result_set, WriteOptions};
 use crate::progress::{Progress, Verbosity};
+use anyhow::{bail, Result};
+use memcontact::io::result_set::ResultSet;
+use memcontact::output::{write_files, write_result_set, write_sweep_csv, WriteOptions};
 use memcontact::{Case, Discretization, Outcome};
 use std::path::Path;
 use std::time::Instant;
@@ -33,6 +34,9 @@ pub struct SolveFlags<'a> {
 pub fn solve(case_path: &Path, flags: &SolveFlags) -> Result<()> {
     let started = Instant::now();
     let case = Case::load(case_path, flags.sets)?;
+    if case.sweep.is_some() || !case.load_cases.is_empty() {
+        return sweep(case_path, &case, flags, started);
+    }
     let mut progress = Progress::new(flags.verbosity);
     let outcome = memcontact::run(&case.problem, &case.settings, &mut progress)?;
     progress.finish();
@@ -83,6 +87,107 @@ pub fn solve(case_path: &Path, flags: &SolveFlags) -> Result<()> {
     // The process ends right after this: returning the (possibly gigabytes of) mesh
     // levels and matrices to the allocator page by page would only delay the exit.
     std::mem::forget(outcome);
+    Ok(())
+}
+
+/// `memcontact solve` on a case with `[sweep]` or `[[load_case]]`: every step in turn,
+/// warm-started from the previous one, written into one result set: a subdirectory per
+/// step, `sweep.csv` and `sweep.png` (the force-deflection curve).
+fn sweep(case_path: &Path, case: &Case, flags: &SolveFlags, started: Instant) -> Result<()> {
+    let label = case_path.display().to_string();
+    let plots = output::plot_options(case, &label);
+    let set = ResultSet::begin(flags.out, flags.force)?;
+    let steps = memcontact::sweep::steps(case)?;
+    let total = steps.len();
+    let mut progress = Progress::new(flags.verbosity);
+    let mut rows = Vec::new();
+    let mut written = 0;
+    let result =
+        memcontact::sweep::run_sweep(case, true, &mut progress, &mut |step, outcome, row| {
+            rows.push(row.clone());
+            if !outcome.report.accepted && !flags.write_unconverged {
+                return Ok(());
+            }
+            let dir = set.dir().join(&step.name);
+            std::fs::create_dir(&dir).map_err(|source| memcontact::Error::Io {
+                path: dir.clone(),
+                source,
+            })?;
+            let options = WriteOptions {
+                label: format!("{label} [{}]", step.name),
+                vtu: case.output.vtu,
+                force: false,
+                started: Instant::now(),
+                plot_options: serde_json::to_value(&plots).ok(),
+            };
+            let mut step_plots = plots.clone();
+            step_plots.title = Some(options.label.clone());
+            let mut pictures = output::pictures(outcome, &step_plots);
+            write_files(&dir, outcome, case, &options, &mut pictures)?;
+            written += 1;
+            Ok(())
+        });
+    progress.finish();
+    let result = match result {
+        Err(e) if !flags.write_unconverged => return Err(e.into()),
+        other => other.map(|_| ()),
+    };
+    let (tag, value_name) = match &case.sweep {
+        Some(s) => ("sweep", s.parameter.name().replace('_', " ")),
+        None => ("load cases", "load factor".to_string()),
+    };
+    write_sweep_csv(&set.dir().join("sweep.csv"), &rows)?;
+    let force = match &case.units.force {
+        Some(f) => format!(" [{f}]"),
+        None => String::new(),
+    };
+    let length = match &case.units.length {
+        Some(l) => format!(" [{l}]"),
+        None => String::new(),
+    };
+    memcontact_plot::line_plot(
+        &set.dir().join("sweep.png"),
+        &memcontact_plot::LinePlot {
+            title: format!("Force-deflection ({tag}): {label}"),
+            x_label: format!("max deflection{length}"),
+            y_label: format!("force{force}"),
+            series: vec![memcontact_plot::Series {
+                name: "total contact force".into(),
+                points: rows
+                    .iter()
+                    .map(|r| (r.max_deflection, r.total_contact_force))
+                    .collect(),
+            }],
+        },
+    )?;
+    set.commit()?;
+    println!("memcontact: {label} ({tag}: {total} steps, {value_name})");
+    println!(
+        "  {:>5} {:>16} {:>12} {:>12} {:>12} {:>12} {:>6} {:>10}",
+        "step", "name", "value", "max |u|", "contact area", "force", "iters", "KKT"
+    );
+    for r in &rows {
+        println!(
+            "  {:>5} {:>16} {:>12.5e} {:>12.5e} {:>12.5e} {:>12.5e} {:>6} {:>10.3e}",
+            r.step,
+            r.name,
+            r.value,
+            r.max_deflection,
+            r.contact_area,
+            r.total_contact_force,
+            r.iterations,
+            r.kkt_residual
+        );
+    }
+    let iterations: usize = rows.iter().map(|r| r.iterations).sum();
+    println!(
+        "  total        {iterations} iterations, {:.3} s; wrote {}/{{{} step directories, \
+         sweep.csv, sweep.png}}",
+        started.elapsed().as_secs_f64(),
+        flags.out.display(),
+        written
+    );
+    result?;
     Ok(())
 }
 

@@ -59,6 +59,14 @@ impl Progress {
         }
     }
 
+    /// Sets the prefix of the messages (e.g. `step 3/10: `).
+    pub fn set_prefix(&mut self, prefix: &str) {
+        self.prefix = prefix.to_string();
+        if let Some(b) = &self.bar {
+            b.set_prefix(prefix.to_string());
+        }
+    }
+
     /// Removes the spinner.
     pub fn finish(&self) {
         if let Some(b) = &self.bar {
@@ -98,6 +106,10 @@ impl Observer for Progress {
         if self.verbosity == Verbosity::Verbose {
             eprintln!("  {}{name} …", self.prefix);
         }
+    }
+
+    fn step_started(&mut self, index: usize, total: usize, name: &str) {
+        self.set_prefix(&format!("step {}/{total} ({name}): ", index + 1));
     }
 
     fn phase_finished(&mut self, name: &str, seconds: f64) {

@@ -28,6 +28,7 @@ pub mod run;
 pub mod solve;
 pub mod sparse;
 pub mod summary;
+pub mod sweep;
 
 pub use error::{Error, Result};
 pub use problem::{Case, Problem};

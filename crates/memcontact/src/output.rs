@@ -11,6 +11,7 @@ use crate::problem::{Case, VtuFormat};
 use crate::results::NodalFields;
 use crate::run::Outcome;
 use crate::summary::{FileRecord, Summary};
+use crate::sweep::StepRow;
 use crate::{Error, Result};
 use std::path::Path;
 use std::time::Instant;
@@ -115,9 +116,39 @@ pub fn write_fields(
     write_columns_csv(&dir.join("nodes.csv"), &columns)
 }
 
-/// Writes the result set of `outcome` into `target` atomically: `solution.vtu`,
-/// `nodes.csv`, what `extra` writes into the staging directory it is given (it returns the
-/// names of its files), and `summary.json` last. Returns the summary written.
+/// Writes the files of `outcome` into the directory `dir` (which must exist and is not
+/// replaced: use [`write_result_set`] for an atomic set): `solution.vtu`, `nodes.csv`,
+/// what `extra` writes (it returns the names of its files), and `summary.json` last.
+/// Returns the summary written.
+pub fn write_files(
+    dir: &Path,
+    outcome: &Outcome,
+    case: &Case,
+    options: &WriteOptions,
+    extra: &mut dyn FnMut(&Path, &NodalFields) -> Result<Vec<String>>,
+) -> Result<Summary> {
+    let t0 = Instant::now();
+    let (fields, totals) = outcome.fields();
+    write_fields(dir, outcome, &fields, options.vtu)?;
+    let mut names = vec!["solution.vtu".to_string(), "nodes.csv".to_string()];
+    names.extend(extra(dir, &fields)?);
+    let quality = outcome.mesh().quality();
+    let mut summary = Summary::new(&options.label, outcome, &quality, &totals);
+    summary.run_id = new_run_id();
+    summary.input_hash = input_hash(case);
+    summary.plot_options = options.plot_options.clone();
+    for name in names {
+        let record = file_record(&dir.join(&name))?;
+        summary.files.insert(name, record);
+    }
+    summary.time_write_s = t0.elapsed().as_secs_f64();
+    summary.time_total_s = options.started.elapsed().as_secs_f64();
+    write_json(&dir.join("summary.json"), &summary)?;
+    Ok(summary)
+}
+
+/// Writes the result set of `outcome` into `target` atomically ([`ResultSet`]): the files
+/// of [`write_files`], moved into place together. Returns the summary written.
 pub fn write_result_set(
     target: &Path,
     outcome: &Outcome,
@@ -125,24 +156,34 @@ pub fn write_result_set(
     options: &WriteOptions,
     extra: &mut dyn FnMut(&Path, &NodalFields) -> Result<Vec<String>>,
 ) -> Result<Summary> {
-    let t0 = Instant::now();
     let set = ResultSet::begin(target, options.force)?;
-    let (fields, totals) = outcome.fields();
-    write_fields(set.dir(), outcome, &fields, options.vtu)?;
-    let mut names = vec!["solution.vtu".to_string(), "nodes.csv".to_string()];
-    names.extend(extra(set.dir(), &fields)?);
-    let quality = outcome.mesh().quality();
-    let mut summary = Summary::new(&options.label, outcome, &quality, &totals);
-    summary.run_id = new_run_id();
-    summary.input_hash = input_hash(case);
-    summary.plot_options = options.plot_options.clone();
-    for name in names {
-        let record = file_record(&set.dir().join(&name))?;
-        summary.files.insert(name, record);
-    }
-    summary.time_write_s = t0.elapsed().as_secs_f64();
-    summary.time_total_s = options.started.elapsed().as_secs_f64();
-    write_json(&set.dir().join("summary.json"), &summary)?;
+    let summary = write_files(set.dir(), outcome, case, options, extra)?;
     set.commit()?;
     Ok(summary)
+}
+
+/// Writes `sweep.csv`: one row per step, with the columns of [`StepRow::HEADER`].
+pub fn write_sweep_csv(path: &Path, rows: &[StepRow]) -> Result<()> {
+    let mut text = StepRow::HEADER.join(",");
+    text.push('\n');
+    for r in rows {
+        // `{:e}` is the shortest representation that reads back exactly.
+        let cells = [
+            r.step.to_string(),
+            r.name.clone(),
+            format!("{:e}", r.value),
+            format!("{:e}", r.max_deflection),
+            format!("{:e}", r.contact_area),
+            format!("{:e}", r.liftoff_area),
+            format!("{:e}", r.total_contact_force),
+            format!("{:e}", r.max_pressure),
+            format!("{:e}", r.energy),
+            r.iterations.to_string(),
+            format!("{:e}", r.kkt_residual),
+            format!("{:e}", r.seconds),
+        ];
+        text.push_str(&cells.join(","));
+        text.push('\n');
+    }
+    crate::io::write_atomic(path, |w| w.write_all(text.as_bytes()))
 }

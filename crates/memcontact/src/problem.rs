@@ -39,6 +39,10 @@ pub struct Case {
     pub exact: Option<ExactSpec>,
     /// `[units]`: the names of the case's units, for labels.
     pub units: Units,
+    /// `[sweep]`: one parameter varied over a list of values.
+    pub sweep: Option<crate::sweep::SweepSpec>,
+    /// `[[load_case]]`: named combinations overriding the case's data.
+    pub load_cases: Vec<crate::sweep::LoadCase>,
 }
 
 /// `[units]`: the names of the length and force units the case's numbers are in (the
@@ -69,6 +73,10 @@ struct CaseFile {
     exact: Option<ExactSpec>,
     #[serde(default)]
     units: Units,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    sweep: Option<crate::sweep::SweepSpec>,
+    #[serde(default, rename = "load_case", skip_serializing_if = "Vec::is_empty")]
+    load_cases: Vec<crate::sweep::LoadCase>,
 }
 
 impl From<CaseFile> for Case {
@@ -83,6 +91,8 @@ impl From<CaseFile> for Case {
             output: c.output,
             exact: c.exact,
             units: c.units,
+            sweep: c.sweep,
+            load_cases: c.load_cases,
         }
     }
 }
@@ -97,6 +107,8 @@ impl From<Case> for CaseFile {
             output: c.output,
             exact: c.exact,
             units: c.units,
+            sweep: c.sweep,
+            load_cases: c.load_cases,
         }
     }
 }
@@ -881,6 +893,7 @@ impl Case {
         self.problem.validate()?;
         self.settings.validate()?;
         self.output.validate()?;
+        crate::sweep::validate(self)?;
         if let Some(ExactSpec::Manufactured { amplitude, .. }) = &self.exact {
             if !(amplitude.is_finite() && *amplitude != 0.0) {
                 return Err(Invalid::new(

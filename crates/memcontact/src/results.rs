@@ -45,6 +45,11 @@ pub struct Totals {
     pub total_contact_force: f64,
     /// The largest |u|.
     pub max_deflection: f64,
+    /// Area where the body lies under the membrane but the membrane is clear of it
+    /// (nodal areas of the covered unknowns with U < φ).
+    pub liftoff_area: f64,
+    /// The largest contact pressure.
+    pub max_pressure: f64,
     /// The smallest u.
     pub min_u: f64,
     /// The largest u.
@@ -99,13 +104,24 @@ pub fn derive_from(mesh: &Mesh, model: &Model, u_dofs: &[f64]) -> (NodalFields, 
         })
         .collect();
     let count = |s: i8| states.iter().filter(|&&x| x == s).count();
-    let contact_area = (0..nv)
-        .filter(|&v| state[v] >= 0)
-        .map(|v| nodal_area[v])
-        .sum();
+    // (An empty f64 sum is −0.)
+    let contact_area = 0.0
+        + (0..nv)
+            .filter(|&v| state[v] >= 0)
+            .map(|v| nodal_area[v])
+            .sum::<f64>();
+    let covered: Vec<bool> = model.h_vertices.iter().map(|&h| h > 0.0).collect();
+    let liftoff_area = 0.0
+        + (0..nv)
+            .filter(|&v| covered[v] && state[v] < 0 && !mesh_boundary(dofs, v))
+            .map(|v| nodal_area[v])
+            .sum::<f64>();
+    let max_pressure = pressure.iter().cloned().fold(0.0f64, f64::max);
     let max_u = u.iter().cloned().fold(f64::NEG_INFINITY, f64::max);
     let min_u = u.iter().cloned().fold(f64::INFINITY, f64::min);
     let totals = Totals {
+        liftoff_area,
+        max_pressure,
         contact_vertices: count(0) + count(1),
         touching_vertices: count(0),
         penetrating_vertices: count(1),
@@ -125,8 +141,13 @@ pub fn derive_from(mesh: &Mesh, model: &Model, u_dofs: &[f64]) -> (NodalFields, 
             pressure,
             contact_force,
             state,
-            covered: model.h_vertices.iter().map(|&h| h > 0.0).collect(),
+            covered,
         },
         totals,
     )
+}
+
+/// `true` for a vertex that carries no unknown (on the fixed boundary).
+fn mesh_boundary(dofs: &crate::mesh::DofMap, v: usize) -> bool {
+    dofs.dof[v].is_none()
 }

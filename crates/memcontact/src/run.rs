@@ -159,9 +159,20 @@ impl Discretization {
 
     /// Solves the discrete problem with `settings`.
     pub fn solve(&self, settings: &Settings, observer: &mut dyn Observer) -> Result<Report> {
+        self.solve_from(settings, None, observer)
+    }
+
+    /// Solves the discrete problem with `settings`, starting from `start` (U over the
+    /// unknowns, e.g. the answer of a neighbouring load step) when given.
+    pub fn solve_from(
+        &self,
+        settings: &Settings,
+        start: Option<&[f64]>,
+        observer: &mut dyn Observer,
+    ) -> Result<Report> {
         observer.phase_started("solve");
         let t0 = Instant::now();
-        let a = solve::attempt(&self.model, self.levels(), settings, observer)?;
+        let a = solve::attempt_from(&self.model, self.levels(), settings, start, observer)?;
         let seconds = t0.elapsed().as_secs_f64();
         observer.phase_finished("solve", seconds);
         let mut phases = self.phases.clone();

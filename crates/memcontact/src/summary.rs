@@ -85,6 +85,10 @@ pub struct Summary {
     pub total_contact_force: f64,
     /// max |u|.
     pub max_deflection: f64,
+    /// Area covered by the body where the membrane is clear of it.
+    pub liftoff_area: f64,
+    /// The largest contact pressure.
+    pub max_pressure: f64,
     /// min u.
     pub min_u: f64,
     /// max u.
@@ -177,6 +181,8 @@ impl Summary {
             total_load: totals.total_load,
             total_contact_force: totals.total_contact_force,
             max_deflection: totals.max_deflection,
+            liftoff_area: totals.liftoff_area,
+            max_pressure: totals.max_pressure,
             min_u: totals.min_u,
             max_u: totals.max_u,
             history: r.history.clone(),

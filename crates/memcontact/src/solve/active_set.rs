@@ -31,7 +31,16 @@ pub(crate) const MAX_ITERATIONS: usize = 500;
 
 /// A starting point: zero, moved below φ where the obstacle is rigid.
 pub fn feasible_start(model: &Model) -> Vec<f64> {
-    let mut v: Vec<f64> = vec![0.0; model.n()];
+    start_from(model, None)
+}
+
+/// The start of an iteration: `start` (a warm start) or zero, projected below φ on M for
+/// the rigid obstacle.
+pub fn start_from(model: &Model, start: Option<&[f64]>) -> Vec<f64> {
+    let mut v: Vec<f64> = match start {
+        Some(s) => s.to_vec(),
+        None => vec![0.0; model.n()],
+    };
     if model.is_rigid() {
         for ((vi, fi), &c) in v.iter_mut().zip(&model.phi).zip(&model.can_touch) {
             if c {

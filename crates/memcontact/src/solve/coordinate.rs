@@ -13,9 +13,19 @@ pub(crate) const MAX_SWEEPS: usize = 1_000_000;
 
 /// Sweeps until the KKT residual is below the tolerance (checked every few sweeps).
 pub fn solve(model: &Model, settings: &Settings, observer: &mut dyn Observer) -> Result<Solution> {
+    solve_from(model, settings, None, observer)
+}
+
+/// [`solve`] from `start` (made feasible for a rigid obstacle) when given.
+pub fn solve_from(
+    model: &Model,
+    settings: &Settings,
+    start: Option<&[f64]>,
+    observer: &mut dyn Observer,
+) -> Result<Solution> {
     let mut timer = PhaseTimer::default();
     let max = settings.max_iterations.unwrap_or(MAX_SWEEPS);
-    let mut v = super::active_set::feasible_start(model);
+    let mut v = super::active_set::start_from(model, start);
     let mut history = Vec::new();
     let mut sweeps = 0;
     let mut check_every = 1;

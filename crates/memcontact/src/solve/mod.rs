@@ -159,6 +159,8 @@ pub trait Observer {
     fn phase_started(&mut self, _name: &str) {}
     /// A phase of the run ends after `seconds`.
     fn phase_finished(&mut self, _name: &str, _seconds: f64) {}
+    /// Step `index` (0-based) of `total` of a sweep starts.
+    fn step_started(&mut self, _index: usize, _total: usize, _name: &str) {}
 }
 
 /// An observer that ignores everything.
@@ -359,13 +361,14 @@ fn run_method(
     model: &Model,
     hierarchy: Option<&Hierarchy>,
     settings: &Settings,
+    start: Option<&[f64]>,
     observer: &mut dyn Observer,
 ) -> Result<(Solution, Status, Option<String>)> {
     let result = match method {
         Method::Linear => linear::solve(model, settings),
         Method::ActiveSet => active_set::solve(model, settings, observer),
         Method::Qp => qp::solve(model, settings),
-        Method::Coordinate => coordinate::solve(model, settings, observer),
+        Method::Coordinate => coordinate::solve_from(model, settings, start, observer),
         Method::Multigrid => {
             let h = hierarchy.ok_or_else(|| Error::Solver {
                 solver: "multigrid".into(),
@@ -468,13 +471,34 @@ pub fn attempt(
     settings: &Settings,
     observer: &mut dyn Observer,
 ) -> Result<Attempt> {
+    attempt_from(model, hierarchy, settings, None, observer)
+}
+
+/// [`attempt`] from a given iterate (a warm start; methods without one ignore it). A start
+/// of the wrong length is an error.
+pub fn attempt_from(
+    model: &Model,
+    hierarchy: Option<&Hierarchy>,
+    settings: &Settings,
+    start: Option<&[f64]>,
+    observer: &mut dyn Observer,
+) -> Result<Attempt> {
     settings.validate().map_err(|e| e.into_error())?;
+    if let Some(s) = start {
+        if s.len() != model.n() || s.iter().any(|v| !v.is_finite()) {
+            return Err(Error::Data(format!(
+                "the start iterate has {} values (finite ones needed), the problem {} unknowns",
+                s.len(),
+                model.n()
+            )));
+        }
+    }
     let (method, choice) = match settings.method {
         Method::Auto => auto_choice(model, hierarchy),
         m => (m, Choice::Requested),
     };
     let (mut solution, mut status, mut message) =
-        run_method(method, model, hierarchy, settings, observer)?;
+        run_method(method, model, hierarchy, settings, start, observer)?;
     let mut fallback = None;
     if settings.method == Method::Auto
         && method == Method::Multigrid
@@ -486,8 +510,14 @@ pub fn attempt(
             residual: solution.certificate.kkt(),
             message: message.take(),
         });
-        (solution, status, message) =
-            run_method(Method::ActiveSet, model, hierarchy, settings, observer)?;
+        (solution, status, message) = run_method(
+            Method::ActiveSet,
+            model,
+            hierarchy,
+            settings,
+            start,
+            observer,
+        )?;
     }
     Ok(Attempt {
         solution,

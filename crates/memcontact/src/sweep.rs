@@ -1,0 +1,560 @@
+//! Load sweeps and load combinations. A tensionless foundation cannot be superposed: every
+//! load level or combination is its own nonlinear solve. A sweep varies one parameter
+//! (`[sweep]`); load cases override the base case's data (`[[load_case]]`). Steps run in
+//! turn on one mesh, each warm-started from the previous answer.
+//!
+//! A sweep parameter enters the discrete model linearly, so a step scales the assembled
+//! base model instead of assembling again: the load factor scales D, the stiffness factor
+//! L, the tension S, and the obstacle offset adds to φₙ. A load case with new data
+//! assembles once on the same mesh.
+
+use crate::field::{Field, Stiffness};
+use crate::model::{FoundationMatrix, Model};
+use crate::problem::{Case, Invalid, Problem};
+use crate::run::{Discretization, Outcome};
+use crate::solve::Observer;
+use crate::{Error, Result};
+use serde::{Deserialize, Serialize};
+use std::time::Instant;
+
+/// The parameter a `[sweep]` varies.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum SweepParameter {
+    /// Scales the load f.
+    LoadFactor,
+    /// Scales the stiffness h.
+    StiffnessFactor,
+    /// The tension t.
+    Tension,
+    /// Added to the obstacle's surface φ.
+    ObstacleOffset,
+}
+
+impl SweepParameter {
+    /// The name used in case files.
+    pub fn name(self) -> &'static str {
+        match self {
+            SweepParameter::LoadFactor => "load_factor",
+            SweepParameter::StiffnessFactor => "stiffness_factor",
+            SweepParameter::Tension => "tension",
+            SweepParameter::ObstacleOffset => "obstacle_offset",
+        }
+    }
+}
+
+/// `[sweep]`: one parameter over a list of values (`values`, or `from`, `to`, `steps`
+/// evenly spaced, both ends included).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SweepSpec {
+    /// What varies.
+    pub parameter: SweepParameter,
+    /// The values, in order.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub values: Option<Vec<f64>>,
+    /// First value (with `to` and `steps`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub from: Option<f64>,
+    /// Last value.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub to: Option<f64>,
+    /// Number of values from `from` to `to` (at least 2).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub steps: Option<usize>,
+}
+
+impl SweepSpec {
+    /// The values of the sweep.
+    pub fn values(&self) -> std::result::Result<Vec<f64>, Invalid> {
+        let values = match (&self.values, self.from, self.to, self.steps) {
+            (Some(v), None, None, None) => v.clone(),
+            (None, Some(a), Some(b), Some(n)) if n >= 2 => (0..n)
+                .map(|k| a + (b - a) * k as f64 / (n - 1) as f64)
+                .collect(),
+            (None, Some(_), Some(_), Some(n)) => {
+                return Err(Invalid::new(
+                    "sweep.steps",
+                    format!("must be at least 2, got {n}"),
+                ))
+            }
+            _ => {
+                return Err(Invalid::new(
+                    "sweep",
+                    "give either `values = [...]` or `from`, `to` and `steps`",
+                ))
+            }
+        };
+        if values.is_empty() {
+            return Err(Invalid::new("sweep.values", "is empty"));
+        }
+        if values.len() > MAX_STEPS {
+            return Err(Invalid::new(
+                "sweep.values",
+                format!("{} steps is more than {MAX_STEPS}", values.len()),
+            ));
+        }
+        for v in &values {
+            let ok = v.is_finite()
+                && match self.parameter {
+                    SweepParameter::LoadFactor | SweepParameter::ObstacleOffset => true,
+                    SweepParameter::StiffnessFactor => *v >= 0.0,
+                    SweepParameter::Tension => *v > 0.0,
+                };
+            if !ok {
+                return Err(Invalid::new(
+                    "sweep.values",
+                    format!("{v} is not a valid {}", self.parameter.name()),
+                ));
+            }
+        }
+        Ok(values)
+    }
+}
+
+/// The most steps a sweep or a list of load cases may have.
+pub const MAX_STEPS: usize = 10_000;
+
+/// `[[load_case]]`: a named combination, overriding the base case's data.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LoadCase {
+    /// The name (and the name of its output directory).
+    pub name: String,
+    /// The load f of this case (default: the base case's).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub load: Option<Field>,
+    /// A factor on the load (default 1).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub load_factor: Option<f64>,
+    /// The obstacle's surface φ (default: the base case's).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub shape: Option<Field>,
+    /// The stiffness h (default: the base case's).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub stiffness: Option<Stiffness>,
+}
+
+impl LoadCase {
+    /// The base problem with this case's data.
+    pub fn problem(&self, base: &Problem) -> Problem {
+        let mut p = base.clone();
+        if let Some(f) = &self.load {
+            p.membrane.load = f.clone();
+        }
+        if let Some(phi) = &self.shape {
+            p.obstacle.shape = phi.clone();
+        }
+        if let Some(h) = &self.stiffness {
+            p.obstacle.stiffness = h.clone();
+        }
+        p
+    }
+
+    /// Whether the case needs its own assembly (new data, not just a factor).
+    fn assembles(&self) -> bool {
+        self.load.is_some() || self.shape.is_some() || self.stiffness.is_some()
+    }
+}
+
+/// Checks the sweep and load cases of a case.
+pub fn validate(case: &Case) -> std::result::Result<(), Invalid> {
+    if case.sweep.is_some() && !case.load_cases.is_empty() {
+        return Err(Invalid::new(
+            "sweep",
+            "a case has either a [sweep] or [[load_case]] entries, not both",
+        ));
+    }
+    if let Some(s) = &case.sweep {
+        s.values()?;
+    }
+    if case.load_cases.len() > MAX_STEPS {
+        return Err(Invalid::new(
+            "load_case",
+            format!("more than {MAX_STEPS} load cases"),
+        ));
+    }
+    for (i, lc) in case.load_cases.iter().enumerate() {
+        let key = |k: &str| format!("load_case.{i}.{k}");
+        let name = lc.name.trim();
+        let safe = !name.is_empty()
+            && name
+                .chars()
+                .all(|c| c.is_alphanumeric() || matches!(c, '-' | '_' | '.' | ' '))
+            && !name.starts_with('.');
+        if !safe {
+            return Err(Invalid::new(
+                key("name"),
+                format!(
+                    "\"{}\" cannot name an output directory: use letters, digits, '-', '_', \
+                     '.' and spaces",
+                    lc.name
+                ),
+            ));
+        }
+        if case.load_cases[..i].iter().any(|o| o.name.trim() == name) {
+            return Err(Invalid::new(
+                key("name"),
+                format!("\"{name}\" is used twice"),
+            ));
+        }
+        if let Some(k) = lc.load_factor {
+            if !k.is_finite() {
+                return Err(Invalid::new(
+                    key("load_factor"),
+                    format!("must be finite, got {k}"),
+                ));
+            }
+        }
+        let p = lc.problem(&case.problem);
+        p.validate()
+            .map_err(|e| Invalid::new(e.key.replace("membrane.", &key("")), e.message))?;
+    }
+    Ok(())
+}
+
+/// One step of a sweep or one load case.
+#[derive(Debug, Clone, PartialEq)]
+pub struct StepSpec {
+    /// 0-based index.
+    pub index: usize,
+    /// The output directory name: `step-000`, … or the load case's name.
+    pub name: String,
+    /// The swept value (the load factor of a load case).
+    pub value: f64,
+}
+
+/// The steps of a case: its sweep's values or its load cases (empty for neither).
+pub fn steps(case: &Case) -> Result<Vec<StepSpec>> {
+    if let Some(s) = &case.sweep {
+        let values = s.values().map_err(Invalid::into_error)?;
+        return Ok(values
+            .into_iter()
+            .enumerate()
+            .map(|(index, value)| StepSpec {
+                index,
+                name: format!("step-{index:03}"),
+                value,
+            })
+            .collect());
+    }
+    Ok(case
+        .load_cases
+        .iter()
+        .enumerate()
+        .map(|(index, lc)| StepSpec {
+            index,
+            name: lc.name.trim().to_string(),
+            value: lc.load_factor.unwrap_or(1.0),
+        })
+        .collect())
+}
+
+/// `model` with one sweep parameter set to `value` (the base model has factor 1, the
+/// case's tension, and offset 0).
+pub fn apply(base: &Model, parameter: SweepParameter, value: f64) -> Model {
+    let mut m = base.clone();
+    match parameter {
+        SweepParameter::LoadFactor => scale_load(&mut m, value),
+        SweepParameter::StiffnessFactor => {
+            match &mut m.l {
+                FoundationMatrix::Consistent(l) => l.val.iter_mut().for_each(|v| *v *= value),
+                FoundationMatrix::Lumped(d) => d.iter_mut().for_each(|v| *v *= value),
+                FoundationMatrix::Rigid => {}
+            }
+            if !m.is_rigid() {
+                m.h_vertices.iter_mut().for_each(|h| *h *= value);
+                // M is where L_ii > 0: a zero factor leaves nothing to touch.
+                for (i, c) in m.can_touch.iter_mut().enumerate() {
+                    *c = *c && value > 0.0 && m.l.diag(i) > 0.0;
+                }
+            }
+        }
+        SweepParameter::Tension => {
+            let k = value / base.tension;
+            m.s.val.iter_mut().for_each(|v| *v *= k);
+            m.tension = value;
+        }
+        SweepParameter::ObstacleOffset => {
+            m.phi.iter_mut().for_each(|p| *p += value);
+            m.phi_vertices.iter_mut().for_each(|p| *p += value);
+        }
+    }
+    m
+}
+
+/// Scales D (and ∫f) by `k`.
+fn scale_load(m: &mut Model, k: f64) {
+    m.d.iter_mut().for_each(|v| *v *= k);
+    m.total_load *= k;
+}
+
+/// What a step produced, for `sweep.csv`.
+#[derive(Debug, Clone, Serialize)]
+pub struct StepRow {
+    /// 0-based index.
+    pub step: usize,
+    /// `step-000` or the load case's name.
+    pub name: String,
+    /// The swept value (a load case's load factor).
+    pub value: f64,
+    /// max |u|.
+    pub max_deflection: f64,
+    /// Σ |Qᵢ|/3 over the vertices in contact.
+    pub contact_area: f64,
+    /// Area covered by the body where the membrane is clear of it.
+    pub liftoff_area: f64,
+    /// Σ X₁.
+    pub total_contact_force: f64,
+    /// The largest contact pressure.
+    pub max_pressure: f64,
+    /// J(U).
+    pub energy: f64,
+    /// Iterations of the solve.
+    pub iterations: usize,
+    /// The scaled KKT residual.
+    pub kkt_residual: f64,
+    /// Seconds of the step (assembly when needed, and the solve).
+    pub seconds: f64,
+}
+
+impl StepRow {
+    /// The header of `sweep.csv`.
+    pub const HEADER: [&'static str; 12] = [
+        "step",
+        "name",
+        "value",
+        "max_deflection",
+        "contact_area",
+        "liftoff_area",
+        "total_contact_force",
+        "max_pressure",
+        "energy",
+        "iterations",
+        "kkt_residual",
+        "seconds",
+    ];
+}
+
+/// Runs the steps of a case's sweep or load cases in turn, each warm-started from the
+/// previous answer (`warm = false`: every step from the usual start). `on_step` receives
+/// each step's outcome (to write it) before the next runs; a step the settings do not
+/// accept ends the sweep with its error after `on_step` has seen it.
+pub fn run_sweep(
+    case: &Case,
+    warm: bool,
+    observer: &mut dyn Observer,
+    on_step: &mut dyn FnMut(&StepSpec, &Outcome, &StepRow) -> Result<()>,
+) -> Result<Vec<StepRow>> {
+    let steps = steps(case)?;
+    if steps.is_empty() {
+        return Err(Error::Case {
+            file: None,
+            line: None,
+            key: "sweep".into(),
+            message: "the case has no [sweep] and no [[load_case]]".into(),
+        });
+    }
+    let base = Discretization::new(&case.problem, observer)?;
+    let base_model = base.model.clone();
+    let mut current = base;
+    let mut start: Option<Vec<f64>> = None;
+    let mut rows = Vec::with_capacity(steps.len());
+    for step in &steps {
+        observer.step_started(step.index, steps.len(), &step.name);
+        let t0 = Instant::now();
+        if let Some(s) = &case.sweep {
+            current.model = apply(&base_model, s.parameter, step.value);
+        } else {
+            let lc = &case.load_cases[step.index];
+            if lc.assembles() {
+                let p = lc.problem(&case.problem);
+                let hierarchy = std::mem::replace(
+                    &mut current.hierarchy,
+                    crate::mesh::refine::Hierarchy {
+                        levels: Vec::new(),
+                        refinements: Vec::new(),
+                    },
+                );
+                current = Discretization::assemble(&p, hierarchy, observer)?;
+            } else {
+                current.model = base_model.clone();
+            }
+            scale_load(&mut current.model, step.value);
+        }
+        let report = current.solve_from(
+            &case.settings,
+            if warm { start.as_deref() } else { None },
+            observer,
+        )?;
+        let seconds = t0.elapsed().as_secs_f64();
+        let outcome = Outcome {
+            discretization: current,
+            report,
+        };
+        let (_, t) = outcome.fields();
+        let r = &outcome.report;
+        let row = StepRow {
+            step: step.index,
+            name: step.name.clone(),
+            value: step.value,
+            max_deflection: t.max_deflection,
+            contact_area: t.contact_area,
+            liftoff_area: t.liftoff_area,
+            total_contact_force: t.total_contact_force,
+            max_pressure: t.max_pressure,
+            energy: r.energy,
+            iterations: r.iterations,
+            kkt_residual: r.certificate.kkt(),
+            seconds,
+        };
+        on_step(step, &outcome, &row)?;
+        rows.push(row);
+        if let Some(e) = outcome.report.error() {
+            return Err(match e {
+                Error::Solver { solver, message } => Error::Solver {
+                    solver,
+                    message: format!("{} ({}): {message}", step.name, step.value),
+                },
+                other => other,
+            });
+        }
+        let Outcome {
+            discretization,
+            report,
+        } = outcome;
+        start = Some(report.u);
+        current = discretization;
+    }
+    Ok(rows)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::solve::Silent;
+
+    const BASE: &str = r#"
+[mesh]
+generator = "rectangle"
+nx = 8
+[membrane]
+tension = 2
+load = "10 + x"
+[obstacle]
+shape = "0.1 + 0.05*y"
+stiffness = 300
+"#;
+
+    #[test]
+    fn a_scaled_model_is_the_model_of_the_scaled_data() {
+        let case = Case::from_toml_str(BASE, None).unwrap();
+        let base = Discretization::new(&case.problem, &mut Silent).unwrap();
+        let check = |parameter, value, text: String| {
+            let scaled = apply(&base.model, parameter, value);
+            let other = Case::from_toml_str(&text, None).unwrap();
+            let direct = Discretization::new(&other.problem, &mut Silent)
+                .unwrap()
+                .model;
+            let close = |a: &[f64], b: &[f64]| {
+                a.iter()
+                    .zip(b)
+                    .all(|(x, y)| (x - y).abs() <= 1e-13 * (1.0 + y.abs()))
+            };
+            assert!(close(&scaled.d, &direct.d), "{parameter:?} D");
+            assert!(close(&scaled.s.val, &direct.s.val), "{parameter:?} S");
+            assert!(close(&scaled.phi, &direct.phi), "{parameter:?} φ");
+            let (FoundationMatrix::Consistent(a), FoundationMatrix::Consistent(b)) =
+                (&scaled.l, &direct.l)
+            else {
+                panic!()
+            };
+            assert!(close(&a.val, &b.val), "{parameter:?} L");
+        };
+        check(
+            SweepParameter::LoadFactor,
+            1.5,
+            BASE.replace("\"10 + x\"", "\"1.5*(10 + x)\""),
+        );
+        check(
+            SweepParameter::StiffnessFactor,
+            0.5,
+            BASE.replace("stiffness = 300", "stiffness = 150"),
+        );
+        check(
+            SweepParameter::Tension,
+            3.0,
+            BASE.replace("tension = 2", "tension = 3"),
+        );
+        check(
+            SweepParameter::ObstacleOffset,
+            0.2,
+            BASE.replace("\"0.1 + 0.05*y\"", "\"0.3 + 0.05*y\""),
+        );
+    }
+
+    #[test]
+    fn sweep_values_and_refusals() {
+        let spec = |t: &str| -> Case {
+            Case::from_toml_str(&format!("{BASE}[sweep]\n{t}\n"), None).unwrap()
+        };
+        let c = spec("parameter = \"load_factor\"\nfrom = 0.5\nto = 1.5\nsteps = 3");
+        let s = steps(&c).unwrap();
+        assert_eq!(s.len(), 3);
+        assert_eq!(s[1].value, 1.0);
+        assert_eq!(s[2].name, "step-002");
+        for bad in [
+            "parameter = \"tension\"\nvalues = [1, -1]",
+            "parameter = \"load_factor\"\nvalues = []",
+            "parameter = \"load_factor\"\nfrom = 1\nto = 2",
+            "parameter = \"load_factor\"\nvalues = [1]\nsteps = 3",
+            "parameter = \"gravity\"\nvalues = [1]",
+        ] {
+            let e = Case::from_toml_str(&format!("{BASE}[sweep]\n{bad}\n"), None).unwrap_err();
+            assert!(e.to_string().contains("sweep"), "{bad}: {e}");
+        }
+        let e = Case::from_toml_str(&format!("{BASE}[[load_case]]\nname = \"../x\"\n"), None)
+            .unwrap_err();
+        assert!(e.to_string().contains("load_case.0.name"), "{e}");
+    }
+
+    #[test]
+    fn warm_and_cold_sweeps_give_the_same_answers() {
+        let case = Case::from_toml_str(
+            &format!("{BASE}[sweep]\nparameter = \"load_factor\"\nvalues = [0.5, 1, 2, 4]\n"),
+            None,
+        )
+        .unwrap();
+        let mut warm_u = Vec::new();
+        let warm = run_sweep(&case, true, &mut Silent, &mut |_, o, _| {
+            warm_u.push(o.report.u.clone());
+            Ok(())
+        })
+        .unwrap();
+        let mut k = 0;
+        let cold = run_sweep(&case, false, &mut Silent, &mut |s, o, _| {
+            // Each step equals the base case solved with the scaled load.
+            let scaled = Case::from_toml_str(
+                &BASE.replace("\"10 + x\"", &format!("\"{}*(10 + x)\"", s.value)),
+                None,
+            )
+            .unwrap();
+            let direct = crate::run(&scaled.problem, &scaled.settings, &mut Silent).unwrap();
+            for (a, b) in o.report.u.iter().zip(&direct.report.u) {
+                assert!((a - b).abs() <= 1e-9 * b.abs().max(1e-3));
+            }
+            for (a, b) in o.report.u.iter().zip(&warm_u[k]) {
+                assert!((a - b).abs() <= 1e-9 * b.abs().max(1e-3));
+            }
+            k += 1;
+            Ok(())
+        })
+        .unwrap();
+        assert_eq!(warm.len(), 4);
+        assert_eq!(cold.len(), 4);
+        // Load up, deflection up.
+        assert!(warm
+            .windows(2)
+            .all(|w| w[1].max_deflection > w[0].max_deflection));
+    }
+}
