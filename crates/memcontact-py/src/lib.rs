@@ -9,11 +9,16 @@ mod result;
 
 use case::PyCase;
 use convert::py_err;
+use memcontact::field::{Field, Stiffness};
+use memcontact::problem::Invalid;
 use memcontact::solve::Silent;
 use memcontact::{Discretization, Outcome};
 use mesh::PyMesh;
+use numpy::PyReadonlyArray1;
+use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use result::PyResult_;
+use std::collections::HashMap;
 use std::time::Instant;
 
 /// Solves a case end to end (mesh, assembly, solve) with the GIL released. Returns the
@@ -33,21 +38,36 @@ fn solve(py: Python<'_>, case: PyRef<'_, PyCase>) -> PyResult<PyResult_> {
 }
 
 /// Solves the problem of `case` (its mesh section is not used) on `mesh`, with the GIL
-/// released. Returns the result whatever the status.
+/// released. `nodal` gives data as NumPy arrays of one value per vertex ("load", "shape",
+/// "stiffness"), replacing the case's. Returns the result whatever the status.
 #[pyfunction]
+#[pyo3(signature = (mesh, case, nodal=None))]
 fn solve_on(
     py: Python<'_>,
     mesh: PyRef<'_, PyMesh>,
     case: PyRef<'_, PyCase>,
+    nodal: Option<HashMap<String, PyReadonlyArray1<'_, f64>>>,
 ) -> PyResult<PyResult_> {
-    let c = case.case.clone();
+    let mut c = case.case.clone();
     let label = case.label.clone();
     let mesh = mesh.clone();
+    for (name, values) in nodal.unwrap_or_default() {
+        let field = Field::Nodal(values.as_array().iter().copied().collect());
+        match name.as_str() {
+            "load" => c.problem.membrane.load = field,
+            "shape" => c.problem.obstacle.shape = field,
+            "stiffness" => c.problem.obstacle.stiffness = Stiffness::Elastic(field),
+            other => {
+                return Err(PyValueError::new_err(format!(
+                    "nodal: \"{other}\" is not a field (load, shape or stiffness)"
+                )))
+            }
+        }
+    }
     py.detach(move || {
         let started = Instant::now();
-        c.settings
-            .validate()
-            .map_err(memcontact::problem::Invalid::into_error)?;
+        c.problem.validate().map_err(Invalid::into_error)?;
+        c.settings.validate().map_err(Invalid::into_error)?;
         let discretization =
             Discretization::assemble(&c.problem, (*mesh.hierarchy).clone(), &mut Silent)?;
         let report = discretization.solve(&c.settings, &mut Silent)?;

@@ -326,11 +326,7 @@ pub fn mesh_state<'py>(py: Python<'py>, h: &Hierarchy) -> PyResult<Bound<'py, Py
     d.set_item("levels", levels)?;
     let parents = PyList::empty(py);
     for r in &h.refinements {
-        let flat: Vec<i64> = r
-            .parents
-            .iter()
-            .flat_map(|p| p.map(i64::from))
-            .collect();
+        let flat: Vec<i64> = r.parents.iter().flat_map(|p| p.map(i64::from)).collect();
         let a = Array2::from_shape_vec((r.parents.len(), 2), flat).expect("k x 2");
         parents.append(PyArray2::from_owned_array(py, a))?;
     }
@@ -338,7 +334,9 @@ pub fn mesh_state<'py>(py: Python<'py>, h: &Hierarchy) -> PyResult<Bound<'py, Py
     d.set_item("names", h.finest().region_names.clone())?;
     d.set_item(
         "circle",
-        h.finest().curve.map(|c| (c.center[0], c.center[1], c.radius)),
+        h.finest()
+            .curve
+            .map(|c| (c.center[0], c.center[1], c.radius)),
     )?;
     Ok(d.into_any())
 }
@@ -439,6 +437,9 @@ pub fn disk(
     Ok(PyMesh::new_from(Hierarchy::single(mesh)))
 }
 
+/// A named region polygon, as Python gives it.
+type NamedPolygon = (String, Vec<(f64, f64)>);
+
 /// A constrained Delaunay mesh of the polygon `outer` minus `holes`, with named
 /// sub-polygons `regions` (a dict name -> polygon; triangles outside all of them are the
 /// region "default"), elements of about `size` and angles of at least `min_angle` degrees.
@@ -449,7 +450,7 @@ pub fn polygon(
     outer: Vec<(f64, f64)>,
     size: f64,
     holes: Option<Vec<Vec<(f64, f64)>>>,
-    regions: Option<Vec<(String, Vec<(f64, f64)>)>>,
+    regions: Option<Vec<NamedPolygon>>,
     min_angle: f64,
 ) -> PyResult<PyMesh> {
     let pts = |v: Vec<(f64, f64)>| v.into_iter().map(|(x, y)| [x, y]).collect::<Vec<_>>();

@@ -89,11 +89,8 @@ impl PyResult_ {
             return Ok(o.clone());
         }
         let d = &self.data;
-        let discretization = Discretization::assemble(
-            &d.case.problem,
-            (*d.mesh.hierarchy).clone(),
-            &mut Silent,
-        )?;
+        let discretization =
+            Discretization::assemble(&d.case.problem, (*d.mesh.hierarchy).clone(), &mut Silent)?;
         let o = Arc::new(Outcome {
             discretization,
             report: d.report.clone(),
@@ -356,9 +353,10 @@ impl PyResult_ {
                 .map_err(|e| PyValueError::new_err(format!("cannot pickle: {e}")))?,
         )?;
         let f = &d.fields;
-        for (name, v) in FIELD_NAMES
-            .iter()
-            .zip([&f.u, &f.phi, &f.penetration, &f.pressure, &f.contact_force])
+        for (name, v) in
+            FIELD_NAMES
+                .iter()
+                .zip([&f.u, &f.phi, &f.penetration, &f.pressure, &f.contact_force])
         {
             state.set_item(*name, Self::f64_array(py, v))?;
         }

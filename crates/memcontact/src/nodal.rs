@@ -289,7 +289,10 @@ mod tests {
                 Field::parse(phi).unwrap(),
             ));
             let (dn, rn) = solve(problem(nodal(f), nodal(h), nodal(phi)));
-            assert!(re.u.iter().zip(&de.model.phi).any(|(u, p)| u > p), "no contact");
+            assert!(
+                re.u.iter().zip(&de.model.phi).any(|(u, p)| u > p),
+                "no contact"
+            );
             for (a, b) in re.u.iter().zip(&rn.u) {
                 assert!((a - b).abs() <= 1e-12, "{foundation:?}: {a} vs {b}");
             }

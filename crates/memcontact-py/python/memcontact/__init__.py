@@ -268,7 +268,9 @@ def solve_mesh(
     :class:`Mesh` (then ``triangles`` is left out and its levels serve multigrid).
 
     ``tension`` is t > 0; ``load`` f, ``shape`` φ and ``stiffness`` h (or ``"rigid"``) are
-    numbers, expressions of x and y, or dicts of region names (or tags) to those.
+    numbers, expressions of x and y, dicts of region names (or tags) to those, or NumPy
+    arrays of one value per vertex: their P1 interpolant enters the quadrature of f and h,
+    and φ's values are its samples (nodal sampling only).
     ``foundation`` is ``"consistent"`` or ``"lumped"``, ``sampling`` ``"nodal"`` or
     ``"mollified"`` (with ``epsilon``), ``method`` one of ``auto``, ``linear``,
     ``active-set``, ``qp``, ``coordinate``, ``multigrid``.
@@ -284,6 +286,21 @@ def solve_mesh(
         if triangles is None:
             raise TypeError("solve_mesh needs triangles (or a Mesh)")
         mesh = Mesh(vertices, triangles, regions, region_names)
+    # NumPy arrays (one value per vertex) go to the library as arrays; the case holds a
+    # placeholder for them.
+    nodal: Dict[str, np.ndarray] = {}
+    given = {"load": load, "shape": shape, "stiffness": stiffness}
+    for name, value in given.items():
+        if isinstance(value, np.ndarray):
+            a = np.ascontiguousarray(value, dtype=np.float64)
+            if a.ndim != 1 or a.shape[0] != mesh.n_vertices:
+                raise ValueError(
+                    f"{name}: nodal values must have shape ({mesh.n_vertices},), one per "
+                    f"vertex, got shape {value.shape}"
+                )
+            nodal[name] = a
+            given[name] = 0.0
+    load, shape, stiffness = given["load"], given["shape"], given["stiffness"]
     obstacle: Dict[str, Any] = {
         "shape": shape,
         "stiffness": stiffness,
@@ -306,7 +323,7 @@ def solve_mesh(
     except ValueError as e:
         raise ValueError(_rename_keys(str(e))) from None
     try:
-        result = _native.solve_on(mesh, case)
+        result = _native.solve_on(mesh, case, nodal)
     except ValueError as e:
         raise ValueError(_rename_keys(str(e))) from None
     return _check(result) if check else result
