@@ -53,16 +53,19 @@ pub fn solve(case_path: &Path, flags: &SolveFlags) -> Result<()> {
     let mut progress = Progress { quiet: flags.quiet };
     let outcome = memcontact::run(&case.problem, &case.settings, &mut progress)?;
     print_warnings(&outcome.discretization);
-    let converged = outcome.status().is_converged();
-    if !converged && !flags.write_unconverged {
+    let accepted = outcome.report.accepted;
+    if !accepted && !flags.write_unconverged {
         eprint!(
             "{}",
             output::human(&case_path.display().to_string(), &outcome, None)
         );
         bail!(
             "{}; no result files were written (pass --write-unconverged to keep the \
-             iterate, marked as unconverged in summary.json)",
-            not_converged(&outcome)
+             iterate, marked as not accepted in summary.json){}",
+            not_converged(&outcome),
+            output::floor_note(&outcome)
+                .map(|n| format!("\n{n}"))
+                .unwrap_or_default()
         );
     }
     let options = WriteOptions {
@@ -79,9 +82,12 @@ pub fn solve(case_path: &Path, flags: &SolveFlags) -> Result<()> {
         "{}",
         output::human(&options.label, &outcome, Some((&summary, flags.out)))
     );
-    if !converged {
+    if let Some(note) = output::floor_note(&outcome) {
+        eprintln!("{note}");
+    }
+    if !accepted {
         bail!(
-            "{}; the files in {} hold the unconverged iterate (summary.json: \"converged\": \
+            "{}; the files in {} hold the unconverged iterate (summary.json: \"accepted\": \
              false)",
             not_converged(&outcome),
             flags.out.display()

@@ -67,6 +67,37 @@ pub fn pictures<'a>(
     }
 }
 
+/// What to do when a solve stopped at the rounding floor above the tolerance.
+pub fn floor_note(outcome: &Outcome) -> Option<String> {
+    let r = &outcome.report;
+    if r.status != memcontact::Status::RoundingFloor {
+        return None;
+    }
+    let kkt = r.certificate.kkt();
+    // The tolerance to set: the residual reached, rounded up to two digits.
+    let e = kkt.log10().floor();
+    let suggested = (kkt / 10f64.powf(e) * 10.0).ceil() / 10.0 * 10f64.powf(e);
+    Some(format!(
+        "note: the residual {kkt:.2e} is at the rounding floor of double precision for \
+         these data and this mesh (≈ {:.1e}), above the tolerance {:.1e}: no solver can \
+         certify more. {} set [solver] tolerance = {suggested:.1e} to state the accuracy \
+         this answer has{}.",
+        r.certificate.rounding_floor,
+        r.tolerance,
+        if r.accepted {
+            "The answer is accepted as it is (solver.accept_rounding_floor = true);"
+        } else {
+            "To accept it,"
+        },
+        if r.certificate.rounding_floor > 1e-6 {
+            ", or make the data better conditioned (a stiffness this large is close to \
+             rigid: stiffness = \"rigid\")"
+        } else {
+            ""
+        }
+    ))
+}
+
 /// The human summary of a run; with `written`, the summary.json values and where the files
 /// went.
 pub fn human(label: &str, outcome: &Outcome, written: Option<(&Summary, &Path)>) -> String {

@@ -90,6 +90,11 @@ fn normalise(key: &str, v: &Value, tolerance: f64) -> Value {
             assert!(r <= tolerance, "{key} = {r} above the tolerance");
             Value::String("[≤ tolerance]".into())
         }
+        Value::Number(n) if key == "rounding_floor" => {
+            let f = n.as_f64().unwrap();
+            assert!(f > 0.0 && f < tolerance, "{key} = {f}");
+            Value::String("[below the tolerance]".into())
+        }
         Value::Number(n) if key == "force_scale" || key == "iterations" => {
             assert!(n.as_f64().unwrap() > 0.0);
             Value::String("[positive]".into())

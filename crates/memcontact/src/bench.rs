@@ -113,7 +113,7 @@ pub fn run_bench(
     let settings = Settings {
         method: Method::Multigrid,
         tolerance: TOLERANCE,
-        max_iterations: None,
+        ..Settings::default()
     };
     for &n in sizes {
         // (seconds, V-cycles, phases) of the Poisson solve, once per size.

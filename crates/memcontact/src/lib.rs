@@ -9,6 +9,7 @@
 //! and [`results`] derives the physical fields that the [`io`] writers store.
 
 pub mod bench;
+pub mod certificate;
 pub mod convergence;
 pub mod error;
 pub mod errors;

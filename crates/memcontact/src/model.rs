@@ -3,6 +3,7 @@
 //! obstacle φₙ and the set M of vertices that can touch; the energy J of Problem 2b and the
 //! certificates of Problems 2e and 2f.
 
+pub use crate::certificate::Certificate;
 use crate::fem::{
     assemble_stiffness_and_mass, assemble_vector, unknowns_pattern, Coefficient, Element,
     VertexTriangles,
@@ -341,7 +342,9 @@ impl Model {
             .collect()
     }
 
-    /// A force scale for the certificates: `max(‖D‖∞, ‖Sφ‖∞, ‖L|φ|‖∞)`.
+    /// A force scale of the data, `max(‖D‖∞, ‖Sφ‖∞, ‖L|φ|‖∞)`: the size of the forces the
+    /// problem can involve, for scaling a formulation (the QP). Certificates are scaled by
+    /// the forces of the iterate instead ([`crate::certificate`]).
     pub fn force_scale(&self) -> f64 {
         let sphi = norm_inf(&self.s.mul(&self.phi));
         let abs_phi: Vec<f64> = self.phi.iter().map(|p| p.abs()).collect();
@@ -353,89 +356,10 @@ impl Model {
             .max(f64::MIN_POSITIVE)
     }
 
-    /// The optimality certificates of a candidate U (SPEC §3): the conditions of
-    /// Problem 2f and of the Kuhn-Tucker system 2e with `X₁ = D − S U`.
+    /// The optimality certificates of a candidate U (Problems 2e and 2f, scaled by the
+    /// forces of U): see [`crate::certificate`].
     pub fn certificate(&self, u: &[f64]) -> Certificate {
-        let scale = self.force_scale();
-        let r = self.residual(u);
-        let p = self.penetration(u);
-        let mut lp = vec![0.0; self.n()];
-        self.l.mul_into(&p, &mut lp);
-        let rigid = self.is_rigid();
-        let (mut sign_r, mut sign_q, mut comp_p, mut comp_clear) = (0.0f64, 0.0f64, 0.0f64, 0.0f64);
-        let (mut x1_neg, mut x2_neg, mut off_m, mut comp1, mut comp2) =
-            (0.0f64, 0.0f64, 0.0f64, 0.0f64, 0.0f64);
-        let mut feas = 0.0f64;
-        let length = norm_inf(u).max(norm_inf(&self.phi)).max(f64::MIN_POSITIVE);
-        for i in 0..self.n() {
-            let q = r[i] + lp[i];
-            // 2f: r ≤ 0, r + Lp ≥ 0, pᵀ(r + Lp) = 0, rᵀ(p − (U − φ)) = 0, componentwise.
-            if self.can_touch[i] {
-                sign_r = sign_r.max(r[i]);
-                if !rigid {
-                    sign_q = sign_q.max(-q);
-                }
-                if p[i] > 0.0 {
-                    comp_p = comp_p.max(q.abs());
-                }
-                if u[i] < self.phi[i] {
-                    comp_clear = comp_clear.max(r[i].abs());
-                }
-                if rigid {
-                    feas = feas.max(u[i] - self.phi[i]);
-                }
-                // 2e with X₁ = −r, U₂ = p, X₂ = L̃U₂ − X₁.
-                let x1 = -r[i];
-                let x2 = lp[i] - x1;
-                x1_neg = x1_neg.max(-x1);
-                if !rigid {
-                    x2_neg = x2_neg.max(-x2);
-                    if p[i] > 0.0 {
-                        comp2 = comp2.max(x2.abs());
-                    }
-                }
-                if u[i] - self.phi[i] - p[i] < 0.0 {
-                    comp1 = comp1.max(x1.abs());
-                }
-            } else {
-                // Off M, L vanishes: 2f reduces to r_i = 0, and 2e's X̂₁ is zero there.
-                comp_clear = comp_clear.max(r[i].abs());
-                off_m = off_m.max(r[i].abs());
-            }
-        }
-        let f2 = [sign_r, sign_q, comp_p, comp_clear]
-            .iter()
-            .fold(0.0f64, |m, v| m.max(*v))
-            / scale;
-        let e2 = [x1_neg, x2_neg, off_m, comp1, comp2]
-            .iter()
-            .fold(0.0f64, |m, v| m.max(*v))
-            / scale;
-        Certificate {
-            residual_2f: f2.max(feas / length),
-            residual_2e: e2.max(feas / length),
-            force_scale: scale,
-        }
-    }
-}
-
-/// The scaled optimality residuals of a candidate U: zero exactly at the solution.
-#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
-pub struct Certificate {
-    /// Largest violation of Problem 2f's conditions, componentwise, divided by the force
-    /// scale (`r ≤ 0`, `r + Lp ≥ 0`, `r + Lp = 0` where `U > φ`, `r = 0` where `U < φ`).
-    pub residual_2f: f64,
-    /// Largest violation of the Kuhn-Tucker system 2e with `X₁ = D − SU`, `U₂ = p`,
-    /// `X₂ = L̃U₂ − X₁`: `X ≥ 0`, `X̂₁ = 0` off M, and both complementarities.
-    pub residual_2e: f64,
-    /// The force scale used.
-    pub force_scale: f64,
-}
-
-impl Certificate {
-    /// `max(residual_2f, residual_2e)`.
-    pub fn kkt(&self) -> f64 {
-        self.residual_2f.max(self.residual_2e)
+        crate::certificate::evaluate(self, u).certificate
     }
 }
 

@@ -14,13 +14,13 @@
 use crate::field::{BoundField, Stiffness as FieldStiffness};
 use crate::mesh::refine::Hierarchy;
 use crate::mesh::Mesh;
-use crate::model::{Certificate, Model, ProblemData, Stiffness};
+use crate::model::{Certificate, FoundationMatrix, Model, ProblemData, Stiffness};
 use crate::problem::{Invalid, Problem};
 use crate::results::{derive_from, NodalFields, Totals};
 use crate::solve::{
     self, Choice, Fallback, IterationRecord, Method, Observer, Settings, Solution, Status,
 };
-use crate::Result;
+use crate::{Error, Result};
 use std::time::Instant;
 
 /// The problem's data f, φ, h bound to a mesh's regions.
@@ -122,7 +122,9 @@ impl Discretization {
         let t0 = Instant::now();
         let mesh = hierarchy.finest();
         let bound = BoundData::new(problem, mesh)?;
+        check_boundary_data(mesh, &bound)?;
         let model = Model::assemble(mesh, &bound.data(problem))?;
+        check_overflow(mesh, &model)?;
         let seconds = t0.elapsed().as_secs_f64();
         observer.phase_finished("assembly", seconds);
         Ok(Discretization {
@@ -165,6 +167,7 @@ impl Discretization {
         });
         let s = a.solution;
         Ok(Report {
+            accepted: a.status.is_accepted(settings),
             status: a.status,
             requested: a.requested,
             method: s.method,
@@ -188,12 +191,111 @@ impl Discretization {
     }
 }
 
+/// Checks the data where assembly does not sample it: f on the boundary vertices (a load
+/// singular on the boundary, like `1/x` on x = 0, is refused), and, for the rigid obstacle,
+/// that φ is not below the fixed boundary (`u = 0 > φ` there: no continuous solution).
+fn check_boundary_data(mesh: &Mesh, data: &BoundData) -> Result<()> {
+    let boundary = mesh.boundary_vertices();
+    let adj = crate::fem::VertexTriangles::new(mesh);
+    for (v, &on) in boundary.iter().enumerate() {
+        if !on {
+            continue;
+        }
+        let p = mesh.points[v];
+        for &k in adj.of(v) {
+            let region = mesh.regions[k as usize];
+            let f = data.load.eval(p, region);
+            if !f.is_finite() {
+                return Err(Error::Data(format!(
+                    "membrane.load f is not finite on the boundary at ({}, {}) (f = {f}): the \
+                     load must be bounded on the closed domain",
+                    p[0], p[1]
+                )));
+            }
+            if data.stiffness.is_none() {
+                let phi = data.shape.eval(p, region);
+                if phi < 0.0 {
+                    return Err(Error::Data(format!(
+                        "obstacle.shape φ = {phi} at the boundary point ({}, {}) lies below \
+                         the fixed boundary (u = 0 there): with a rigid obstacle (u ≤ φ) the \
+                         problem has no continuous solution; raise φ to at least 0 on the \
+                         boundary or give the obstacle a finite stiffness",
+                        p[0], p[1]
+                    )));
+                }
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Refuses a model whose matrices or data overflowed double precision, naming the data.
+fn check_overflow(mesh: &Mesh, model: &Model) -> Result<()> {
+    let smallest_area = (0..mesh.n_triangles())
+        .map(|k| mesh.area(k).abs())
+        .fold(f64::INFINITY, f64::min);
+    if !model.s.is_finite() {
+        return Err(Error::Data(format!(
+            "the stiffness matrix S overflows double precision: tension t = {} on triangles \
+             as small as {smallest_area:e} (S grows like t × edge² / area); rescale the \
+             problem (units) so that t and the mesh are moderate",
+            model.tension
+        )));
+    }
+    if let FoundationMatrix::Consistent(l) = &model.l {
+        if !l.is_finite() {
+            return Err(Error::Data(
+                "the foundation matrix L = ∫h gᵢgⱼ overflows double precision: \
+                 obstacle.stiffness h is too large (use stiffness = \"rigid\" for a rigid \
+                 body)"
+                    .into(),
+            ));
+        }
+    }
+    if let FoundationMatrix::Lumped(d) = &model.l {
+        if d.iter().any(|v| !v.is_finite()) {
+            return Err(Error::Data(
+                "the lumped foundation lᵢ = ∫h gᵢ overflows double precision: \
+                 obstacle.stiffness h is too large (use stiffness = \"rigid\" for a rigid \
+                 body)"
+                    .into(),
+            ));
+        }
+    }
+    if let Some(i) = model.phi.iter().position(|v| !v.is_finite()) {
+        let p = mesh.points[model.dofs.vertex[i] as usize];
+        return Err(Error::Data(format!(
+            "obstacle.shape φ is not finite at ({}, {})",
+            p[0], p[1]
+        )));
+    }
+    if !model.total_load.is_finite() {
+        return Err(Error::Data(
+            "the total load ∫f overflows double precision: membrane.load f is too large".into(),
+        ));
+    }
+    // J = ½UᵀSU − UᵀD with U of the size D/S: the products must stay finite.
+    let d_max = crate::sparse::norm_inf(&model.d);
+    let s_min = model.s.diag().into_iter().fold(f64::INFINITY, f64::min);
+    let u_size = d_max / s_min * (model.n() as f64).sqrt();
+    if !(d_max * u_size * model.n() as f64).is_finite() {
+        return Err(Error::Data(format!(
+            "the energy J would overflow double precision: the nodal loads |D| reach \
+             {d_max:e} against a stiffness of {s_min:e} (membrane.load is too large for the \
+             tension); rescale the problem (units)"
+        )));
+    }
+    Ok(())
+}
+
 /// How a solve went, with its iterate: the status, the method used and why, iterations,
 /// J, the certificates of 2e and 2f, the history and the phase times.
 #[derive(Debug, Clone, serde::Serialize)]
 pub struct Report {
     /// How the solve ended.
     pub status: Status,
+    /// The settings accept the outcome (converged, or at the rounding floor when allowed).
+    pub accepted: bool,
     /// The method the settings asked for (maybe `auto`).
     pub requested: Method,
     /// The method that produced the iterate.
@@ -236,9 +338,9 @@ impl Report {
             .sum()
     }
 
-    /// The error naming how the solve ended, when it did not converge.
+    /// The error naming how the solve ended, when the settings do not accept it.
     pub fn error(&self) -> Option<crate::Error> {
-        (!self.status.is_converged()).then(|| {
+        (!self.accepted).then(|| {
             solve::status_error(
                 self.status,
                 self.method,

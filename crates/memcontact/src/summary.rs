@@ -63,8 +63,10 @@ pub struct Summary {
     pub residual_2e: f64,
     /// The scaled residual of the complementarity problem 2f.
     pub residual_2f: f64,
-    /// The force the residuals are divided by.
+    /// The force the residuals are divided by (the largest force of the iterate).
     pub force_scale: f64,
+    /// The rounding floor of the residuals at U: what double precision can resolve.
+    pub rounding_floor: f64,
     /// |M|: unknowns the obstacle can touch.
     pub can_touch_vertices: usize,
     /// Vertices in contact (touching or penetrating).
@@ -104,8 +106,11 @@ pub struct Summary {
     /// How the solve ended (`converged`, `iteration_limit`, `stalled`,
     /// `numerical_failure`).
     pub status: Status,
-    /// `status == converged`: files written with `false` hold an unconverged iterate.
+    /// `status == converged`: the residual meets the tolerance.
     pub converged: bool,
+    /// The outcome is accepted: converged, or at the rounding floor of double precision
+    /// when the settings accept that. Files written with `false` hold an unaccepted iterate.
+    pub accepted: bool,
     /// The method the case asked for (maybe `auto`).
     pub requested_solver: String,
     /// Why `solver` was used.
@@ -159,6 +164,7 @@ impl Summary {
             residual_2e: r.certificate.residual_2e,
             residual_2f: r.certificate.residual_2f,
             force_scale: r.certificate.force_scale,
+            rounding_floor: r.certificate.rounding_floor,
             can_touch_vertices: m.can_touch.iter().filter(|&&c| c).count(),
             contact_vertices: totals.contact_vertices,
             touching_vertices: totals.touching_vertices,
@@ -183,6 +189,7 @@ impl Summary {
             time_total_s: 0.0,
             status: r.status,
             converged: r.status.is_converged(),
+            accepted: r.accepted,
             requested_solver: r.requested.name().into(),
             solver_choice: r.choice,
             fallback: r.fallback.clone(),

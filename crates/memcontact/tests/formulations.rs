@@ -30,7 +30,7 @@ fn run(model: &Model, method: Method) -> Solution {
     let s = Settings {
         method,
         tolerance: 1e-11,
-        max_iterations: None,
+        ..Settings::default()
     };
     solve(model, None, &s, &mut Silent).unwrap_or_else(|e| panic!("{}: {e}", method.name()))
 }

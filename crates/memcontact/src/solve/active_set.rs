@@ -178,8 +178,9 @@ pub fn solve(model: &Model, settings: &Settings, observer: &mut dyn Observer) ->
     let mut certificate = model.certificate(&v);
     let mut iterations = 0;
     let mut stalled = 0;
+    let mut watch = crate::certificate::FloorWatch::default();
     while iterations < max {
-        if certificate.kkt() <= settings.tolerance {
+        if certificate.settled(settings.tolerance) || watch.stuck(&certificate) {
             break;
         }
         iterations += 1;

@@ -20,6 +20,7 @@ pub fn solve(model: &Model, settings: &Settings, observer: &mut dyn Observer) ->
     let mut sweeps = 0;
     let mut check_every = 1;
     let mut certificate = model.certificate(&v);
+    let mut watch = crate::certificate::FloorWatch::default();
     while sweeps < max {
         let todo = check_every.min(max - sweeps);
         timer.time("sweeps", || {
@@ -36,7 +37,7 @@ pub fn solve(model: &Model, settings: &Settings, observer: &mut dyn Observer) ->
         };
         observer.iteration(&record);
         history.push(record);
-        if certificate.kkt() <= settings.tolerance {
+        if certificate.settled(settings.tolerance) || watch.stuck(&certificate) {
             break;
         }
         // Check less often as sweeps accumulate (at most ~2% of the work is checking).

@@ -93,6 +93,9 @@ pub struct Settings {
     /// Iteration limit (`None`: the method's default).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub max_iterations: Option<usize>,
+    /// Accept a solve whose residual stops at the rounding floor of double precision above
+    /// the tolerance (reported as [`Status::RoundingFloor`]); `false` makes it a failure.
+    pub accept_rounding_floor: bool,
 }
 
 /// Tolerances at or above this certify nothing: a residual of 1 % of the forces.
@@ -132,6 +135,7 @@ impl Default for Settings {
             method: Method::Auto,
             tolerance: 1e-10,
             max_iterations: None,
+            accept_rounding_floor: true,
         }
     }
 }
@@ -227,6 +231,9 @@ impl PhaseTimer {
 pub enum Status {
     /// The scaled KKT residual reached the tolerance.
     Converged,
+    /// The residual stopped at the rounding floor of double precision, above the
+    /// tolerance: the iterate is as accurate as the arithmetic allows for these data.
+    RoundingFloor,
     /// The iteration limit was reached first.
     IterationLimit,
     /// The iterate stopped changing before the tolerance was reached.
@@ -240,6 +247,7 @@ impl Status {
     pub fn name(self) -> &'static str {
         match self {
             Status::Converged => "converged",
+            Status::RoundingFloor => "rounding_floor",
             Status::IterationLimit => "iteration_limit",
             Status::Stalled => "stalled",
             Status::NumericalFailure => "numerical_failure",
@@ -249,6 +257,13 @@ impl Status {
     /// `true` for [`Status::Converged`].
     pub fn is_converged(self) -> bool {
         self == Status::Converged
+    }
+
+    /// `true` when the settings accept the outcome: converged, or at the rounding floor
+    /// with [`Settings::accept_rounding_floor`].
+    pub fn is_accepted(self, settings: &Settings) -> bool {
+        self == Status::Converged
+            || (self == Status::RoundingFloor && settings.accept_rounding_floor)
     }
 }
 
@@ -369,16 +384,29 @@ fn run_method(
             let limit = settings
                 .max_iterations
                 .unwrap_or(method.default_max_iterations());
-            let status = if kkt <= settings.tolerance {
-                Status::Converged
+            let floor = solution.certificate.rounding_floor;
+            let (status, message) = if kkt <= settings.tolerance {
+                (Status::Converged, None)
             } else if !kkt.is_finite() || !solution.energy.is_finite() {
-                Status::NumericalFailure
+                (Status::NumericalFailure, None)
+            } else if floor >= LOOSEST_TOLERANCE {
+                (
+                    Status::NumericalFailure,
+                    Some(format!(
+                        "the rounding floor of the residual is {floor:.1e}: the data's scales \
+                         are beyond what double precision resolves (typically a stiffness h \
+                         so large that the foundation force h(u − φ) comes from a penetration \
+                         below the rounding of φ: use stiffness = \"rigid\", or rescale)"
+                    )),
+                )
+            } else if solution.certificate.near_floor() {
+                (Status::RoundingFloor, None)
             } else if solution.iterations >= limit {
-                Status::IterationLimit
+                (Status::IterationLimit, None)
             } else {
-                Status::Stalled
+                (Status::Stalled, None)
             };
-            Ok((solution, status, None))
+            Ok((solution, status, message))
         }
         Err(Error::Solver { message, .. }) => {
             let u = active_set::feasible_start(model);
@@ -417,7 +445,10 @@ pub fn attempt(
     let (mut solution, mut status, mut message) =
         run_method(method, model, hierarchy, settings, observer)?;
     let mut fallback = None;
-    if settings.method == Method::Auto && method == Method::Multigrid && !status.is_converged() {
+    if settings.method == Method::Auto
+        && method == Method::Multigrid
+        && !status.is_accepted(settings)
+    {
         fallback = Some(Fallback {
             from: method,
             status,
@@ -437,8 +468,8 @@ pub fn attempt(
     })
 }
 
-/// [`attempt`], for callers that need a converged answer: any status but
-/// [`Status::Converged`] is an [`Error::Solver`] naming it.
+/// [`attempt`], for callers that need an accepted answer: any status the settings do not
+/// accept ([`Status::is_accepted`]) is an [`Error::Solver`] naming it.
 pub fn solve(
     model: &Model,
     hierarchy: Option<&Hierarchy>,
@@ -446,7 +477,7 @@ pub fn solve(
     observer: &mut dyn Observer,
 ) -> Result<Solution> {
     let a = attempt(model, hierarchy, settings, observer)?;
-    if a.status.is_converged() {
+    if a.status.is_accepted(settings) {
         return Ok(a.solution);
     }
     Err(not_converged(&a, settings))
@@ -476,6 +507,9 @@ pub fn status_error(
 ) -> Error {
     let what = match status {
         Status::Converged => "converged".to_string(),
+        Status::RoundingFloor => format!(
+            "stopped at the rounding floor of double precision after {iterations} iterations"
+        ),
         Status::IterationLimit => format!("reached the iteration limit ({iterations})"),
         Status::Stalled => format!("stalled after {iterations} iterations"),
         Status::NumericalFailure => format!(

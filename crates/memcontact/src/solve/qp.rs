@@ -568,7 +568,7 @@ mod tests {
         Settings {
             method: Method::Qp,
             tolerance: 1e-11,
-            max_iterations: None,
+            ..Settings::default()
         }
     }
 

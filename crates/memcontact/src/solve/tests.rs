@@ -30,7 +30,7 @@ fn settings(method: Method) -> Settings {
     Settings {
         method,
         tolerance: 1e-11,
-        max_iterations: None,
+        ..Settings::default()
     }
 }
 

@@ -302,7 +302,6 @@ fn level_solve(ls: LevelSolve) -> Result<(usize, f64, Option<Certificate>)> {
     } = ls;
     let n = model.n();
     let pattern = model.s.pattern.clone();
-    let scale = model.force_scale();
     let mut a = Csr::zeros(pattern.clone());
     let mut mg = Multigrid::new(levels, top);
     mg.smoothing = options.smoothing;
@@ -317,13 +316,14 @@ fn level_solve(ls: LevelSolve) -> Result<(usize, f64, Option<Certificate>)> {
     let mut stalled = 0;
     let mut kkt;
     let mut certificate = None;
+    let mut watch = crate::certificate::FloorWatch::default();
     loop {
-        let (k, energy) = timer.time("certificate", || fast_kkt(model, v, scale));
-        kkt = k;
+        let ev = timer.time("certificate", || crate::certificate::evaluate(model, v));
+        kkt = ev.certificate.kkt();
         if iterations > 0 {
             let record = IterationRecord {
                 iteration: iterations,
-                energy,
+                energy: ev.energy,
                 residual: kkt,
             };
             observer.iteration(&record);
@@ -331,17 +331,12 @@ fn level_solve(ls: LevelSolve) -> Result<(usize, f64, Option<Certificate>)> {
                 h.push(record);
             }
         }
-        if kkt <= tolerance {
-            if !confirm {
-                break;
+        // Met the tolerance, or at the rounding floor (more iterations cannot help).
+        if ev.certificate.settled(tolerance) || watch.stuck(&ev.certificate) {
+            if confirm {
+                certificate = Some(ev.certificate);
             }
-            // The authoritative certificate (the same formula, assembled by the model).
-            let c = timer.time("certificate", || model.certificate(v));
-            if c.kkt() <= tolerance {
-                kkt = c.kkt();
-                certificate = Some(c);
-                break;
-            }
+            break;
         }
         if !kkt.is_finite() || iterations >= max_iterations || stalled >= STALL_LIMIT {
             break;
@@ -511,118 +506,6 @@ fn mark_dirty(
     dirty.iter().filter(|&&d| d).count()
 }
 
-/// Rows per block of the deterministic reductions.
-const BLOCK: usize = 4096;
-
-/// The scaled KKT residual of [`Model::certificate`] (max of 2e and 2f) and the energy J
-/// at `v`, in one pass over the matrices with no allocation, summed in fixed blocks so
-/// that the result does not depend on the number of threads. The force scale is the
-/// model's, computed once by the caller.
-///
-/// With `r = SV − D`, `p = (V − φ)⁺`, `q = r + Lp`, the conditions of 2f and those of 2e
-/// (with `X₁ = −r`, `X₂ = L̃p − X₁ = q`) coincide componentwise: on M, `r ≤ 0`,
-/// `q ≥ 0` (elastic), `q = 0` where `p > 0`, `r = 0` where `V < φ`; off M, `r = 0`; for
-/// the rigid obstacle also `V ≤ φ`, measured against `max(‖V‖∞, ‖φ‖∞)`.
-fn fast_kkt(model: &Model, v: &[f64], scale: f64) -> (f64, f64) {
-    match &model.l {
-        FoundationMatrix::Consistent(l) => fast_kkt_with(model, v, scale, |i, s, e| {
-            let mut lp = 0.0;
-            for (&j, &lv) in l.pattern.col[s..e].iter().zip(&l.val[s..e]) {
-                let j = j as usize;
-                if lv != 0.0 && model.can_touch[j] {
-                    lp += lv * (v[j] - model.phi[j]).max(0.0);
-                }
-            }
-            let _ = i;
-            lp
-        }),
-        FoundationMatrix::Lumped(d) => fast_kkt_with(model, v, scale, |i, _, _| {
-            if model.can_touch[i] {
-                d[i] * (v[i] - model.phi[i]).max(0.0)
-            } else {
-                0.0
-            }
-        }),
-        FoundationMatrix::Rigid => fast_kkt_with(model, v, scale, |_, _, _| 0.0),
-    }
-}
-
-/// [`fast_kkt`] with `(L p)_i = lp(i, row start, row end)` (S and a consistent L share
-/// their pattern).
-fn fast_kkt_with(
-    model: &Model,
-    v: &[f64],
-    scale: f64,
-    lp_of: impl Fn(usize, usize, usize) -> f64 + Sync,
-) -> (f64, f64) {
-    let n = model.n();
-    let rigid = model.is_rigid();
-    let pat = &model.s.pattern;
-    let sval = &model.s.val;
-    // Per block: (force violation, feasibility violation, max |V|, vᵀr − vᵀD, pᵀLp).
-    let block = |b: usize| -> [f64; 5] {
-        let mut acc = [0.0f64; 5];
-        let (lo, hi) = (b * BLOCK, ((b + 1) * BLOCK).min(n));
-        for i in lo..hi {
-            let (s, e) = (pat.row_ptr[i], pat.row_ptr[i + 1]);
-            let mut sv = 0.0;
-            for (&j, &a) in pat.col[s..e].iter().zip(&sval[s..e]) {
-                sv += a * v[j as usize];
-            }
-            let r = sv - model.d[i];
-            let (vi, fi) = (v[i], model.phi[i]);
-            let force = if model.can_touch[i] {
-                let lp = lp_of(i, s, e);
-                let p = (vi - fi).max(0.0);
-                let q = r + lp;
-                let mut f = r;
-                if !rigid {
-                    f = f.max(-q);
-                }
-                if p > 0.0 {
-                    f = f.max(q.abs());
-                }
-                if vi < fi {
-                    f = f.max(r.abs());
-                }
-                if rigid {
-                    acc[1] = acc[1].max(vi - fi);
-                }
-                acc[4] += p * lp;
-                f
-            } else {
-                r.abs()
-            };
-            acc[0] = acc[0].max(force);
-            acc[2] = acc[2].max(vi.abs()).max(fi.abs());
-            acc[3] += vi * (r - model.d[i]);
-        }
-        acc
-    };
-    let nb = n.div_ceil(BLOCK);
-    let parts: Vec<[f64; 5]> = if n >= transfer::PAR_ROWS {
-        (0..nb).into_par_iter().map(block).collect()
-    } else {
-        (0..nb).map(block).collect()
-    };
-    let mut tot = [0.0f64; 5];
-    for p in &parts {
-        tot[0] = tot[0].max(p[0]);
-        tot[1] = tot[1].max(p[1]);
-        tot[2] = tot[2].max(p[2]);
-        tot[3] += p[3];
-        tot[4] += p[4];
-    }
-    let length = tot[2].max(f64::MIN_POSITIVE);
-    let kkt = (tot[0] / scale).max(tot[1] / length);
-    let energy = if rigid && tot[1] > 0.0 {
-        f64::INFINITY
-    } else {
-        0.5 * tot[3] + 0.5 * tot[4]
-    };
-    (if kkt.is_nan() { f64::INFINITY } else { kkt }, energy)
-}
-
 /// Wall-clock and CPU (all threads) milliseconds per call of the kernels of one TNNMG
 /// iteration on `model` (for the benchmark's `--micro` mode; `reps` calls each, at a point
 /// with every vertex state).
@@ -661,15 +544,8 @@ pub fn kernel_timings(
     let mut v: Vec<f64> = (0..n)
         .map(|i| model.phi[i] + 0.01 * ((i as f64) * 0.37).sin())
         .collect();
-    let scale = model.force_scale();
-    time("fast kkt", &mut || {
-        std::hint::black_box(fast_kkt(model, &v, scale));
-    });
-    time("force scale", &mut || {
-        std::hint::black_box(model.force_scale());
-    });
-    time("model certificate", &mut || {
-        std::hint::black_box(model.certificate(&v));
+    time("certificate", &mut || {
+        std::hint::black_box(crate::certificate::evaluate(model, &v));
     });
     time("nonsmooth sweep", &mut || sweep_forward(model, &mut v));
     let mut st = NewtonStates::of(model, &v);
