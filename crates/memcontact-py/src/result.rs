@@ -108,6 +108,7 @@ impl PyResult_ {
 #[derive(Serialize, Deserialize)]
 struct ReportState {
     status: Status,
+    accepted: bool,
     requested: Method,
     method: Method,
     choice: Choice,
@@ -183,8 +184,8 @@ impl PyResult_ {
         PyArray1::from_slice(py, &self.data.fields.state)
     }
 
-    /// How the solve ended: "converged", "iteration_limit", "stalled" or
-    /// "numerical_failure".
+    /// How the solve ended: "converged", "rounding_floor", "iteration_limit", "stalled"
+    /// or "numerical_failure".
     #[getter]
     fn status(&self) -> &'static str {
         self.data.report.status.name()
@@ -196,7 +197,14 @@ impl PyResult_ {
         self.data.report.status.is_converged()
     }
 
-    /// What went wrong, for a solve that did not converge (None otherwise).
+    /// Whether the settings accept the outcome: converged, or at the rounding floor of
+    /// double precision when the settings allow it (what `solve` checks).
+    #[getter]
+    fn accepted(&self) -> bool {
+        self.data.report.accepted
+    }
+
+    /// What went wrong, for a solve that was not accepted (None otherwise).
     #[getter]
     fn message(&self) -> Option<String> {
         self.data.report.error().map(|e| e.to_string())
@@ -329,6 +337,7 @@ impl PyResult_ {
             summary: d.summary.clone(),
             report: ReportState {
                 status: r.status,
+                accepted: r.accepted,
                 requested: r.requested,
                 method: r.method,
                 choice: r.choice,
@@ -408,6 +417,7 @@ pub fn _result_from_state(state: &Bound<'_, PyDict>) -> PyResult<PyResult_> {
     let s = meta.report;
     let report = Report {
         status: s.status,
+        accepted: s.accepted,
         requested: s.requested,
         method: s.method,
         choice: s.choice,

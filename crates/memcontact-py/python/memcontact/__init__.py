@@ -71,8 +71,8 @@ Point = Tuple[float, float]
 
 
 class SolverError(RuntimeError):
-    """A solve that did not reach its tolerance (iteration limit, stall, numerical
-    failure). ``result`` is the :class:`Result` with the best iterate, its ``status`` and
+    """A solve whose outcome the settings do not accept (iteration limit, stall, numerical
+    failure, or the rounding floor when the settings do not allow it). ``result`` is the :class:`Result` with the best iterate, its ``status`` and
     its certificate (``result.kkt_residual``)."""
 
     def __init__(self, message: str, result: Result) -> None:
@@ -204,7 +204,7 @@ def refine(mesh: Mesh, times: int = 1) -> Mesh:
 def _check(result: Result) -> Result:
     for note in result.warnings:
         warnings.warn(note, stacklevel=3)
-    if not result.converged:
+    if not result.accepted:
         raise SolverError(result.message or f"the solve ended {result.status}", result)
     return result
 
