@@ -175,3 +175,28 @@ def test_solves_release_the_gil():
     quarter = (end - start) / 4
     inside = [x for x in ticks if start + quarter < x < end - quarter]
     assert len(inside) > 0
+
+
+def test_polygon_regions_and_gmsh_names(examples):
+    outer = [[0, 0], [12, 0], [12, 8], [0, 8]]
+    block = [[1.5, 2.5], [5, 2.5], [5, 5.5], [1.5, 5.5]]
+    a = mc.polygon(outer, 0.5, holes=[[[7, 3], [9, 3], [9, 5], [7, 5]]],
+                   regions={"block": block}, min_angle=28.0)
+    b = mc.polygon(np.array(outer, float), 0.5, holes=[np.array([[7, 3], [9, 3], [9, 5], [7, 5]])],
+                   regions=[{"name": "block", "polygon": block}], min_angle=28.0)
+    assert np.array_equal(a.vertices, b.vertices) and np.array_equal(a.regions, b.regions)
+    assert "block" in a.region_names.values()
+    # The triangles tagged "block" are those whose centroid lies in the block.
+    tag = next(t for t, n in a.region_names.items() if n == "block")
+    c = a.vertices[a.triangles].mean(axis=1)
+    inside = (c[:, 0] > 1.5) & (c[:, 0] < 5) & (c[:, 1] > 2.5) & (c[:, 1] < 5.5)
+    assert np.array_equal(a.regions == tag, inside)
+    # The same mesh as the case file's polygon generator.
+    case = mc.load_case(examples / "roof.toml", {"mesh.size": 0.5})
+    assert np.array_equal(mc.solve(case).mesh.vertices, a.vertices)
+    g = mc.read_gmsh(examples / "disk.msh")
+    assert set(g.region_names.values()) == {"foam", "soil"}
+    fine = mc.refine(g, 2)
+    assert fine.n_triangles == 16 * g.n_triangles and fine.levels == 3
+    # Every triangle's four children keep its region.
+    assert np.array_equal(np.bincount(fine.regions), 16 * np.bincount(g.regions))

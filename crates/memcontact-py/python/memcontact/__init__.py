@@ -168,7 +168,8 @@ def polygon(
 ) -> Mesh:
     """A constrained Delaunay mesh of the polygon ``outer`` (k × 2 points) minus ``holes``,
     elements of about ``size``, angles of at least ``min_angle`` degrees (≤ 30).
-    ``regions`` names sub-polygons (a dict name → points): their triangles get a tag named
+    ``regions`` names sub-polygons (a dict name → points, or a list of ``(name, points)``
+    or of the case file's ``{"name": ..., "polygon": ...}``): their triangles get a tag named
     after them (usable as keys of region tables); the rest is the region ``"default"``."""
     hole_list = [_points(h, "holes") for h in (holes or [])]
     if regions is None:
@@ -176,7 +177,11 @@ def polygon(
     elif isinstance(regions, Mapping):
         region_list = [(str(k), _points(v, f"regions[{k!r}]")) for k, v in regions.items()]
     else:
-        region_list = [(str(k), _points(v, f"regions[{k!r}]")) for k, v in regions]
+        region_list = []
+        for item in regions:
+            # (name, points) pairs, or the case file's {"name": ..., "polygon": ...}.
+            k, v = (item["name"], item["polygon"]) if isinstance(item, Mapping) else item
+            region_list.append((str(k), _points(v, f"regions[{k!r}]")))
     return _native.polygon(
         _points(outer, "outer"), float(size), hole_list, region_list, float(min_angle)
     )
