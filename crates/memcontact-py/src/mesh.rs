@@ -357,12 +357,21 @@ pub fn hierarchy_from_state(state: &Bound<'_, PyAny>) -> PyResult<Hierarchy> {
             PyReadonlyArray2<'_, i64>,
             PyReadonlyArray1<'_, i64>,
         ) = item?.extract()?;
-        let mut mesh = mesh_from_arrays(&v, &t, Some(r), Some(names.clone()))?;
-        mesh.curve = circle.map(|(x, y, r)| Circle {
-            center: [x, y],
-            radius: r,
+        // The arrays come from a checked mesh: only their shapes and indices are checked
+        // again (the full checks of `Mesh::new` cost more than the rest of unpickling).
+        let points = points_of(&v)?;
+        let triangles = triangles_of(&t, points.len())?;
+        let regions = regions_of(Some(r), triangles.len())?;
+        levels.push(Mesh {
+            points,
+            triangles,
+            regions,
+            region_names: names.clone(),
+            curve: circle.map(|(x, y, r)| Circle {
+                center: [x, y],
+                radius: r,
+            }),
         });
-        levels.push(mesh);
     }
     let mut refinements = Vec::new();
     for item in get("parents")?.try_iter()? {

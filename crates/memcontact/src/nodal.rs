@@ -9,7 +9,6 @@
 
 use crate::mesh::{Mesh, Point};
 use crate::{Error, Result};
-use std::collections::HashMap;
 use std::sync::Arc;
 
 /// The P1 interpolant of values at the vertices of a mesh, evaluable at any point of the
@@ -18,8 +17,6 @@ pub struct NodalP1 {
     points: Vec<Point>,
     triangles: Vec<[u32; 3]>,
     values: Arc<[f64]>,
-    /// Exact vertex positions, for exact values at the vertices.
-    vertex_at: HashMap<(u64, u64), u32>,
     grid: Grid,
 }
 
@@ -119,11 +116,6 @@ impl Grid {
     }
 }
 
-/// The position of a point as a hash key (−0 and +0 are the same point).
-fn key(p: Point) -> (u64, u64) {
-    ((p[0] + 0.0).to_bits(), (p[1] + 0.0).to_bits())
-}
-
 impl NodalP1 {
     /// The interpolant of `values` (one per vertex of `mesh`). `name` names the field in
     /// errors.
@@ -142,18 +134,11 @@ impl NodalP1 {
                 values[i]
             )));
         }
-        let vertex_at = mesh
-            .points
-            .iter()
-            .enumerate()
-            .map(|(i, &p)| (key(p), i as u32))
-            .collect();
         Ok(NodalP1 {
             grid: Grid::new(&mesh.points, &mesh.triangles),
             points: mesh.points.clone(),
             triangles: mesh.triangles.clone(),
             values,
-            vertex_at,
         })
     }
 
@@ -170,22 +155,29 @@ impl NodalP1 {
     /// The interpolant at `p`: the value given at a vertex, the P1 interpolant of the
     /// triangle holding `p` elsewhere, NaN outside the mesh.
     pub fn eval(&self, p: Point) -> f64 {
-        if let Some(&v) = self.vertex_at.get(&key(p)) {
-            return self.values[v as usize];
-        }
-        // The triangle in which p is deepest (p on an edge: either one, the same value).
+        // The first triangle holding p, else the one p is closest to being in (p on an
+        // edge, within rounding: either side gives the same value).
         let mut best = (f64::NEG_INFINITY, [0.0; 3], 0usize);
         for &k in self.grid.candidates(p) {
             let l = self.barycentric(k as usize, p);
             let depth = l[0].min(l[1]).min(l[2]);
             if depth > best.0 {
                 best = (depth, l, k as usize);
+                if depth >= 0.0 {
+                    break;
+                }
             }
         }
         if best.0 < -1e-9 {
             return f64::NAN;
         }
         let (l, t) = (best.1, self.triangles[best.2]);
+        // At a vertex, the value given there, exactly.
+        for &v in &t {
+            if self.points[v as usize] == p {
+                return self.values[v as usize];
+            }
+        }
         l[0] * self.values[t[0] as usize]
             + l[1] * self.values[t[1] as usize]
             + l[2] * self.values[t[2] as usize]
