@@ -3,27 +3,10 @@
 use crate::output;
 use anyhow::{bail, Result};
 use memcontact::output::{write_result_set, WriteOptions};
-use memcontact::solve::{IterationRecord, Observer};
+use crate::progress::{Progress, Verbosity};
 use memcontact::{Case, Discretization, Outcome};
 use std::path::Path;
 use std::time::Instant;
-
-/// Prints one line per iteration on stderr (unless quiet).
-pub struct Progress {
-    /// Print nothing.
-    pub quiet: bool,
-}
-
-impl Observer for Progress {
-    fn iteration(&mut self, r: &IterationRecord) {
-        if !self.quiet {
-            eprintln!(
-                "  iteration {:>5}  J = {:+.12e}  KKT = {:.3e}",
-                r.iteration, r.energy, r.residual
-            );
-        }
-    }
-}
 
 /// Prints the mesh reader's warnings.
 pub fn print_warnings(d: &Discretization) {
@@ -38,8 +21,8 @@ pub struct SolveFlags<'a> {
     pub out: &'a Path,
     /// `--set` overrides.
     pub sets: &'a [String],
-    /// No progress lines.
-    pub quiet: bool,
+    /// How much progress to show.
+    pub verbosity: Verbosity,
     /// Replace an output directory holding other files.
     pub force: bool,
     /// Write the result files of a solve that did not converge (marked in summary.json).
@@ -50,8 +33,9 @@ pub struct SolveFlags<'a> {
 pub fn solve(case_path: &Path, flags: &SolveFlags) -> Result<()> {
     let started = Instant::now();
     let case = Case::load(case_path, flags.sets)?;
-    let mut progress = Progress { quiet: flags.quiet };
+    let mut progress = Progress::new(flags.verbosity);
     let outcome = memcontact::run(&case.problem, &case.settings, &mut progress)?;
+    progress.finish();
     print_warnings(&outcome.discretization);
     let accepted = outcome.report.accepted;
     if !accepted && !flags.write_unconverged {
@@ -68,14 +52,17 @@ pub fn solve(case_path: &Path, flags: &SolveFlags) -> Result<()> {
                 .unwrap_or_default()
         );
     }
+    let label = case_path.display().to_string();
+    let plots = output::plot_options(&case, &label);
     let options = WriteOptions {
-        label: case_path.display().to_string(),
+        label,
         vtu: case.output.vtu,
         force: flags.force,
         started,
+        plot_options: serde_json::to_value(&plots).ok(),
     };
     let summary = {
-        let mut pictures = output::pictures(&case, &outcome, &options.label);
+        let mut pictures = output::pictures(&outcome, &plots);
         write_result_set(flags.out, &outcome, &case, &options, &mut pictures)?
     };
     print!(
@@ -113,7 +100,7 @@ pub fn check(case_path: &Path, sets: &[String]) -> Result<()> {
     let case = Case::load(case_path, sets)?;
     // Building the mesh, binding and assembling checks the data on the mesh (regions,
     // signs, NaN), everything `solve` checks before it solves.
-    let d = Discretization::new(&case.problem, &mut Progress { quiet: true })?;
+    let d = Discretization::new(&case.problem, &mut Progress::new(Verbosity::Quiet))?;
     print_warnings(&d);
     let mesh = d.mesh();
     println!("case {}: valid", case_path.display());

@@ -2,7 +2,6 @@
 //! and log-log plot, the lumped/consistent and nodal/mollified comparisons and the
 //! rigid-limit sweep. The numerics are in `memcontact::convergence`.
 
-use crate::plot;
 use anyhow::{anyhow, bail, Context, Result};
 use memcontact::convergence::{
     self as study, LevelResult, ManufacturedLoad, Study, StudySettings, Sweep, Target,
@@ -17,6 +16,7 @@ use memcontact::model::{Foundation, ProblemData, Sampling};
 use memcontact::problem::{ExactSpec, ManufacturedDomain, MeshSource};
 use memcontact::run::BoundData;
 use memcontact::Case;
+use memcontact_plot as plot;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 

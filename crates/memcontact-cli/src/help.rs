@@ -18,10 +18,15 @@ CASE FILE (TOML; paths relative to the case file; unknown keys are errors)
               foundation = consistent    or lumped (l_i = ∫ h g_i)
               sampling = nodal           or mollified (φ_n = r_n(J_ε * φ)); epsilon = ε (paper's ε_n)
 [solver]      method = auto              linear | active-set | qp | coordinate | multigrid
-              tolerance = 1e-10          on the scaled KKT residual (2e, 2f)
+              tolerance = 1e-10          on the scaled KKT residual (2e, 2f), below 1e-2
               max_iterations             per method by default
+              accept_rounding_floor = true   accept an answer at the rounding floor of
+                                         double precision above the tolerance (reported)
 [output]      vtu = binary               or ascii
-              plot = true|false          deflection.png (default: meshes ≤ 200 000 triangles)
+              plots = [\"deflection\", \"pressure\", \"liftoff\", \"profile\"]  (default all; [] none)
+              allowable_pressure = p     force/area: pressure.png maps pressure / p
+              profile = [[x0, y0], [x1, y1]]  the line of profile.png (default: mid-height)
+[units]       length = \"m\", force = \"kN\"   names for the labels of the pictures
 
 Units: any consistent system (e.g. m, kN: t in kN/m, f in kN/m², h in kN/m³).
 Expressions: x, y, r, pi, e; + - * / ^; < <= > >= == != && || !; sin cos tan asin acos atan

@@ -7,7 +7,8 @@ mod convergence;
 mod examples;
 mod help;
 mod output;
-mod plot;
+mod plot_cmd;
+mod progress;
 
 use clap::{Parser, Subcommand};
 use std::path::PathBuf;
@@ -46,9 +47,12 @@ enum Command {
         /// Override a case key, e.g. --set mesh.nx=128 --set obstacle.foundation=lumped.
         #[arg(long = "set", value_name = "KEY=VALUE")]
         sets: Vec<String>,
-        /// Print no progress lines.
+        /// Show no progress.
         #[arg(short, long)]
         quiet: bool,
+        /// Print every phase and iteration (energy J and the KKT residual).
+        #[arg(short, long, conflicts_with = "quiet")]
+        verbose: bool,
         /// Replace the output directory even if it holds files that are not a result.
         #[arg(long)]
         force: bool,
@@ -84,6 +88,9 @@ enum Command {
         #[arg(long)]
         phases: bool,
     },
+    /// Redraw the pictures of a result directory (deflection.png, pressure.png,
+    /// liftoff.png, profile.png) from its solution.vtu and summary.json, without solving.
+    Plot(plot_cmd::Args),
     /// List the example cases, or write one (and any mesh it needs) to a directory.
     Example {
         /// The example to write; omit to list them.
@@ -114,6 +121,7 @@ fn main() -> ExitCode {
             output,
             sets,
             quiet,
+            verbose,
             force,
             write_unconverged,
         } => commands::solve(
@@ -121,13 +129,14 @@ fn main() -> ExitCode {
             &commands::SolveFlags {
                 out: &output,
                 sets: &sets,
-                quiet,
+                verbosity: progress::Verbosity::of(quiet, verbose),
                 force,
                 write_unconverged,
             },
         ),
         Command::Check { case, sets } => commands::check(&case, &sets),
         Command::Convergence(args) => convergence::run(&args),
+        Command::Plot(args) => plot_cmd::run(&args),
         Command::Example { name, dir, force } => examples::run(name.as_deref(), &dir, force),
         Command::Bench {
             sizes,

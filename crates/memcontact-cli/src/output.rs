@@ -3,14 +3,12 @@
 //! (`memcontact::output`).
 
 use memcontact::mesh::{Mesh, MeshQuality};
+use memcontact::problem::PictureKind;
 use memcontact::results::NodalFields;
 use memcontact::{Case, Outcome, Summary};
+use memcontact_plot::{draw_all, PlotData, PlotKind, PlotOptions, Units};
 use std::fmt::Write as _;
 use std::path::Path;
-
-/// Above this many triangles `deflection.png` is written only when asked for (it draws
-/// every triangle).
-const PLOT_TRIANGLES: usize = 200_000;
 
 /// The mesh report of `check` and `solve`.
 pub fn mesh_report(mesh: &Mesh, q: &MeshQuality, levels: usize) -> String {
@@ -39,31 +37,57 @@ pub fn mesh_report(mesh: &Mesh, q: &MeshQuality, levels: usize) -> String {
     s
 }
 
-/// The pictures `solve` adds to the result set (see `[output] plot`): a function that
-/// draws them into the staging directory and returns their names.
+/// The options of the pictures of `case` (the `[output]` and `[units]` keys), titled
+/// with `label`.
+pub fn plot_options(case: &Case, label: &str) -> PlotOptions {
+    PlotOptions {
+        plots: case
+            .output
+            .pictures()
+            .into_iter()
+            .map(|k| match k {
+                PictureKind::Deflection => PlotKind::Deflection,
+                PictureKind::Pressure => PlotKind::Pressure,
+                PictureKind::Liftoff => PlotKind::Liftoff,
+                PictureKind::Profile => PlotKind::Profile,
+            })
+            .collect(),
+        allowable_pressure: case.output.allowable_pressure,
+        profile: case.output.profile,
+        units: Units {
+            length: case.units.length.clone(),
+            force: case.units.force.clone(),
+        },
+        title: Some(label.to_string()),
+    }
+}
+
+/// The pictures `solve` adds to the result set (`[output] plots`): a function that draws
+/// them into the staging directory and returns their names.
 pub fn pictures<'a>(
-    case: &'a Case,
     outcome: &'a Outcome,
-    label: &'a str,
+    options: &'a PlotOptions,
 ) -> impl FnMut(&Path, &NodalFields) -> memcontact::Result<Vec<String>> + 'a {
     move |dir: &Path, fields: &NodalFields| {
-        let mesh = outcome.mesh();
-        let plotted = case
-            .output
-            .plot
-            .unwrap_or(mesh.n_triangles() <= PLOT_TRIANGLES);
-        if !plotted {
+        if options.plots.is_empty() {
             return Ok(Vec::new());
         }
-        crate::plot::field_plot(
-            &dir.join("deflection.png"),
-            &mesh.points,
-            &mesh.triangles,
-            &fields.u,
-            &format!("deflection u: {label}"),
-        )
-        .map_err(|e| memcontact::Error::Data(format!("deflection.png: {e:#}")))?;
-        Ok(vec!["deflection.png".into()])
+        let mesh = outcome.mesh();
+        let data = PlotData {
+            points: &mesh.points,
+            triangles: &mesh.triangles,
+            u: &fields.u,
+            phi: &fields.phi,
+            state: &fields.state,
+            pressure: &fields.pressure,
+            covered: &fields.covered,
+        };
+        let files = draw_all(dir, &data, options)
+            .map_err(|e| memcontact::Error::Data(format!("pictures: {e}")))?;
+        Ok(files
+            .iter()
+            .filter_map(|f| f.file_name().map(|n| n.to_string_lossy().into_owned()))
+            .collect())
     }
 }
 

@@ -100,7 +100,7 @@ fn normalise(key: &str, v: &Value, tolerance: f64) -> Value {
             Value::String("[positive]".into())
         }
         Value::Number(n) if n.is_f64() => round(n.as_f64().unwrap()),
-        Value::String(_) if key == "case" => Value::String("[case path]".into()),
+        Value::String(_) if key == "case" || key == "title" => Value::String("[case path]".into()),
         other => other.clone(),
     }
 }

@@ -6,7 +6,8 @@ use crate::convert::{py_err, to_py};
 use crate::mesh::{hierarchy_from_state, mesh_state, PyMesh};
 use memcontact::model::Certificate;
 use memcontact::output::{input_hash, new_run_id, write_result_set, WriteOptions};
-use memcontact::problem::VtuFormat;
+use memcontact::problem::{PictureKind, VtuFormat};
+use memcontact_plot::{draw_all, PlotData, PlotKind, PlotOptions, Units};
 use memcontact::results::NodalFields;
 use memcontact::run::Phase;
 use memcontact::solve::{Choice, Fallback, IterationRecord, Multipliers, Silent};
@@ -269,16 +270,18 @@ impl PyResult_ {
     }
 
     /// Writes the result set the command-line tool writes (`solution.vtu`, `nodes.csv`,
+    /// the pictures of the case's `[output] plots` unless `pictures` is false, and
     /// `summary.json`) into `directory`, atomically; `vtu` ("binary" or "ascii") defaults
     /// to the case's `[output] vtu`. A directory holding other files is refused unless
     /// `force`. Returns the summary written.
-    #[pyo3(signature = (directory, force=false, vtu=None))]
+    #[pyo3(signature = (directory, force=false, vtu=None, pictures=true))]
     fn write<'py>(
         &self,
         py: Python<'py>,
         directory: PathBuf,
         force: bool,
         vtu: Option<&str>,
+        pictures: bool,
     ) -> PyResult<Bound<'py, PyAny>> {
         let vtu = match vtu {
             None => self.data.case.output.vtu,
@@ -293,6 +296,10 @@ impl PyResult_ {
         let summary = py
             .detach(|| {
                 let outcome = self.outcome()?;
+                let mut plots = plot_options(&self.data.case, &self.data.label);
+                if !pictures {
+                    plots.plots.clear();
+                }
                 let now = Instant::now();
                 let options = WriteOptions {
                     label: self.data.label.clone(),
@@ -301,13 +308,35 @@ impl PyResult_ {
                     started: now
                         .checked_sub(Duration::from_secs_f64(self.data.seconds))
                         .unwrap_or(now),
+                    plot_options: serde_json::to_value(&plots).ok(),
+                };
+                let mesh = outcome.mesh();
+                let mut draw = |dir: &std::path::Path, fields: &NodalFields| {
+                    if plots.plots.is_empty() {
+                        return Ok(Vec::new());
+                    }
+                    let data = PlotData {
+                        points: &mesh.points,
+                        triangles: &mesh.triangles,
+                        u: &fields.u,
+                        phi: &fields.phi,
+                        state: &fields.state,
+                        pressure: &fields.pressure,
+                        covered: &fields.covered,
+                    };
+                    let files = draw_all(dir, &data, &plots)
+                        .map_err(|e| memcontact::Error::Data(format!("pictures: {e}")))?;
+                    Ok(files
+                        .iter()
+                        .filter_map(|f| f.file_name().map(|n| n.to_string_lossy().into_owned()))
+                        .collect())
                 };
                 write_result_set(
                     &directory,
                     &outcome,
                     &self.data.case,
                     &options,
-                    &mut |_, _| Ok(Vec::new()),
+                    &mut draw,
                 )
             })
             .map_err(py_err)?;
@@ -370,6 +399,7 @@ impl PyResult_ {
             state.set_item(*name, Self::f64_array(py, v))?;
         }
         state.set_item("state", PyArray1::from_slice(py, &f.state))?;
+        state.set_item("covered", PyArray1::from_slice(py, &f.covered))?;
         state.set_item("u_dofs", Self::f64_array(py, &r.u))?;
         if let Some(m) = &r.multipliers {
             state.set_item("x1", Self::f64_array(py, &m.x1))?;
@@ -380,6 +410,36 @@ impl PyResult_ {
             .import("memcontact._memcontact")?
             .getattr("_result_from_state")?;
         PyTuple::new(py, [rebuild, PyTuple::new(py, [state])?.into_any()])
+    }
+}
+
+fn vec_bool(a: &Bound<'_, PyAny>) -> PyResult<Vec<bool>> {
+    let a: PyReadonlyArray1<'_, bool> = a.extract()?;
+    Ok(a.as_array().to_vec())
+}
+
+/// The pictures of `case` as the command-line tool draws them (`[output]`, `[units]`),
+/// titled with `label`.
+fn plot_options(case: &Case, label: &str) -> PlotOptions {
+    PlotOptions {
+        plots: case
+            .output
+            .pictures()
+            .into_iter()
+            .map(|k| match k {
+                PictureKind::Deflection => PlotKind::Deflection,
+                PictureKind::Pressure => PlotKind::Pressure,
+                PictureKind::Liftoff => PlotKind::Liftoff,
+                PictureKind::Profile => PlotKind::Profile,
+            })
+            .collect(),
+        allowable_pressure: case.output.allowable_pressure,
+        profile: case.output.profile,
+        units: Units {
+            length: case.units.length.clone(),
+            force: case.units.force.clone(),
+        },
+        title: Some(label.to_string()),
     }
 }
 
@@ -400,6 +460,7 @@ pub fn _result_from_state(state: &Bound<'_, PyDict>) -> PyResult<PyResult_> {
     let case = Case::from_toml_str(&meta.case, None).map_err(py_err)?;
     let state_arr: PyReadonlyArray1<'_, i8> = get("state")?.extract()?;
     let fields = NodalFields {
+        covered: vec_bool(&get("covered")?)?,
         u: vec("u")?,
         phi: vec("phi")?,
         penetration: vec("penetration")?,

@@ -71,5 +71,11 @@ def test_python_solve_equals_cli_nodes_csv(cli, examples, tmp_path, example, ove
         assert py_summary[key] == pytest.approx(cli_summary[key], rel=1e-12, abs=1e-14), key
     assert py_summary["input_hash"] == cli_summary["input_hash"]
     assert (py_dir / "solution.vtu").stat().st_size > 0
+    # The same pictures, drawn from the same numbers: the same bytes.
+    assert set(py_summary["files"]) == set(cli_summary["files"])
+    pictures = [n for n in cli_summary["files"] if n.endswith(".png")]
+    assert pictures, "the CLI drew no picture"
+    for name in pictures:
+        assert py_summary["files"][name] == cli_summary["files"][name], name
     # The in-memory summary has the same keys as the file.
     assert set(result.summary) == set(cli_summary)

@@ -45,7 +45,11 @@ pub const AT_FLOOR: f64 = 2.0;
 
 /// A solve whose residual stops decreasing within this factor of the rounding floor has
 /// reached what the arithmetic allows (the floor is an estimate, not a bound).
-pub const NEAR_FLOOR: f64 = 64.0;
+pub const NEAR_FLOOR: f64 = 8.0;
+
+/// Above this rounding floor the certificate can no longer certify an answer worth
+/// having: the data's scales are beyond what double precision resolves.
+pub const FLOOR_LIMIT: f64 = 1e-6;
 
 /// Iterations without a 10 % decrease of the best residual after which a solve near the
 /// rounding floor is considered stuck there.

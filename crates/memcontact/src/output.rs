@@ -37,6 +37,8 @@ pub struct WriteOptions {
     pub force: bool,
     /// When the run started (for `time_total_s`).
     pub started: Instant,
+    /// The options of the pictures, recorded in `summary.json` so they can be redrawn.
+    pub plot_options: Option<serde_json::Value>,
 }
 
 /// A fresh random run identifier (32 hex digits).
@@ -85,6 +87,7 @@ pub fn write_fields(
     let mesh = outcome.mesh();
     let region: Vec<i32> = mesh.regions.iter().map(|&r| r as i32).collect();
     let state: Vec<i32> = fields.state.iter().map(|&s| s as i32).collect();
+    let covered: Vec<i32> = fields.covered.iter().map(|&c| c as i32).collect();
     let point_data = [
         ("u", DataArray::F64(&fields.u)),
         ("phi", DataArray::F64(&fields.phi)),
@@ -93,10 +96,12 @@ pub fn write_fields(
         ("contact_force", DataArray::F64(&fields.contact_force)),
         ("state", DataArray::I32(&state)),
     ];
+    let mut vtu_points = point_data.to_vec();
+    vtu_points.push(("covered", DataArray::I32(&covered)));
     write_vtu(
         &dir.join("solution.vtu"),
         mesh,
-        &point_data,
+        &vtu_points,
         &[("region", DataArray::I32(&region))],
         match vtu {
             VtuFormat::Binary => VtuEncoding::Binary,
@@ -130,6 +135,7 @@ pub fn write_result_set(
     let mut summary = Summary::new(&options.label, outcome, &quality, &totals);
     summary.run_id = new_run_id();
     summary.input_hash = input_hash(case);
+    summary.plot_options = options.plot_options.clone();
     for name in names {
         let record = file_record(&set.dir().join(&name))?;
         summary.files.insert(name, record);

@@ -22,6 +22,8 @@ pub struct NodalFields {
     pub contact_force: Vec<f64>,
     /// −1 clear, 0 touching (U = φ), 1 penetrating.
     pub state: Vec<i8>,
+    /// Where the body lies against the membrane: h > 0 around the vertex, or rigid.
+    pub covered: Vec<bool>,
 }
 
 /// Scalar results.
@@ -123,6 +125,7 @@ pub fn derive_from(mesh: &Mesh, model: &Model, u_dofs: &[f64]) -> (NodalFields, 
             pressure,
             contact_force,
             state,
+            covered: model.h_vertices.iter().map(|&h| h > 0.0).collect(),
         },
         totals,
     )

@@ -236,7 +236,7 @@ fn check_overflow(mesh: &Mesh, model: &Model) -> Result<()> {
         .fold(f64::INFINITY, f64::min);
     if !model.s.is_finite() {
         return Err(Error::Data(format!(
-            "the stiffness matrix S overflows double precision: tension t = {} on triangles \
+            "the stiffness matrix S overflows double precision: tension t = {:e} on triangles \
              as small as {smallest_area:e} (S grows like t × edge² / area); rescale the \
              problem (units) so that t and the mesh are moderate",
             model.tension

@@ -125,6 +125,9 @@ pub struct Summary {
     pub input_hash: String,
     /// The other files of the result set, by name.
     pub files: BTreeMap<String, FileRecord>,
+    /// How the pictures were drawn (so `memcontact plot` redraws them identically).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub plot_options: Option<serde_json::Value>,
 }
 
 impl Summary {
@@ -197,6 +200,7 @@ impl Summary {
             run_id: String::new(),
             input_hash: String::new(),
             files: BTreeMap::new(),
+            plot_options: None,
         }
     }
 }

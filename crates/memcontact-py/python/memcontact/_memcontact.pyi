@@ -97,7 +97,11 @@ class Result:
     @property
     def warnings(self) -> List[str]: ...
     def write(
-        self, directory: Union[str, PathLike[str]], force: bool = False, vtu: Optional[str] = None
+        self,
+        directory: Union[str, PathLike[str]],
+        force: bool = False,
+        vtu: Optional[str] = None,
+        pictures: bool = True,
     ) -> Dict[str, Any]: ...
 
 def solve(case: Case) -> Result: ...

@@ -389,7 +389,7 @@ fn run_method(
                 (Status::Converged, None)
             } else if !kkt.is_finite() || !solution.energy.is_finite() {
                 (Status::NumericalFailure, None)
-            } else if floor >= LOOSEST_TOLERANCE {
+            } else if floor > crate::certificate::FLOOR_LIMIT {
                 (
                     Status::NumericalFailure,
                     Some(format!(
@@ -406,9 +406,17 @@ fn run_method(
             } else {
                 (Status::Stalled, None)
             };
+            let message = match status {
+                Status::Converged | Status::RoundingFloor => message,
+                _ => message.or_else(|| conditioning(model)),
+            };
             Ok((solution, status, message))
         }
         Err(Error::Solver { message, .. }) => {
+            let message = match conditioning(model) {
+                Some(c) => format!("{message}; {c}"),
+                None => message,
+            };
             let u = active_set::feasible_start(model);
             let certificate = model.certificate(&u);
             let solution = Solution {
@@ -425,6 +433,29 @@ fn run_method(
         }
         Err(e) => Err(e),
     }
+}
+
+/// Above this ratio of foundation to membrane stiffness (diagonals of L and S), solves in
+/// double precision lose the balance between the two.
+const STIFFNESS_RATIO_LIMIT: f64 = 1e6;
+
+/// A note on the model's conditioning when the foundation is so much stiffer than the
+/// membrane that a failed solve is explained by it.
+fn conditioning(model: &Model) -> Option<String> {
+    let s_min = (0..model.n())
+        .map(|i| model.s.get(i, i))
+        .fold(f64::INFINITY, f64::min);
+    let l_max = (0..model.n())
+        .map(|i| model.l.diag(i))
+        .fold(0.0f64, f64::max);
+    let ratio = l_max / s_min;
+    (ratio > STIFFNESS_RATIO_LIMIT).then(|| {
+        format!(
+            "the foundation is {ratio:.1e} times stiffer than the membrane (diagonals of L and \
+             S), beyond what double precision resolves well: use stiffness = \"rigid\" for \
+             so stiff a body, or rescale the problem"
+        )
+    })
 }
 
 /// Solves the model with the settings' method (resolving `auto` by [`auto_choice`], with
@@ -512,15 +543,13 @@ pub fn status_error(
         ),
         Status::IterationLimit => format!("reached the iteration limit ({iterations})"),
         Status::Stalled => format!("stalled after {iterations} iterations"),
-        Status::NumericalFailure => format!(
-            "failed numerically{}",
-            message.map(|m| format!(": {m}")).unwrap_or_default()
-        ),
+        Status::NumericalFailure => "failed numerically".to_string(),
     };
+    let why = message.map(|m| format!(" ({m})")).unwrap_or_default();
     Error::Solver {
         solver: method.name().into(),
         message: format!(
-            "{what}, with scaled KKT residual {kkt:.3e} above the tolerance {tolerance:.1e}"
+            "{what}, with scaled KKT residual {kkt:.3e} above the tolerance {tolerance:.1e}{why}"
         ),
     }
 }

@@ -1,11 +1,11 @@
-//! PNG plots for reports: log-log convergence plots with reference slopes, and a colour map
-//! of a nodal field over a triangle mesh.
+//! The log-log convergence plot with reference slopes (used by `memcontact convergence`).
 //!
-//! Rendering uses plotters' bitmap backend with the DejaVu Sans font shipped in
-//! `assets/` (no system font is needed); images are rendered in memory, encoded as PNG and
-//! written atomically, so a failure never leaves a half-written file.
+//! Rendering uses plotters' bitmap backend with the bundled DejaVu Sans font (no system
+//! font is needed); the image is rendered in memory, encoded as PNG and written
+//! atomically, so a failure never leaves a half-written file.
 
-use anyhow::{bail, Context, Result};
+use crate::canvas::Canvas;
+use memcontact::{Error, Result};
 use plotters::coord::Shift;
 use plotters::element::DashedPathElement;
 use plotters::prelude::*;
@@ -17,8 +17,6 @@ pub const WIDTH: u32 = 900;
 /// Image height in pixels.
 pub const HEIGHT: u32 = 650;
 
-/// The bundled font (DejaVu Sans, Bitstream Vera licence: `assets/LICENSE-DejaVu.txt`).
-static FONT: &[u8] = include_bytes!("../assets/DejaVuSans.ttf");
 /// The family name the bundled font is registered under.
 const FAMILY: &str = "sans-serif";
 
@@ -39,36 +37,35 @@ const COLORS: [RGBColor; 10] = [
 /// Registers the bundled font with plotters (once per process).
 fn ensure_font() -> Result<()> {
     static REGISTERED: std::sync::OnceLock<bool> = std::sync::OnceLock::new();
-    let ok = *REGISTERED
-        .get_or_init(|| plotters::style::register_font(FAMILY, FontStyle::Normal, FONT).is_ok());
+    let ok = *REGISTERED.get_or_init(|| {
+        plotters::style::register_font(FAMILY, FontStyle::Normal, crate::text::FONT_BYTES).is_ok()
+    });
     if !ok {
-        bail!("the bundled font assets/DejaVuSans.ttf could not be loaded");
+        return Err(Error::Data(
+            "the bundled font DejaVuSans.ttf could not be loaded".into(),
+        ));
     }
-    Ok(())
-}
-
-/// Encodes an RGB buffer as PNG and writes it atomically to `path`.
-fn write_png(path: &Path, rgb: &[u8], width: u32, height: u32) -> Result<()> {
-    use image::ImageEncoder;
-    let mut png = Vec::new();
-    image::codecs::png::PngEncoder::new(&mut png)
-        .write_image(rgb, width, height, image::ColorType::Rgb8)
-        .with_context(|| format!("encoding {}", path.display()))?;
-    memcontact::io::write_atomic(path, |w| w.write_all(&png))?;
     Ok(())
 }
 
 /// Renders into a fresh white `WIDTH × HEIGHT` RGB buffer.
-fn render(draw: impl FnOnce(&DrawingArea<BitMapBackend, Shift>) -> Result<()>) -> Result<Vec<u8>> {
+fn render(draw: impl FnOnce(&DrawingArea<BitMapBackend, Shift>) -> DrawResult) -> Result<Vec<u8>> {
     let mut rgb = vec![255u8; (WIDTH * HEIGHT * 3) as usize];
     {
         let root = BitMapBackend::with_buffer(&mut rgb, (WIDTH, HEIGHT)).into_drawing_area();
-        root.fill(&WHITE)?;
-        draw(&root)?;
-        root.present()?;
+        let drawn = (|| -> DrawResult {
+            root.fill(&WHITE)?;
+            draw(&root)?;
+            root.present()?;
+            Ok(())
+        })();
+        drawn.map_err(|e| Error::Data(format!("drawing the plot failed: {e}")))?;
     }
     Ok(rgb)
 }
+
+/// What plotters' drawing calls return.
+type DrawResult = std::result::Result<(), Box<dyn std::error::Error>>;
 
 /// `10^k` written with superscript digits, e.g. `10⁻³`.
 fn power_of_ten(k: i32) -> String {
@@ -169,10 +166,10 @@ pub fn loglog_plot(
         .collect();
     let all: Vec<(f64, f64)> = clean.iter().flat_map(|(_, p)| p.iter().copied()).collect();
     if all.is_empty() {
-        bail!(
+        return Err(Error::Data(format!(
             "log-log plot {}: no point with positive finite coordinates",
             path.display()
-        );
+        )));
     }
     let fold = |f: fn(f64, f64) -> f64, init: f64, c: fn(&(f64, f64)) -> f64| {
         all.iter().map(c).fold(init, f)
@@ -313,7 +310,12 @@ pub fn loglog_plot(
             .draw()?;
         Ok(())
     })?;
-    write_png(path, &rgb, WIDTH, HEIGHT)
+    Canvas {
+        width: WIDTH,
+        height: HEIGHT,
+        rgb,
+    }
+    .write_png(path)
 }
 
 /// The marker of kind `k` (circle, triangle, square), centred on its anchor.
@@ -327,158 +329,6 @@ fn marker_element<DB: DrawingBackend>(
         1 => TriangleMarker::new((0, 0), 7, style).into_dyn(),
         _ => Rectangle::new([(-5, -5), (5, 5)], style).into_dyn(),
     }
-}
-
-/// Linear tick label with at most four significant digits; values below `1e-9 × scale` in
-/// magnitude (rounding noise of tick positions) are written `0`.
-fn linear_tick_label(v: f64, scale: f64) -> String {
-    if v.abs() <= 1e-9 * scale {
-        return "0".into();
-    }
-    let l = v.abs().log10();
-    if !(-3.0..5.0).contains(&l) {
-        return format!("{v:.2e}");
-    }
-    let digits = (3 - l.floor() as i32).max(0) as usize;
-    let s = format!("{v:.digits$}");
-    if s.contains('.') {
-        s.trim_end_matches('0').trim_end_matches('.').to_string()
-    } else {
-        s
-    }
-}
-
-/// Writes a colour map of the nodal field `values` over a triangle mesh as a
-/// `WIDTH × HEIGHT` PNG, for a quick look at a solution (e.g. the deflection).
-///
-/// Each triangle is filled with the viridis colour of the mean of its three vertex values
-/// (non-finite means are drawn grey), on axes of equal scale, with a colour bar. Every
-/// triangle is drawn, so a mesh of millions of triangles takes seconds. Errors: `values`
-/// not one per point, a triangle referring to a missing point, or no finite value.
-pub fn field_plot(
-    path: &Path,
-    points: &[[f64; 2]],
-    triangles: &[[u32; 3]],
-    values: &[f64],
-    title: &str,
-) -> Result<()> {
-    ensure_font()?;
-    if values.len() != points.len() {
-        bail!(
-            "field plot {}: {} values for {} points",
-            path.display(),
-            values.len(),
-            points.len()
-        );
-    }
-    if let Some((t, tri)) = triangles
-        .iter()
-        .enumerate()
-        .find(|(_, t)| t.iter().any(|&v| v as usize >= points.len()))
-    {
-        bail!(
-            "field plot {}: triangle {t} {tri:?} refers to a missing point",
-            path.display()
-        );
-    }
-    let finite = values.iter().copied().filter(|v| v.is_finite());
-    let (vmin, vmax) = finite.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
-        (a.min(v), b.max(v))
-    });
-    if vmin > vmax {
-        bail!("field plot {}: no finite value", path.display());
-    }
-    let (vmin, vmax) = if vmin < vmax {
-        (vmin, vmax)
-    } else {
-        let d = if vmin == 0.0 { 1.0 } else { 0.5 * vmin.abs() };
-        (vmin - d, vmax + d)
-    };
-    let (mut x0, mut x1, mut y0, mut y1) = (
-        f64::INFINITY,
-        f64::NEG_INFINITY,
-        f64::INFINITY,
-        f64::NEG_INFINITY,
-    );
-    for p in triangles.iter().flatten().map(|&v| points[v as usize]) {
-        (x0, x1, y0, y1) = (x0.min(p[0]), x1.max(p[0]), y0.min(p[1]), y1.max(p[1]));
-    }
-    if triangles.is_empty() || !(x1 > x0 && y1 > y0) {
-        bail!(
-            "field plot {}: the mesh has no area to draw",
-            path.display()
-        );
-    }
-
-    let rgb = render(|root| {
-        let root = root.margin(12, 0, 0, 0).titled(title, (FAMILY, 26))?;
-        let (map_area, bar_area) = root.split_horizontally(WIDTH as i32 - 150);
-        // Equal scales: widen the data box to the shape of the plotting area.
-        let (label_x, label_y, margin) = (45u32, 75u32, 15u32);
-        let (w, h) = map_area.dim_in_pixel();
-        let (pw, ph) = (
-            (w - label_y - 2 * margin) as f64,
-            (h - label_x - 2 * margin) as f64,
-        );
-        let (dx, dy) = (x1 - x0, y1 - y0);
-        let scale = (dx / pw).max(dy / ph) * 1.02;
-        let (cx, cy) = (0.5 * (x0 + x1), 0.5 * (y0 + y1));
-        let (hx, hy) = (0.5 * scale * pw, 0.5 * scale * ph);
-        let mut chart = ChartBuilder::on(&map_area)
-            .margin(margin)
-            .x_label_area_size(label_x)
-            .y_label_area_size(label_y)
-            .build_cartesian_2d(cx - hx..cx + hx, cy - hy..cy + hy)?;
-        let scale = hx.max(hy) + cx.abs().max(cy.abs());
-        let fmt = |v: &f64| linear_tick_label(*v, scale);
-        let vscale = vmax.abs().max(vmin.abs());
-        let vfmt = |v: &f64| linear_tick_label(*v, vscale);
-        chart
-            .configure_mesh()
-            .disable_mesh()
-            .x_label_formatter(&fmt)
-            .y_label_formatter(&fmt)
-            .label_style((FAMILY, 16))
-            .draw()?;
-        chart.draw_series(triangles.iter().map(|t| {
-            let mean = t.iter().map(|&v| values[v as usize]).sum::<f64>() / 3.0;
-            let color = if mean.is_finite() {
-                ViridisRGB::get_color_normalized(mean, vmin, vmax)
-            } else {
-                RGBColor(160, 160, 160)
-            };
-            let pts: Vec<(f64, f64)> = t
-                .iter()
-                .map(|&v| (points[v as usize][0], points[v as usize][1]))
-                .collect();
-            Polygon::new(pts, color.filled())
-        }))?;
-
-        // Colour bar.
-        let mut bar = ChartBuilder::on(&bar_area)
-            .margin_top(margin + 10)
-            .margin_bottom(margin + label_x)
-            .margin_left(10)
-            .margin_right(10)
-            .y_label_area_size(0)
-            .right_y_label_area_size(85)
-            .build_cartesian_2d(0.0..1.0, vmin..vmax)?;
-        bar.configure_mesh()
-            .disable_mesh()
-            .disable_x_axis()
-            .y_label_formatter(&vfmt)
-            .label_style((FAMILY, 16))
-            .draw()?;
-        let steps = 256;
-        bar.draw_series((0..steps).map(|k| {
-            let a = vmin + (vmax - vmin) * k as f64 / steps as f64;
-            let b = vmin + (vmax - vmin) * (k + 1) as f64 / steps as f64;
-            let c = ViridisRGB::get_color_normalized(0.5 * (a + b), vmin, vmax);
-            Rectangle::new([(0.0, a), (1.0, b)], c.filled())
-        }))?;
-        Ok(())
-    })?;
-    write_png(path, &rgb, WIDTH, HEIGHT)
 }
 
 #[cfg(test)]
@@ -530,18 +380,19 @@ mod tests {
         .unwrap();
         let bytes = std::fs::read(&path).unwrap();
         assert_eq!(png_size(&bytes), (WIDTH, HEIGHT));
-        let img = image::load_from_memory(&bytes).unwrap().to_rgb8();
-        let non_white = img.pixels().filter(|p| p.0 != [255, 255, 255]).count();
+        let img = crate::canvas::decode_png(&bytes).unwrap();
+        let px = || img.rgb.chunks_exact(3);
+        let non_white = px().filter(|p| p != &[255, 255, 255]).count();
         assert!(non_white > 20_000, "{non_white} non-white pixels");
         // Every series colour is drawn (lines and markers), and so is the reference grey.
         for c in COLORS.iter().take(3).chain([&RGBColor(70, 70, 70)]) {
-            let n = img.pixels().filter(|p| p.0 == [c.0, c.1, c.2]).count();
+            let n = px().filter(|p| p == &[c.0, c.1, c.2]).count();
             assert!(n > 200, "colour {c:?}: {n} pixels");
         }
         // Only the PNG is left in the directory (the write is atomic).
         assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
         if let Ok(keep) = std::env::var("MEMCONTACT_KEEP_PLOTS") {
-            std::fs::copy(&path, Path::new(&keep).join("loglog.png")).unwrap();
+            std::fs::copy(&path, std::path::Path::new(&keep).join("loglog.png")).unwrap();
         }
     }
 
@@ -558,9 +409,6 @@ mod tests {
     #[test]
     fn tick_labels_and_reference_clipping() {
         assert_eq!(power_of_ten(-3), "10⁻³");
-        assert_eq!(linear_tick_label(-2.22e-16, 1.0), "0");
-        assert_eq!(linear_tick_label(0.25, 1.0), "0.25");
-        assert_eq!(linear_tick_label(1.5e-7, 1e-6), "1.50e-7");
         assert_eq!(power_of_ten(12), "10¹²");
         assert_eq!(log_tick_label(1e-3, true), "10⁻³");
         assert_eq!(log_tick_label(2e-3, true), "");
@@ -572,66 +420,5 @@ mod tests {
         assert!((p.0 - 10f64.powf(-0.5)).abs() < 1e-12 && (p.1 - 0.1).abs() < 1e-12);
         assert!((q.0 - 10f64.powf(0.5)).abs() < 1e-12 && (q.1 - 10.0).abs() < 1e-12);
         assert!(clip_reference((100.0, 100.0), 0.0, (0.1, 10.0), (0.1, 10.0)).is_none());
-    }
-}
-
-#[cfg(test)]
-mod field_tests {
-    use super::*;
-
-    #[test]
-    fn field_png_shows_the_colour_range() {
-        // A structured mesh of the unit disc's bounding square, with a radial bump.
-        let n = 30;
-        let points: Vec<[f64; 2]> = (0..(n + 1) * (n + 1))
-            .map(|k| {
-                [
-                    2.0 * (k % (n + 1)) as f64 / n as f64 - 1.0,
-                    (k / (n + 1)) as f64 / n as f64 - 0.5,
-                ]
-            })
-            .collect();
-        let mut triangles = Vec::new();
-        for j in 0..n as u32 {
-            for i in 0..n as u32 {
-                let a = j * (n as u32 + 1) + i;
-                let d = a + n as u32 + 1;
-                triangles.push([a, a + 1, d + 1]);
-                triangles.push([a, d + 1, d]);
-            }
-        }
-        let values: Vec<f64> = points
-            .iter()
-            .map(|p| 1.0 - p[0] * p[0] - p[1] * p[1])
-            .collect();
-        let dir = tempfile::tempdir().unwrap();
-        let path = dir.path().join("field.png");
-        field_plot(
-            &path,
-            &points,
-            &triangles,
-            &values,
-            "deflection u (made-up)",
-        )
-        .unwrap();
-        let bytes = std::fs::read(&path).unwrap();
-        let img = image::load_from_memory(&bytes).unwrap().to_rgb8();
-        assert_eq!(img.dimensions(), (WIDTH, HEIGHT));
-        // Both ends of viridis appear: dark purple (low) and yellow (high).
-        let near = |p: &image::Rgb<u8>, c: RGBColor| {
-            (p.0[0] as i32 - c.0 as i32).abs()
-                + (p.0[1] as i32 - c.1 as i32).abs()
-                + (p.0[2] as i32 - c.2 as i32).abs()
-                < 40
-        };
-        let low = ViridisRGB::get_color_normalized(0.0, 0.0, 1.0);
-        let high = ViridisRGB::get_color_normalized(1.0, 0.0, 1.0);
-        assert!(img.pixels().filter(|p| near(p, low)).count() > 100);
-        assert!(img.pixels().filter(|p| near(p, high)).count() > 100);
-        if let Ok(keep) = std::env::var("MEMCONTACT_KEEP_PLOTS") {
-            std::fs::copy(&path, Path::new(&keep).join("field.png")).unwrap();
-        }
-        let e = field_plot(&path, &points, &triangles, &values[1..], "t").unwrap_err();
-        assert!(e.to_string().contains("values for"), "{e}");
     }
 }

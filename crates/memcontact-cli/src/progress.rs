@@ -1,0 +1,108 @@
+//! Progress on the terminal: a spinner with the current phase and, while solving, the
+//! iteration and its certificate (hidden when stderr is not a terminal or with --quiet);
+//! with --verbose, one line per iteration instead. The library reports progress through
+//! its `Observer`; only this module draws.
+
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use memcontact::solve::{IterationRecord, Observer};
+use std::io::IsTerminal;
+use std::time::Duration;
+
+/// How much the terminal shows.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Verbosity {
+    /// Nothing but the summary and errors.
+    Quiet,
+    /// A progress spinner when stderr is a terminal.
+    Normal,
+    /// One line per phase and per iteration.
+    Verbose,
+}
+
+impl Verbosity {
+    /// From the `--quiet` and `--verbose` flags (quiet wins).
+    pub fn of(quiet: bool, verbose: bool) -> Verbosity {
+        if quiet {
+            Verbosity::Quiet
+        } else if verbose {
+            Verbosity::Verbose
+        } else {
+            Verbosity::Normal
+        }
+    }
+}
+
+/// The CLI's observer of a run.
+pub struct Progress {
+    verbosity: Verbosity,
+    bar: Option<ProgressBar>,
+    /// Prefix of the messages (a sweep step, say).
+    prefix: String,
+}
+
+impl Progress {
+    /// A progress display for `verbosity`.
+    pub fn new(verbosity: Verbosity) -> Progress {
+        let bar = (verbosity == Verbosity::Normal && std::io::stderr().is_terminal()).then(|| {
+            let bar = ProgressBar::with_draw_target(None, ProgressDrawTarget::stderr());
+            bar.set_style(
+                ProgressStyle::with_template("{spinner} {elapsed:>4} {prefix}{msg}")
+                    .unwrap_or_else(|_| ProgressStyle::default_spinner()),
+            );
+            bar.enable_steady_tick(Duration::from_millis(120));
+            bar
+        });
+        Progress {
+            verbosity,
+            bar,
+            prefix: String::new(),
+        }
+    }
+
+    /// Removes the spinner.
+    pub fn finish(&self) {
+        if let Some(b) = &self.bar {
+            b.finish_and_clear();
+        }
+    }
+}
+
+impl Drop for Progress {
+    fn drop(&mut self) {
+        self.finish();
+    }
+}
+
+impl Observer for Progress {
+    fn iteration(&mut self, r: &IterationRecord) {
+        match self.verbosity {
+            Verbosity::Verbose => eprintln!(
+                "  {}iteration {:>5}  J = {:+.12e}  KKT = {:.3e}",
+                self.prefix, r.iteration, r.energy, r.residual
+            ),
+            _ => {
+                if let Some(b) = &self.bar {
+                    b.set_message(format!(
+                        "solve: iteration {}, KKT {:.2e}",
+                        r.iteration, r.residual
+                    ));
+                }
+            }
+        }
+    }
+
+    fn phase_started(&mut self, name: &str) {
+        if let Some(b) = &self.bar {
+            b.set_message(format!("{name} …"));
+        }
+        if self.verbosity == Verbosity::Verbose {
+            eprintln!("  {}{name} …", self.prefix);
+        }
+    }
+
+    fn phase_finished(&mut self, name: &str, seconds: f64) {
+        if self.verbosity == Verbosity::Verbose {
+            eprintln!("  {}{name} done in {seconds:.3} s", self.prefix);
+        }
+    }
+}

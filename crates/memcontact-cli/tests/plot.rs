@@ -1,0 +1,74 @@
+//! End-to-end: `memcontact plot DIR` redraws the pictures of a solved case.
+
+mod common;
+
+use common::{examples, run, text, tmp_in};
+
+/// Width and height from a PNG's IHDR chunk.
+fn png_size(path: &std::path::Path) -> (u32, u32) {
+    let b = std::fs::read(path).unwrap();
+    assert_eq!(&b[..8], b"\x89PNG\r\n\x1a\n", "{} is a PNG", path.display());
+    let be = |i: usize| u32::from_be_bytes(b[i..i + 4].try_into().unwrap());
+    (be(16), be(20))
+}
+
+#[test]
+fn plot_redraws_a_result_directory() {
+    let dir = tmp_in("plot", "disk");
+    let case = examples().join("disk.toml");
+    let o = run(&[
+        "solve",
+        case.to_str().unwrap(),
+        "-o",
+        dir.to_str().unwrap(),
+        "-q",
+    ]);
+    assert!(o.status.success(), "{}", text(&o));
+    let _ = std::fs::remove_file(dir.join("deflection.png"));
+    let o = run(&["plot", dir.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", text(&o));
+    for name in ["deflection", "pressure", "liftoff", "profile"] {
+        let f = dir.join(format!("{name}.png"));
+        let want = if name == "profile" {
+            (
+                memcontact_plot::PROFILE_WIDTH,
+                memcontact_plot::PROFILE_HEIGHT,
+            )
+        } else {
+            (memcontact_plot::MAP_WIDTH, memcontact_plot::MAP_HEIGHT)
+        };
+        assert_eq!(png_size(&f), want, "{name}");
+    }
+    assert!(text(&o).contains("wrote"), "{}", text(&o));
+    // --plots chooses; an unknown name is a clear error.
+    let first = std::fs::read(dir.join("pressure.png")).unwrap();
+    std::fs::remove_file(dir.join("pressure.png")).unwrap();
+    std::fs::remove_file(dir.join("profile.png")).unwrap();
+    let o = run(&["plot", dir.to_str().unwrap(), "--plots", "pressure"]);
+    assert!(o.status.success(), "{}", text(&o));
+    assert_eq!(
+        std::fs::read(dir.join("pressure.png")).unwrap(),
+        first,
+        "same picture again"
+    );
+    assert!(!dir.join("profile.png").exists());
+    let o = run(&[
+        "plot",
+        dir.to_str().unwrap(),
+        "--plots",
+        "pressure,contours",
+    ]);
+    assert!(!o.status.success());
+    assert!(
+        text(&o).contains("unknown plot \"contours\""),
+        "{}",
+        text(&o)
+    );
+    // Not a result directory: the missing file is named.
+    let empty = tmp_in("plot", "empty");
+    let o = run(&["plot", empty.to_str().unwrap()]);
+    assert!(!o.status.success());
+    assert!(text(&o).contains("solution.vtu"), "{}", text(&o));
+    let _ = std::fs::remove_dir_all(&dir);
+    let _ = std::fs::remove_dir_all(&empty);
+}

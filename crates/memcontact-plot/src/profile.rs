@@ -1,0 +1,267 @@
+//! The profile picture: u and φ along a straight line against arc length, exactly as the
+//! P1 fields vary along it (one piece per triangle crossed), contact stretches shaded,
+//! gaps where the line leaves the mesh.
+
+use crate::axes::{self, Axes, Swatch};
+use crate::canvas::{Canvas, Coverage, PixelRect, Rgb};
+use crate::ticks;
+use crate::{Picture, PlotData, PlotKind, PlotOptions, PROFILE_HEIGHT, PROFILE_WIDTH};
+use memcontact::{Error, Result};
+use rayon::prelude::*;
+
+/// Colour of u.
+const U_COLOR: Rgb = [31, 90, 180];
+/// Colour of φ.
+const PHI_COLOR: Rgb = [140, 70, 20];
+/// Shade of the contact stretches.
+pub const CONTACT_SHADE: Rgb = [253, 208, 162];
+
+/// One piece of the line inside one triangle: parameters, and u, φ, contact indicator at
+/// both ends.
+#[derive(Debug, Clone, Copy)]
+struct Piece {
+    t: [f64; 2],
+    u: [f64; 2],
+    phi: [f64; 2],
+    c: [f64; 2],
+}
+
+/// The profile line of `options` (default: through the middle of the bounding box,
+/// horizontally, across it).
+pub fn line_of(data: &PlotData, options: &PlotOptions) -> [[f64; 2]; 2] {
+    options.profile.unwrap_or_else(|| {
+        let b = data.bbox();
+        let y = 0.5 * (b[2] + b[3]);
+        [[b[0], y], [b[1], y]]
+    })
+}
+
+/// The pieces of the segment `a → b` inside each triangle, sorted along it.
+fn pieces(data: &PlotData, a: [f64; 2], b: [f64; 2]) -> Vec<Piece> {
+    let d = [b[0] - a[0], b[1] - a[1]];
+    let (bx0, bx1) = (a[0].min(b[0]), a[0].max(b[0]));
+    let (by0, by1) = (a[1].min(b[1]), a[1].max(b[1]));
+    let contact = |i: usize| if data.state[i] >= 0 { 1.0 } else { 0.0 };
+    let chunks: Vec<Vec<Piece>> = data
+        .triangles
+        .par_chunks(1 << 14)
+        .map(|chunk| {
+            let mut out = Vec::new();
+            for t in chunk {
+                let p = t.map(|v| data.points[v as usize]);
+                let (xmin, xmax) = (
+                    p[0][0].min(p[1][0]).min(p[2][0]),
+                    p[0][0].max(p[1][0]).max(p[2][0]),
+                );
+                let (ymin, ymax) = (
+                    p[0][1].min(p[1][1]).min(p[2][1]),
+                    p[0][1].max(p[1][1]).max(p[2][1]),
+                );
+                if xmax < bx0 || xmin > bx1 || ymax < by0 || ymin > by1 {
+                    continue;
+                }
+                let area = (p[1][0] - p[0][0]) * (p[2][1] - p[0][1])
+                    - (p[1][1] - p[0][1]) * (p[2][0] - p[0][0]);
+                if area == 0.0 {
+                    continue;
+                }
+                // λ_k(t) = (α_k + β_k t) / area, the barycentric coordinate of vertex k.
+                let mut lo = 0.0f64;
+                let mut hi = 1.0f64;
+                let mut ab = [[0.0; 2]; 3];
+                for k in 0..3 {
+                    let (q, r) = (p[(k + 1) % 3], p[(k + 2) % 3]);
+                    let e =
+                        |x: [f64; 2]| (r[0] - q[0]) * (x[1] - q[1]) - (r[1] - q[1]) * (x[0] - q[0]);
+                    let alpha = e(a) / area;
+                    let beta = ((r[0] - q[0]) * d[1] - (r[1] - q[1]) * d[0]) / area;
+                    ab[k] = [alpha, beta];
+                    // alpha + beta t ≥ 0
+                    if beta > 0.0 {
+                        lo = lo.max(-alpha / beta);
+                    } else if beta < 0.0 {
+                        hi = hi.min(-alpha / beta);
+                    } else if alpha < 0.0 {
+                        hi = -1.0;
+                    }
+                }
+                if hi - lo <= 1e-12 {
+                    continue;
+                }
+                let eval = |f: &dyn Fn(usize) -> f64, s: f64| {
+                    (0..3)
+                        .map(|k| (ab[k][0] + ab[k][1] * s) * f(t[k] as usize))
+                        .sum::<f64>()
+                };
+                let at = |f: &dyn Fn(usize) -> f64| [eval(f, lo), eval(f, hi)];
+                out.push(Piece {
+                    t: [lo, hi],
+                    u: at(&|i| data.u[i]),
+                    phi: at(&|i| data.phi[i]),
+                    c: at(&contact),
+                });
+            }
+            out
+        })
+        .collect();
+    let mut all = chunks.concat();
+    all.sort_by(|p, q| p.t[0].total_cmp(&q.t[0]).then(p.t[1].total_cmp(&q.t[1])));
+    all
+}
+
+/// Polylines `(s, value)` of one field, broken where pieces do not meet or the value is not
+/// finite.
+fn polylines(pieces: &[Piece], len: f64, f: impl Fn(&Piece) -> [f64; 2]) -> Vec<Vec<(f64, f64)>> {
+    let mut out: Vec<Vec<(f64, f64)>> = Vec::new();
+    let mut last_t = f64::NEG_INFINITY;
+    for p in pieces {
+        let v = f(p);
+        let ok = v[0].is_finite() && v[1].is_finite();
+        let joined = (p.t[0] - last_t).abs() <= 1e-9;
+        if !ok {
+            last_t = f64::NEG_INFINITY;
+            continue;
+        }
+        if !joined || out.is_empty() {
+            out.push(Vec::new());
+        }
+        let line = out.last_mut().expect("a line was started");
+        if line.is_empty() {
+            line.push((p.t[0] * len, v[0]));
+        }
+        line.push((p.t[1] * len, v[1]));
+        last_t = p.t[1];
+    }
+    out
+}
+
+/// The stretches `[s0, s1]` where the P1 contact indicator is ≥ ½.
+fn contact_stretches(pieces: &[Piece], len: f64) -> Vec<(f64, f64)> {
+    let mut out: Vec<(f64, f64)> = Vec::new();
+    for p in pieces {
+        let [c0, c1] = p.c;
+        let [t0, t1] = p.t;
+        let cross = |c: f64| t0 + (t1 - t0) * (0.5 - c0) / (c - c0);
+        let span = match (c0 >= 0.5, c1 >= 0.5) {
+            (true, true) => Some((t0, t1)),
+            (true, false) => Some((t0, cross(c1))),
+            (false, true) => Some((cross(c1), t1)),
+            (false, false) => None,
+        };
+        if let Some((a, b)) = span {
+            let (a, b) = (a * len, b * len);
+            match out.last_mut() {
+                Some(last) if a <= last.1 + 1e-9 * len => last.1 = last.1.max(b),
+                _ => out.push((a, b)),
+            }
+        }
+    }
+    out
+}
+
+/// Draws the profile picture.
+pub(crate) fn render(data: &PlotData, options: &PlotOptions) -> Result<Picture> {
+    let [a, b] = line_of(data, options);
+    let len = ((b[0] - a[0]).powi(2) + (b[1] - a[1]).powi(2)).sqrt();
+    let ps = pieces(data, a, b);
+    if ps.is_empty() || len.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
+        return Err(Error::Data(format!(
+            "profile: the line from ({}, {}) to ({}, {}) does not cross the mesh",
+            a[0], a[1], b[0], b[1]
+        )));
+    }
+    let u_lines = polylines(&ps, len, |p| p.u);
+    let phi_lines = polylines(&ps, len, |p| p.phi);
+    let stretches = contact_stretches(&ps, len);
+    let vals = u_lines.iter().chain(&phi_lines).flatten().map(|p| p.1);
+    let (lo, hi) = vals.fold((f64::INFINITY, f64::NEG_INFINITY), |r, v| {
+        (r.0.min(v), r.1.max(v))
+    });
+    let (lo, hi) = crate::colormap::widen(lo, hi);
+    let pad = 0.06 * (hi - lo);
+
+    let mut canvas = Canvas::new(PROFILE_WIDTH, PROFILE_HEIGHT);
+    let mut boxes = Vec::new();
+    let ax = Axes {
+        rect: PixelRect {
+            x0: 110,
+            y0: 62,
+            x1: 1040,
+            y1: PROFILE_HEIGHT as i32 - 85,
+        },
+        x: (0.0, len),
+        y: (lo - pad, hi + pad),
+    };
+    let title = match &options.title {
+        Some(t) if !t.is_empty() => format!("Profile: {t}"),
+        _ => "Profile".to_string(),
+    };
+    axes::title(&mut canvas, &title, 30.0, &mut boxes);
+    for &(s0, s1) in &stretches {
+        let x0 = ax.px(s0).round() as i32;
+        let x1 = (ax.px(s1).round() as i32).max(x0 + 1);
+        canvas.fill_rect(
+            PixelRect {
+                x0,
+                y0: ax.rect.y0,
+                x1,
+                y1: ax.rect.y1,
+            },
+            CONTACT_SHADE,
+            1.0,
+        );
+    }
+    ax.grid(&mut canvas);
+    let px = |l: &Vec<(f64, f64)>| {
+        l.iter()
+            .map(|&(s, v)| [ax.px(s), ax.py(v)])
+            .collect::<Vec<_>>()
+    };
+    let mut m = Coverage::new(canvas.width, canvas.height, ax.rect);
+    for l in &phi_lines {
+        m.dashed(&px(l), 2.0, 9.0, 5.0);
+    }
+    canvas.composite(&m, PHI_COLOR, 1.0);
+    let mut m = Coverage::new(canvas.width, canvas.height, ax.rect);
+    for l in &u_lines {
+        m.polyline(&px(l), 2.2);
+    }
+    canvas.composite(&m, U_COLOR, 1.0);
+    let unit = options.units.length_suffix();
+    ax.frame(
+        &mut canvas,
+        &format!("arc length s{unit}"),
+        &format!("u, φ{unit}"),
+        &mut boxes,
+    );
+    let f = |v: f64| ticks::format_sig(v, 4);
+    let mut entries = vec![
+        (Swatch::Line(U_COLOR, 2.2), "deflection u".to_string()),
+        (Swatch::Dashed(PHI_COLOR, 2.0), "obstacle φ".to_string()),
+        (Swatch::Patch(CONTACT_SHADE), "contact (u ≥ φ)".to_string()),
+        (Swatch::None, format!("from ({}, {})", f(a[0]), f(a[1]))),
+        (Swatch::None, format!("to ({}, {})", f(b[0]), f(b[1]))),
+    ];
+    let covered: f64 = ps.iter().map(|p| p.t[1] - p.t[0]).sum::<f64>();
+    if covered < 1.0 - 1e-6 {
+        entries.push((Swatch::None, "gaps: outside the mesh".into()));
+    }
+    axes::legend(&mut canvas, 1070, ax.rect.y0, 220, &entries, &mut boxes);
+    Ok(Picture {
+        kind: PlotKind::Profile,
+        canvas,
+        map: None,
+        text_boxes: boxes,
+        markers: false,
+        range: Some((lo, hi)),
+        axes: Some(ax),
+    })
+}
+
+/// The contact stretches `[s0, s1]` (arc length) along the profile line of `options`: for
+/// checks, and for callers that report them.
+pub fn contact_along(data: &PlotData, options: &PlotOptions) -> Vec<(f64, f64)> {
+    let [a, b] = line_of(data, options);
+    let len = ((b[0] - a[0]).powi(2) + (b[1] - a[1]).powi(2)).sqrt();
+    contact_stretches(&pieces(data, a, b), len)
+}

@@ -1,0 +1,382 @@
+//! The four pictures of real solved cases: sizes, contents, text layout, and the contact
+//! zone drawn where the state field says contact; redrawing from a result directory gives
+//! the same bytes.
+
+mod common;
+
+use common::Solved;
+use memcontact_plot::canvas::{decode_png, Rgb};
+use memcontact_plot::{
+    draw_all, hatch_color, render, MapLayout, Picture, PlotData, PlotKind, PlotOptions, Units,
+    CONTACT, MAP_HEIGHT, MAP_WIDTH, NOT_COVERED, OUTLINE, PROFILE_HEIGHT, PROFILE_WIDTH,
+};
+use std::collections::HashSet;
+
+fn options(s: &Solved) -> PlotOptions {
+    PlotOptions {
+        title: Some(format!("examples/{}.toml", s.name)),
+        units: if s.name == "roof" {
+            Units {
+                length: Some("m".into()),
+                force: Some("kN".into()),
+            }
+        } else {
+            Units::default()
+        },
+        allowable_pressure: (s.name == "roof").then_some(1.8),
+        ..PlotOptions::default()
+    }
+}
+
+/// Distinct colours inside `r`.
+fn distinct(p: &Picture, r: memcontact_plot::PixelRect) -> usize {
+    let mut set = HashSet::new();
+    for y in r.y0..r.y1 {
+        for x in r.x0..r.x1 {
+            set.insert(p.canvas.get(x as u32, y as u32));
+        }
+    }
+    set.len()
+}
+
+/// The vertex class the contact zone is drawn for: 1 contact, 0 clear.
+fn class(d: &PlotData, v: u32) -> u8 {
+    (d.state[v as usize] >= 0) as u8
+}
+
+/// Checks the generic properties of every picture.
+fn check_common(s: &Solved, pics: &[Picture]) {
+    let d = s.data.view();
+    assert_eq!(pics.len(), 4, "{}", s.name);
+    for p in pics {
+        let (w, h) = match p.kind {
+            PlotKind::Profile => (PROFILE_WIDTH, PROFILE_HEIGHT),
+            _ => (MAP_WIDTH, MAP_HEIGHT),
+        };
+        assert_eq!(
+            (p.canvas.width, p.canvas.height),
+            (w, h),
+            "{} {:?}",
+            s.name,
+            p.kind
+        );
+        // Texts lie on the canvas and never overlap.
+        for (i, a) in p.text_boxes.iter().enumerate() {
+            assert!(
+                a.x0 >= 0 && a.y0 >= 0 && a.x1 <= w as i32 && a.y1 <= h as i32,
+                "{} {:?}: text box {a:?} leaves the canvas",
+                s.name,
+                p.kind
+            );
+            for b in &p.text_boxes[..i] {
+                assert!(
+                    !a.overlaps(b),
+                    "{} {:?}: texts {a:?} and {b:?} overlap",
+                    s.name,
+                    p.kind
+                );
+            }
+        }
+        assert!(
+            p.text_boxes.len() > 10,
+            "{} {:?}: axes, title, legend",
+            s.name,
+            p.kind
+        );
+        // Not blank: many colours where the data is drawn.
+        let area = match (&p.map, &p.axes) {
+            (Some((_, frame)), _) => *frame,
+            (_, Some(ax)) => ax.rect,
+            _ => panic!("no drawing area"),
+        };
+        let n = distinct(p, area);
+        let want = if p.kind == PlotKind::Liftoff || p.kind == PlotKind::Profile {
+            20
+        } else {
+            100
+        };
+        assert!(n > want, "{} {:?}: {n} distinct colours", s.name, p.kind);
+    }
+    // The colour bar of u spans the data range of u.
+    let lo = d.u.iter().copied().fold(f64::INFINITY, f64::min);
+    let hi = d.u.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+    assert_eq!(pics[0].range, Some((lo, hi)), "{}", s.name);
+    // The pressure bar spans the pressure (or ratio) range.
+    let a = options(s).allowable_pressure.unwrap_or(1.0);
+    let plo = d
+        .pressure
+        .iter()
+        .map(|p| p / a)
+        .fold(f64::INFINITY, f64::min);
+    let phi = d
+        .pressure
+        .iter()
+        .map(|p| p / a)
+        .fold(f64::NEG_INFINITY, f64::max);
+    assert_eq!(pics[1].range, Some((plo, phi)), "{}", s.name);
+}
+
+/// The deflection map: hatching exactly on the contact zone, in the right direction, and
+/// the outline only where contact and clear vertices meet.
+fn check_deflection(s: &Solved, p: &Picture, layout: &MapLayout) {
+    let d = s.data.view();
+    let (_, frame) = p.map.unwrap();
+    let (mut lattice_in, mut hit_in, mut stray) = (0usize, 0usize, 0usize);
+    let mut mixed_px = HashSet::new();
+    let mut outline_px = Vec::new();
+    for y in frame.y0..frame.y1 {
+        for x in frame.x0..frame.x1 {
+            let c = p.canvas.get(x as u32, y as u32);
+            if c == OUTLINE {
+                outline_px.push((x, y));
+            }
+            let Some(t) = layout.triangle_at(x, y) else {
+                continue;
+            };
+            let tri = d.triangles[t as usize];
+            let cls: Vec<u8> = tri.iter().map(|&v| class(&d, v)).collect();
+            if cls.iter().any(|&k| k != cls[0]) {
+                mixed_px.insert((x, y));
+                continue;
+            }
+            let hatch = c == [255, 255, 255] || c == [0, 0, 0];
+            if cls[0] == 0 {
+                // Clear triangles: no hatching at all.
+                assert!(
+                    !hatch,
+                    "{}: hatch colour at ({x}, {y}) in a clear triangle",
+                    s.name
+                );
+                continue;
+            }
+            let states: Vec<i8> = tri.iter().map(|&v| d.state[v as usize]).collect();
+            if states.iter().any(|&k| k != states[0]) {
+                continue; // touching and penetrating mixed: either pattern
+            }
+            let slash = states[0] == 1;
+            match hatch_color(x, y, slash) {
+                Some(want) => {
+                    lattice_in += 1;
+                    hit_in += (c == want) as usize;
+                }
+                None => stray += hatch as usize,
+            }
+        }
+    }
+    if d.state.iter().any(|&k| k >= 0) {
+        assert!(
+            lattice_in > 50,
+            "{}: {lattice_in} hatch pixels in the contact zone",
+            s.name
+        );
+        // Contour lines, labels and markers may cover some of them.
+        assert!(
+            hit_in as f64 >= 0.75 * lattice_in as f64,
+            "{}: {hit_in} of {lattice_in} hatch pixels",
+            s.name
+        );
+    }
+    assert!(
+        stray <= lattice_in / 50,
+        "{}: {stray} hatch-coloured pixels off the pattern",
+        s.name
+    );
+    // The outline passes only through triangles with contact and clear vertices (within
+    // its width).
+    let near =
+        |x: i32, y: i32| (-3..=3).any(|dy| (-3..=3).any(|dx| mixed_px.contains(&(x + dx, y + dy))));
+    let far: Vec<_> = outline_px.iter().filter(|&&(x, y)| !near(x, y)).collect();
+    assert!(
+        far.is_empty(),
+        "{}: outline pixels away from the contact edge: {:?}",
+        s.name,
+        &far[..far.len().min(5)]
+    );
+    if d.state.iter().any(|&k| k >= 0) && d.state.iter().any(|&k| k < 0) {
+        assert!(outline_px.len() > 20, "{}: the outline is drawn", s.name);
+    }
+}
+
+/// The lift-off map: contact colour exactly over contact triangles, grey where the body
+/// cannot touch, blues elsewhere.
+fn check_liftoff(s: &Solved, p: &Picture, layout: &MapLayout) {
+    let d = s.data.view();
+    let (_, frame) = p.map.unwrap();
+    let (mut n_contact, mut ok_contact, mut n_nc, mut ok_nc) = (0, 0, 0, 0);
+    for y in frame.y0..frame.y1 {
+        for x in frame.x0..frame.x1 {
+            let Some(t) = layout.triangle_at(x, y) else {
+                continue;
+            };
+            let c: Rgb = p.canvas.get(x as u32, y as u32);
+            let tri = d.triangles[t as usize];
+            let cov = tri.iter().filter(|&&v| d.covered[v as usize]).count();
+            let con = tri.iter().filter(|&&v| d.state[v as usize] >= 0).count();
+            if cov == 0 {
+                n_nc += 1;
+                ok_nc += (c == NOT_COVERED) as usize;
+                assert_ne!(
+                    c, CONTACT,
+                    "{}: contact colour where the body cannot touch",
+                    s.name
+                );
+            } else if cov == 3 && con == 3 {
+                n_contact += 1;
+                ok_contact += (c == CONTACT) as usize;
+            } else if cov == 3 && con == 0 {
+                assert_ne!(
+                    c, CONTACT,
+                    "{}: contact colour over lift-off at ({x}, {y})",
+                    s.name
+                );
+                assert_ne!(
+                    c, NOT_COVERED,
+                    "{}: grey over lift-off at ({x}, {y})",
+                    s.name
+                );
+            }
+        }
+    }
+    assert!(
+        ok_contact as f64 >= 0.85 * n_contact as f64,
+        "{}: {ok_contact}/{n_contact}",
+        s.name
+    );
+    if n_nc >= 500 {
+        assert!(
+            ok_nc as f64 >= 0.85 * n_nc as f64,
+            "{}: {ok_nc}/{n_nc}",
+            s.name
+        );
+    }
+}
+
+/// The profile: shaded columns exactly over the contact stretches.
+fn check_profile(s: &Solved, p: &Picture) {
+    let d = s.data.view();
+    let ax = p.axes.unwrap();
+    let stretches = memcontact_plot::profile::contact_along(&d, &options(s));
+    let shade = memcontact_plot::profile::CONTACT_SHADE;
+    let col_shaded = |x: i32| {
+        let n = (ax.rect.y0..ax.rect.y1)
+            .filter(|&y| p.canvas.get(x as u32, y as u32) == shade)
+            .count();
+        n as f64 / ax.rect.height() as f64
+    };
+    for &(a, b) in &stretches {
+        let (xa, xb) = (ax.px(a), ax.px(b));
+        if xb - xa > 6.0 {
+            let m = ((xa + xb) / 2.0) as i32;
+            let f = (m - 3..=m + 3).map(col_shaded).fold(0.0, f64::max);
+            assert!(
+                f > 0.7,
+                "{}: contact stretch [{a}, {b}] shaded on {f}",
+                s.name
+            );
+        }
+    }
+    // Columns well away from every stretch are not shaded.
+    for x in ax.rect.x0 + 2..ax.rect.x1 - 2 {
+        let s_mid = (x as f64 + 0.5 - ax.rect.x0 as f64) / ax.rect.width() as f64 * ax.x.1;
+        let margin = 3.0 / ax.rect.width() as f64 * ax.x.1;
+        if stretches
+            .iter()
+            .all(|&(a, b)| s_mid < a - margin || s_mid > b + margin)
+        {
+            assert_eq!(
+                col_shaded(x),
+                0.0,
+                "{}: column {x} shaded outside contact",
+                s.name
+            );
+        }
+    }
+}
+
+fn check_case(s: Solved) {
+    let d = s.data.view();
+    let opts = options(&s);
+    let pics = render(&d, &opts).unwrap();
+    // The files are the pictures.
+    let dir = tempfile::tempdir().unwrap();
+    let files = draw_all(dir.path(), &d, &opts).unwrap();
+    assert_eq!(files.len(), 4);
+    for (f, p) in files.iter().zip(&pics) {
+        common::keep(f, s.name);
+        assert_eq!(f.file_name().unwrap().to_string_lossy(), p.kind.file_name());
+        let back = decode_png(&std::fs::read(f).unwrap()).unwrap();
+        assert!(
+            back == p.canvas,
+            "{}: {} differs from the rendered picture",
+            s.name,
+            f.display()
+        );
+    }
+    assert_eq!(
+        std::fs::read_dir(dir.path()).unwrap().count(),
+        4,
+        "only the four PNGs"
+    );
+    check_common(&s, &pics);
+    let layout = MapLayout::new(&d);
+    check_deflection(&s, &pics[0], &layout);
+    check_liftoff(&s, &pics[2], &layout);
+    check_profile(&s, &pics[3]);
+}
+
+#[test]
+fn disk_pictures() {
+    check_case(common::disk());
+}
+
+#[test]
+fn disk_step_pictures() {
+    check_case(common::disk_step());
+}
+
+#[test]
+fn rigid_square_pictures() {
+    check_case(common::rigid_square());
+}
+
+#[test]
+fn roof_pictures() {
+    check_case(common::roof());
+}
+
+#[test]
+fn gmsh_disk_pictures() {
+    check_case(common::gmsh_disk());
+}
+
+#[test]
+fn half_covered_pictures() {
+    check_case(common::half_covered());
+}
+
+#[test]
+fn disk_rigid_pictures() {
+    check_case(common::disk_rigid());
+}
+
+#[test]
+fn manufactured_square_pictures() {
+    let s = common::manufactured_square();
+    let d = s.data.view();
+    // Coarse: the markers are drawn, and the pixel under each contact vertex shows its
+    // state's marker colour (orange penetrating, light touching).
+    let pics = render(&d, &options(&s)).unwrap();
+    assert!(pics[0].markers);
+    let layout = MapLayout::new(&d);
+    for (v, &st) in d.state.iter().enumerate() {
+        let (x, y) = layout.transform.pixel_of(d.points[v]);
+        let c = pics[0].canvas.get(x as u32, y as u32);
+        match st {
+            1 => assert_eq!(c, [255, 120, 0], "vertex {v}"),
+            0 => assert_eq!(c, [250, 250, 250], "vertex {v}"),
+            _ => assert!(c != [255, 120, 0] && c != [250, 250, 250], "vertex {v}"),
+        }
+    }
+    assert!(d.state.iter().any(|&st| st >= 0), "the case has contact");
+    check_case(s);
+}
