@@ -7,11 +7,11 @@ use crate::mesh::{hierarchy_from_state, mesh_state, PyMesh};
 use memcontact::model::Certificate;
 use memcontact::output::{input_hash, new_run_id, write_result_set, WriteOptions};
 use memcontact::problem::{PictureKind, VtuFormat};
-use memcontact_plot::{draw_all, PlotData, PlotKind, PlotOptions, Units};
 use memcontact::results::NodalFields;
 use memcontact::run::Phase;
 use memcontact::solve::{Choice, Fallback, IterationRecord, Multipliers, Silent};
 use memcontact::{Case, Discretization, Method, Outcome, Report, Status, Summary};
+use memcontact_plot::{draw_all, PlotData, PlotKind, PlotOptions, Units};
 use numpy::{PyArray1, PyReadonlyArray1};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
@@ -331,13 +331,7 @@ impl PyResult_ {
                         .filter_map(|f| f.file_name().map(|n| n.to_string_lossy().into_owned()))
                         .collect())
                 };
-                write_result_set(
-                    &directory,
-                    &outcome,
-                    &self.data.case,
-                    &options,
-                    &mut draw,
-                )
+                write_result_set(&directory, &outcome, &self.data.case, &options, &mut draw)
             })
             .map_err(py_err)?;
         to_py(py, &summary)
