@@ -1,9 +1,9 @@
 //! The `solve` and `check` commands: thin shells over the library's run.
 
 use crate::output;
-use crate::progress::{Progress, Verbosity};
 use anyhow::{bail, Result};
 use memcontact::output::{write_result_set, WriteOptions};
+use crate::progress::{Progress, Verbosity};
 use memcontact::{Case, Discretization, Outcome};
 use std::path::Path;
 use std::time::Instant;

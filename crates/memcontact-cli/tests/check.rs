@@ -57,80 +57,24 @@ fn check_refuses_what_solve_refuses() {
     let with = |extra: &str| format!("{GOOD}{extra}");
     let cases: Vec<(&str, String, &str)> = vec![
         ("malformed", "[mesh\n".into(), "malformed TOML"),
-        (
-            "unknown-section",
-            with("[solvr]\nmethod = \"qp\"\n"),
-            "solvr",
-        ),
-        (
-            "unknown-mesh-key",
-            GOOD.replace("nx = 8", "nx = 8\nnz = 2"),
-            "nz",
-        ),
-        (
-            "unknown-output-key",
-            with("[output]\nformat = \"vtk\"\n"),
-            "format",
-        ),
+        ("unknown-section", with("[solvr]\nmethod = \"qp\"\n"), "solvr"),
+        ("unknown-mesh-key", GOOD.replace("nx = 8", "nx = 8\nnz = 2"), "nz"),
+        ("unknown-output-key", with("[output]\nformat = \"vtk\"\n"), "format"),
         ("bad-vtu", with("[output]\nvtu = \"xml\"\n"), "output.vtu"),
-        (
-            "bad-plots",
-            with("[output]\nplots = [\"contours\"]\n"),
-            "output.plots",
-        ),
-        (
-            "bad-allowable",
-            with("[output]\nallowable_pressure = -1\n"),
-            "allowable_pressure",
-        ),
-        (
-            "bad-profile",
-            with("[output]\nprofile = [[0, 0], [0, 0]]\n"),
-            "output.profile",
-        ),
+        ("bad-plots", with("[output]\nplots = [\"contours\"]\n"), "output.plots"),
+        ("bad-allowable", with("[output]\nallowable_pressure = -1\n"), "allowable_pressure"),
+        ("bad-profile", with("[output]\nprofile = [[0, 0], [0, 0]]\n"), "output.profile"),
         ("bad-units", with("[units]\ntime = \"s\"\n"), "time"),
-        (
-            "tension",
-            GOOD.replace("tension = 1.0", "tension = -1"),
-            "membrane.tension",
-        ),
-        (
-            "nan-load",
-            GOOD.replace("load = \"8\"", "load = nan"),
-            "membrane.load",
-        ),
-        (
-            "negative-h",
-            GOOD.replace("stiffness = 100.0", "stiffness = -1"),
-            "stiffness",
-        ),
+        ("tension", GOOD.replace("tension = 1.0", "tension = -1"), "membrane.tension"),
+        ("nan-load", GOOD.replace("load = \"8\"", "load = nan"), "membrane.load"),
+        ("negative-h", GOOD.replace("stiffness = 100.0", "stiffness = -1"), "stiffness"),
         ("method", with("[solver]\nmethod = \"magic\"\n"), "magic"),
-        (
-            "tolerance",
-            with("[solver]\ntolerance = 0.5\n"),
-            "solver.tolerance",
-        ),
-        (
-            "iterations",
-            with("[solver]\nmax_iterations = 0\n"),
-            "max_iterations",
-        ),
+        ("tolerance", with("[solver]\ntolerance = 0.5\n"), "solver.tolerance"),
+        ("iterations", with("[solver]\nmax_iterations = 0\n"), "max_iterations"),
         ("exact-kind", with("[exact]\nkind = \"foo\"\n"), "foo"),
-        (
-            "generator",
-            GOOD.replace("\"rectangle\"", "\"hexagon\""),
-            "hexagon",
-        ),
-        (
-            "refine",
-            GOOD.replace("nx = 8", "nx = 8\nrefine = 40"),
-            "mesh.refine",
-        ),
-        (
-            "epsilon",
-            GOOD.replace("stiffness = 100.0", "stiffness = 1\nepsilon = 0.1"),
-            "epsilon",
-        ),
+        ("generator", GOOD.replace("\"rectangle\"", "\"hexagon\""), "hexagon"),
+        ("refine", GOOD.replace("nx = 8", "nx = 8\nrefine = 40"), "mesh.refine"),
+        ("epsilon", GOOD.replace("stiffness = 100.0", "stiffness = 1\nepsilon = 0.1"), "epsilon"),
         (
             "region",
             GOOD.replace("stiffness = 100.0", "stiffness = { clay = 5 }"),
@@ -154,10 +98,7 @@ fn check_refuses_what_solve_refuses() {
         ),
         (
             "missing-mesh",
-            GOOD.replace(
-                "generator = \"rectangle\"\nnx = 8",
-                "file = \"nowhere.msh\"",
-            ),
+            GOOD.replace("generator = \"rectangle\"\nnx = 8", "file = \"nowhere.msh\""),
             "nowhere.msh",
         ),
     ];

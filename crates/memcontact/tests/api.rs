@@ -91,12 +91,7 @@ fn every_status_carries_the_iterate_and_its_certificate() {
         r
     };
     // One iteration is not enough.
-    for method in [
-        Method::ActiveSet,
-        Method::Multigrid,
-        Method::Coordinate,
-        Method::Qp,
-    ] {
+    for method in [Method::ActiveSet, Method::Multigrid, Method::Coordinate, Method::Qp] {
         let s = Settings {
             method,
             max_iterations: Some(1),
@@ -149,17 +144,13 @@ fn every_status_carries_the_iterate_and_its_certificate() {
 #[test]
 fn auto_records_its_choice() {
     let case = Case::from_toml_str(SQUARE, None).unwrap();
-    let r = run(&case.problem, &case.settings, &mut Silent)
-        .unwrap()
-        .report;
+    let r = run(&case.problem, &case.settings, &mut Silent).unwrap().report;
     assert_eq!(r.requested, Method::Auto);
     assert_eq!(r.method, Method::Multigrid);
     assert_eq!(r.choice, memcontact::solve::Choice::GeometricHierarchy);
-    let free =
-        Case::from_toml_str(&SQUARE.replace("stiffness = 1000.0", "stiffness = 0"), None).unwrap();
-    let r = run(&free.problem, &free.settings, &mut Silent)
-        .unwrap()
-        .report;
+    let free = Case::from_toml_str(&SQUARE.replace("stiffness = 1000.0", "stiffness = 0"), None)
+        .unwrap();
+    let r = run(&free.problem, &free.settings, &mut Silent).unwrap().report;
     assert_eq!(r.method, Method::Linear);
     assert_eq!(r.choice, memcontact::solve::Choice::LinearProblem);
 }
@@ -177,8 +168,8 @@ fn a_result_set_is_written_and_read_back_without_the_cli() {
         started: Instant::now(),
         plot_options: None,
     };
-    let written =
-        write_result_set(&out, &outcome, &case, &options, &mut |_, _| Ok(vec![])).unwrap();
+    let written = write_result_set(&out, &outcome, &case, &options, &mut |_, _| Ok(vec![]))
+        .unwrap();
     let text = std::fs::read_to_string(out.join("summary.json")).unwrap();
     let summary: Summary = serde_json::from_str(&text).unwrap();
     assert_eq!(summary.run_id, written.run_id);
@@ -187,10 +178,7 @@ fn a_result_set_is_written_and_read_back_without_the_cli() {
     // Every file is listed with its size and hash, and matches.
     for name in ["solution.vtu", "nodes.csv"] {
         let rec = &summary.files[name];
-        assert_eq!(
-            rec,
-            &memcontact::output::file_record(&out.join(name)).unwrap()
-        );
+        assert_eq!(rec, &memcontact::output::file_record(&out.join(name)).unwrap());
     }
     // nodes.csv, read independently, holds U at the interior vertices.
     let csv = std::fs::read_to_string(out.join("nodes.csv")).unwrap();
@@ -199,10 +187,6 @@ fn a_result_set_is_written_and_read_back_without_the_cli() {
         .skip(1)
         .map(|l| l.split(',').nth(2).unwrap().parse().unwrap())
         .collect();
-    let expect = outcome
-        .discretization
-        .model
-        .dofs
-        .to_vertices(&outcome.report.u, 0.0);
+    let expect = outcome.discretization.model.dofs.to_vertices(&outcome.report.u, 0.0);
     assert_eq!(u, expect);
 }
