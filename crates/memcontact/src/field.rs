@@ -8,11 +8,14 @@
 //! sampled values (`h ≥ 0`, no NaN, ...) and says where a bad value sits.
 
 use crate::expr::Expr;
+use crate::mesh::Mesh;
+use crate::nodal::NodalP1;
 use crate::{Error, Result};
-use serde::de::{self, Deserializer, MapAccess, Visitor};
+use serde::de::{self, Deserializer, MapAccess, SeqAccess, Visitor};
 use serde::ser::{SerializeMap, Serializer};
 use std::collections::BTreeMap;
 use std::fmt;
+use std::sync::Arc;
 
 /// The key of a region table that applies to the regions not listed.
 pub const DEFAULT_KEY: &str = "default";
@@ -37,6 +40,10 @@ pub enum Field {
     /// A value per region: keys are region names, region tags as text, or
     /// [`DEFAULT_KEY`]; values are [`Field::Constant`] or [`Field::Expr`].
     Regions(BTreeMap<String, Field>),
+    /// One value per mesh vertex, in the mesh's vertex order: the P1 interpolant of those
+    /// values (φ sampled at a vertex is the value given there). Binds only with the mesh
+    /// ([`Field::bind_to_mesh`]).
+    Nodal(Arc<[f64]>),
 }
 
 impl Field {
@@ -68,6 +75,29 @@ impl Field {
                     .all(|v| v.is_some_and(|v| v.to_bits() == first.to_bits()))
                     .then_some(first)
             }
+            Field::Nodal(_) => None,
+        }
+    }
+
+    /// Resolves the field against `mesh`: its regions ([`Field::bind`]), or, for nodal
+    /// values, its vertices (one value per vertex, all finite).
+    pub fn bind_to_mesh(&self, name: &str, mesh: &Mesh) -> Result<BoundField> {
+        match self {
+            Field::Nodal(values) => Ok(BoundField {
+                name: name.to_string(),
+                regions: Vec::new(),
+                fallback: Some(Value::Nodal(Arc::new(NodalP1::new(
+                    name,
+                    mesh,
+                    values.clone(),
+                )?))),
+            }),
+            _ => {
+                let mut tags: Vec<u32> = mesh.regions.clone();
+                tags.sort_unstable();
+                tags.dedup();
+                self.bind(name, &mesh.region_names, &tags)
+            }
         }
     }
 
@@ -80,7 +110,7 @@ impl Field {
     ///
     /// Errors ([`Error::Data`]): a key naming no region of the mesh, a region given twice
     /// (by name and by tag), a region without a value and no default, a table inside a
-    /// table.
+    /// table, nodal values (they need the mesh: [`Field::bind_to_mesh`]).
     pub fn bind(
         &self,
         name: &str,
@@ -106,6 +136,12 @@ impl Field {
         };
         let table = match self {
             Field::Regions(table) => table,
+            Field::Nodal(_) => {
+                return Err(Error::Data(format!(
+                    "{name}: nodal values belong to one mesh and cannot be carried to \
+                     another; give a number, an expression or a region table"
+                )))
+            }
             uniform => {
                 return Ok(BoundField {
                     name: name.to_string(),
@@ -210,6 +246,7 @@ impl std::str::FromStr for Field {
 enum Value {
     Constant(f64),
     Expr(Expr),
+    Nodal(Arc<NodalP1>),
 }
 
 impl Value {
@@ -226,6 +263,12 @@ impl Value {
                      it must be a number or an expression"
                 )))
             }
+            Field::Nodal(_) => {
+                return Err(Error::Data(format!(
+                    "{name}: the value of region '{key}' is an array; \
+                     it must be a number or an expression"
+                )))
+            }
         })
     }
 
@@ -234,13 +277,14 @@ impl Value {
         match self {
             Value::Constant(v) => *v,
             Value::Expr(e) => e.eval(p[0], p[1]),
+            Value::Nodal(n) => n.eval(p),
         }
     }
 
     fn constant(&self) -> Option<f64> {
         match self {
             Value::Constant(v) => Some(*v),
-            Value::Expr(_) => None,
+            Value::Expr(_) | Value::Nodal(_) => None,
         }
     }
 }
@@ -452,7 +496,7 @@ fn number(v: f64) -> String {
 // serde.
 
 const EXPECTING: &str = "a number, a string with a number or an expression of x and y, \
-     or a table of region values";
+     a table of region values, or an array of one value per mesh vertex";
 
 struct FieldVisitor;
 
@@ -477,6 +521,19 @@ impl<'de> Visitor<'de> for FieldVisitor {
 
     fn visit_str<E: de::Error>(self, v: &str) -> std::result::Result<Field, E> {
         Field::parse(v).map_err(E::custom)
+    }
+
+    fn visit_seq<A: SeqAccess<'de>>(self, mut seq: A) -> std::result::Result<Field, A::Error> {
+        let mut values = Vec::with_capacity(seq.size_hint().unwrap_or(0));
+        while let Some(v) = seq.next_element::<f64>()? {
+            values.push(v);
+        }
+        if values.is_empty() {
+            return Err(de::Error::custom(
+                "an empty array: give one value per mesh vertex",
+            ));
+        }
+        Ok(Field::Nodal(values.into()))
     }
 
     fn visit_map<A: MapAccess<'de>>(self, mut map: A) -> std::result::Result<Field, A::Error> {
@@ -564,6 +621,10 @@ impl<'de> Visitor<'de> for StiffnessVisitor {
     fn visit_map<A: MapAccess<'de>>(self, map: A) -> std::result::Result<Stiffness, A::Error> {
         FieldVisitor.visit_map(map).map(Stiffness::Elastic)
     }
+
+    fn visit_seq<A: SeqAccess<'de>>(self, seq: A) -> std::result::Result<Stiffness, A::Error> {
+        FieldVisitor.visit_seq(seq).map(Stiffness::Elastic)
+    }
 }
 
 impl<'de> serde::Deserialize<'de> for Stiffness {
@@ -586,6 +647,7 @@ impl serde::Serialize for Field {
                 }
                 map.end()
             }
+            Field::Nodal(values) => values.serialize(s),
         }
     }
 }
@@ -798,7 +860,8 @@ mod tests {
         }
         for (bad, fragment) in [
             ("true", "a number, a string"),
-            ("[1, 2]", "a number, a string"),
+            ("[]", "empty array"),
+            ("[1, \"x\"]", "f64"),
             ("null", "a number, a string"),
             ("\"1 + z\"", "unknown variable 'z'"),
             (r#"{"soil": {"a": 1}}"#, "a region's value"),

@@ -20,6 +20,7 @@ pub mod field;
 pub mod io;
 pub mod mesh;
 pub mod model;
+pub mod nodal;
 pub mod output;
 pub mod problem;
 pub mod quadrature;

@@ -845,6 +845,12 @@ fn check_field(key: &str, f: &Field, non_negative: bool) -> std::result::Result<
     match f {
         Field::Constant(v) => check(key.to_string(), *v),
         Field::Expr(_) => Ok(()),
+        Field::Nodal(values) => {
+            for (i, v) in values.iter().enumerate() {
+                check(format!("{key}[{i}]"), *v)?;
+            }
+            Ok(())
+        }
         Field::Regions(t) => {
             for (name, v) in t {
                 if let Field::Constant(c) = v {
@@ -872,6 +878,15 @@ impl Problem {
         check_field("obstacle.shape", &self.obstacle.shape, false)?;
         if let Stiffness::Elastic(h) = &self.obstacle.stiffness {
             check_field("obstacle.stiffness", h, true)?;
+        }
+        if let (SamplingKind::Mollified, Field::Nodal(_)) =
+            (self.obstacle.sampling, &self.obstacle.shape)
+        {
+            return Err(Invalid::new(
+                "obstacle.sampling",
+                "mollified sampling needs φ as a function of x and y; nodal values of φ \
+                 are its samples (use sampling = \"nodal\")",
+            ));
         }
         match (self.obstacle.sampling, self.obstacle.epsilon) {
             (SamplingKind::Nodal, Some(_)) => Err(Invalid::new(

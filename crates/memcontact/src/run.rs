@@ -36,21 +36,17 @@ pub struct BoundData {
 
 impl BoundData {
     /// Binds the problem's f, φ and h to the regions of `mesh` (a region table must name
-    /// regions the mesh has, or give a default).
+    /// regions the mesh has, or give a default) or, for nodal values, to its vertices.
     pub fn new(problem: &Problem, mesh: &Mesh) -> Result<BoundData> {
-        let mut tags: Vec<u32> = mesh.regions.clone();
-        tags.sort_unstable();
-        tags.dedup();
-        let names = &mesh.region_names;
         Ok(BoundData {
-            load: problem.membrane.load.bind("membrane.load", names, &tags)?,
+            load: problem.membrane.load.bind_to_mesh("membrane.load", mesh)?,
             shape: problem
                 .obstacle
                 .shape
-                .bind("obstacle.shape", names, &tags)?,
+                .bind_to_mesh("obstacle.shape", mesh)?,
             stiffness: match &problem.obstacle.stiffness {
                 FieldStiffness::Rigid => None,
-                FieldStiffness::Elastic(h) => Some(h.bind("obstacle.stiffness", names, &tags)?),
+                FieldStiffness::Elastic(h) => Some(h.bind_to_mesh("obstacle.stiffness", mesh)?),
             },
         })
     }

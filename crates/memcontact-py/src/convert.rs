@@ -1,0 +1,159 @@
+//! Conversions between Python values and the library's serde values, and between the
+//! library's errors and Python exceptions.
+
+use memcontact::Error;
+use pyo3::exceptions::{PyFileNotFoundError, PyOSError, PyRuntimeError, PyValueError};
+use pyo3::prelude::*;
+use pyo3::types::{PyBool, PyDict, PyFloat, PyInt, PyList, PyString, PyTuple};
+
+/// The Python exception for a library error: bad data (a case, a mesh, an expression, a
+/// file that does not parse) is a `ValueError`, a missing file `FileNotFoundError`, an
+/// input/output failure `OSError`, anything the solver reports `RuntimeError`.
+pub fn py_err(e: Error) -> PyErr {
+    match &e {
+        Error::Io { source, .. } if source.kind() == std::io::ErrorKind::NotFound => {
+            PyFileNotFoundError::new_err(e.to_string())
+        }
+        Error::Io { .. } => PyOSError::new_err(e.to_string()),
+        Error::File { path, .. } if !path.exists() => PyFileNotFoundError::new_err(e.to_string()),
+        Error::Solver { .. } => PyRuntimeError::new_err(e.to_string()),
+        _ => PyValueError::new_err(e.to_string()),
+    }
+}
+
+/// A refused case given as a dict: `key: message` (the line of the TOML text it was turned
+/// into means nothing to the caller).
+pub fn dict_case_err(e: Error) -> PyErr {
+    match e {
+        Error::Case { key, message, .. } => PyValueError::new_err(if key.is_empty() {
+            message
+        } else {
+            format!("{key}: {message}")
+        }),
+        other => py_err(other),
+    }
+}
+
+/// The dotted key of `part` below `key`.
+fn join(key: &str, part: &str) -> String {
+    if key.is_empty() {
+        part.to_string()
+    } else {
+        format!("{key}.{part}")
+    }
+}
+
+/// A Python value (dicts, lists, tuples, numbers, strings, booleans, NumPy arrays and
+/// scalars, paths) as a TOML value. `key` names the value in errors.
+pub fn to_toml(obj: &Bound<'_, PyAny>, key: &str) -> PyResult<toml::Value> {
+    let bad = |what: String| PyValueError::new_err(format!("{}{what}", prefix(key)));
+    if obj.is_instance_of::<PyBool>() {
+        return Ok(toml::Value::Boolean(obj.extract::<bool>()?));
+    }
+    if obj.is_instance_of::<PyInt>() {
+        return match obj.extract::<i64>() {
+            Ok(v) => Ok(toml::Value::Integer(v)),
+            Err(_) => Err(bad(format!("the integer {obj} is too large"))),
+        };
+    }
+    if obj.is_instance_of::<PyFloat>() {
+        return Ok(toml::Value::Float(obj.extract::<f64>()?));
+    }
+    if obj.is_instance_of::<PyString>() {
+        return Ok(toml::Value::String(obj.extract::<String>()?));
+    }
+    if let Ok(d) = obj.cast::<PyDict>() {
+        let mut table = toml::Table::new();
+        for (k, v) in d.iter() {
+            // Region tables may be keyed by numeric tags.
+            let name = if k.is_instance_of::<PyString>() {
+                k.extract::<String>()?
+            } else if k.is_instance_of::<PyInt>() && !k.is_instance_of::<PyBool>() {
+                k.str()?.to_string()
+            } else {
+                return Err(bad(format!(
+                    "keys must be strings, got {}",
+                    k.get_type().name()?
+                )));
+            };
+            let value = to_toml(&v, &join(key, &name))?;
+            table.insert(name, value);
+        }
+        return Ok(toml::Value::Table(table));
+    }
+    if obj.is_none() {
+        return Err(bad(
+            "None is not a value (leave the key out to get its default)".into(),
+        ));
+    }
+    if obj.is_instance_of::<PyList>() || obj.is_instance_of::<PyTuple>() {
+        let mut items = Vec::new();
+        for (i, v) in obj.try_iter()?.enumerate() {
+            items.push(to_toml(&v?, &format!("{key}[{i}]"))?);
+        }
+        return Ok(toml::Value::Array(items));
+    }
+    // NumPy arrays and scalars: their Python equivalents.
+    if obj.hasattr("tolist")? && obj.hasattr("dtype")? {
+        let plain = obj.call_method0("tolist")?;
+        return to_toml(&plain, key);
+    }
+    // Paths.
+    if obj.hasattr("__fspath__")? {
+        let text = obj.call_method0("__fspath__")?;
+        return to_toml(&text, key);
+    }
+    Err(bad(format!(
+        "a {} is not a case value (use numbers, strings, lists and dicts)",
+        obj.get_type().name()?
+    )))
+}
+
+fn prefix(key: &str) -> String {
+    if key.is_empty() {
+        String::new()
+    } else {
+        format!("{key}: ")
+    }
+}
+
+/// A JSON value as the equivalent Python value (dicts, lists, floats, ints, strings, None).
+pub fn json_to_py<'py>(py: Python<'py>, v: &serde_json::Value) -> PyResult<Bound<'py, PyAny>> {
+    use serde_json::Value;
+    Ok(match v {
+        Value::Null => py.None().into_bound(py),
+        Value::Bool(b) => PyBool::new(py, *b).to_owned().into_any(),
+        Value::Number(n) => {
+            if let Some(i) = n.as_i64() {
+                i.into_pyobject(py)?.into_any()
+            } else if let Some(u) = n.as_u64() {
+                u.into_pyobject(py)?.into_any()
+            } else {
+                n.as_f64().unwrap_or(f64::NAN).into_pyobject(py)?.into_any()
+            }
+        }
+        Value::String(s) => PyString::new(py, s).into_any(),
+        Value::Array(items) => {
+            let list = PyList::empty(py);
+            for item in items {
+                list.append(json_to_py(py, item)?)?;
+            }
+            list.into_any()
+        }
+        Value::Object(map) => {
+            let dict = PyDict::new(py);
+            for (k, item) in map {
+                dict.set_item(k, json_to_py(py, item)?)?;
+            }
+            dict.into_any()
+        }
+    })
+}
+
+/// A serde value as a Python value (through JSON; non-finite floats become None, as JSON
+/// has no NaN).
+pub fn to_py<'py, T: serde::Serialize>(py: Python<'py>, value: &T) -> PyResult<Bound<'py, PyAny>> {
+    let v = serde_json::to_value(value)
+        .map_err(|e| PyValueError::new_err(format!("cannot convert to Python: {e}")))?;
+    json_to_py(py, &v)
+}

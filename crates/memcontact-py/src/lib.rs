@@ -1,0 +1,100 @@
+//! The `memcontact` Python module's native part (`memcontact._memcontact`): cases,
+//! meshes as NumPy arrays, solves with the GIL released, results that pickle. The typed
+//! Python package `memcontact` wraps it.
+
+mod case;
+mod convert;
+mod mesh;
+mod result;
+
+use case::PyCase;
+use convert::py_err;
+use memcontact::field::{Field, Stiffness};
+use memcontact::problem::Invalid;
+use memcontact::solve::Silent;
+use memcontact::{Discretization, Outcome};
+use mesh::PyMesh;
+use numpy::PyReadonlyArray1;
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+use result::PyResult_;
+use std::collections::HashMap;
+use std::time::Instant;
+
+/// Solves a case end to end (mesh, assembly, solve) with the GIL released. Returns the
+/// result whatever the status; bad data raises `ValueError`.
+#[pyfunction]
+fn solve(py: Python<'_>, case: PyRef<'_, PyCase>) -> PyResult<PyResult_> {
+    let c = case.case.clone();
+    let label = case.label.clone();
+    drop(case);
+    py.detach(move || {
+        let started = Instant::now();
+        let outcome = memcontact::run(&c.problem, &c.settings, &mut Silent)?;
+        let mesh = PyMesh::new_from(outcome.discretization.hierarchy.clone());
+        Ok(PyResult_::new(label, c, mesh, outcome, started))
+    })
+    .map_err(py_err)
+}
+
+/// Solves the problem of `case` (its mesh section is not used) on `mesh`, with the GIL
+/// released. `nodal` gives data as NumPy arrays of one value per vertex ("load", "shape",
+/// "stiffness"), replacing the case's. Returns the result whatever the status.
+#[pyfunction]
+#[pyo3(signature = (mesh, case, nodal=None))]
+fn solve_on(
+    py: Python<'_>,
+    mesh: PyRef<'_, PyMesh>,
+    case: PyRef<'_, PyCase>,
+    nodal: Option<HashMap<String, PyReadonlyArray1<'_, f64>>>,
+) -> PyResult<PyResult_> {
+    let mut c = case.case.clone();
+    let label = case.label.clone();
+    let mesh = mesh.clone();
+    for (name, values) in nodal.unwrap_or_default() {
+        let field = Field::Nodal(values.as_array().iter().copied().collect());
+        match name.as_str() {
+            "load" => c.problem.membrane.load = field,
+            "shape" => c.problem.obstacle.shape = field,
+            "stiffness" => c.problem.obstacle.stiffness = Stiffness::Elastic(field),
+            other => {
+                return Err(PyValueError::new_err(format!(
+                    "nodal: \"{other}\" is not a field (load, shape or stiffness)"
+                )))
+            }
+        }
+    }
+    py.detach(move || {
+        let started = Instant::now();
+        c.problem.validate().map_err(Invalid::into_error)?;
+        c.settings.validate().map_err(Invalid::into_error)?;
+        let discretization =
+            Discretization::assemble(&c.problem, (*mesh.hierarchy).clone(), &mut Silent)?;
+        let report = discretization.solve(&c.settings, &mut Silent)?;
+        let outcome = Outcome {
+            discretization,
+            report,
+        };
+        Ok(PyResult_::new(label, c, mesh, outcome, started))
+    })
+    .map_err(py_err)
+}
+
+/// The native module.
+#[pymodule]
+fn _memcontact(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_class::<PyCase>()?;
+    m.add_class::<PyMesh>()?;
+    m.add_class::<PyResult_>()?;
+    m.add_function(wrap_pyfunction!(solve, m)?)?;
+    m.add_function(wrap_pyfunction!(solve_on, m)?)?;
+    m.add_function(wrap_pyfunction!(mesh::rectangle, m)?)?;
+    m.add_function(wrap_pyfunction!(mesh::disk, m)?)?;
+    m.add_function(wrap_pyfunction!(mesh::polygon, m)?)?;
+    m.add_function(wrap_pyfunction!(mesh::read_gmsh, m)?)?;
+    m.add_function(wrap_pyfunction!(mesh::_mesh_from_state, m)?)?;
+    m.add_function(wrap_pyfunction!(result::_result_from_state, m)?)?;
+    m.add_function(wrap_pyfunction!(case::_toml_value, m)?)?;
+    m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    Ok(())
+}

@@ -1,0 +1,505 @@
+//! `Result`: the outcome of one solve as NumPy arrays and dicts, writable as the command
+//! line tool's result set, picklable.
+
+use crate::case::PyCase;
+use crate::convert::{py_err, to_py};
+use crate::mesh::{hierarchy_from_state, mesh_state, PyMesh};
+use memcontact::model::Certificate;
+use memcontact::output::{input_hash, new_run_id, write_result_set, WriteOptions};
+use memcontact::problem::{PictureKind, VtuFormat};
+use memcontact::results::NodalFields;
+use memcontact::run::Phase;
+use memcontact::solve::{Choice, Fallback, IterationRecord, Multipliers, Silent};
+use memcontact::{Case, Discretization, Method, Outcome, Report, Status, Summary};
+use memcontact_plot::{draw_all, PlotData, PlotKind, PlotOptions, Units};
+use numpy::{PyArray1, PyReadonlyArray1};
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyTuple};
+use serde::{Deserialize, Serialize};
+use std::path::PathBuf;
+use std::sync::{Arc, Mutex};
+use std::time::{Duration, Instant};
+
+/// What a result holds (shared, immutable).
+pub struct ResultData {
+    /// The case's label.
+    pub label: String,
+    /// The case solved (for a mesh given in Python: its data, with a placeholder mesh).
+    pub case: Case,
+    /// The solved mesh and its levels.
+    pub mesh: PyMesh,
+    /// The vertex fields.
+    pub fields: NodalFields,
+    /// The scalars of `summary.json` (without the file records).
+    pub summary: Summary,
+    /// Status, method, certificate, history, times, and U.
+    pub report: Report,
+    /// Warnings from reading the mesh.
+    pub warnings: Vec<String>,
+    /// Seconds from the start of the run to the end of the solve.
+    pub seconds: f64,
+}
+
+/// The result of a solve: the vertex fields as NumPy arrays, the status, the report and
+/// the summary. Immutable; pickles (the fields and the iterate travel, the assembled
+/// matrices are rebuilt when `write` needs them).
+#[pyclass(name = "Result", module = "memcontact._memcontact", frozen)]
+pub struct PyResult_ {
+    data: Arc<ResultData>,
+    /// The discretisation and report, kept for `write` (rebuilt after unpickling).
+    outcome: Mutex<Option<Arc<Outcome>>>,
+}
+
+impl PyResult_ {
+    /// The result of `outcome`, solved from `case` on `mesh`.
+    pub fn new(
+        label: String,
+        case: Case,
+        mesh: PyMesh,
+        outcome: Outcome,
+        started: Instant,
+    ) -> PyResult_ {
+        let (fields, totals) = outcome.fields();
+        let quality = outcome.mesh().quality();
+        let mut summary = Summary::new(&label, &outcome, &quality, &totals);
+        summary.run_id = new_run_id();
+        summary.input_hash = input_hash(&case);
+        let seconds = started.elapsed().as_secs_f64();
+        summary.time_total_s = seconds;
+        PyResult_ {
+            data: Arc::new(ResultData {
+                label,
+                case,
+                mesh,
+                fields,
+                summary,
+                report: outcome.report.clone(),
+                warnings: outcome.discretization.warnings.clone(),
+                seconds,
+            }),
+            outcome: Mutex::new(Some(Arc::new(outcome))),
+        }
+    }
+
+    /// The outcome, rebuilt (assembled again on the stored mesh) when the result was
+    /// unpickled.
+    fn outcome(&self) -> memcontact::Result<Arc<Outcome>> {
+        let mut slot = self.outcome.lock().unwrap_or_else(|p| p.into_inner());
+        if let Some(o) = slot.as_ref() {
+            return Ok(o.clone());
+        }
+        let d = &self.data;
+        let discretization =
+            Discretization::assemble(&d.case.problem, (*d.mesh.hierarchy).clone(), &mut Silent)?;
+        let o = Arc::new(Outcome {
+            discretization,
+            report: d.report.clone(),
+        });
+        *slot = Some(o.clone());
+        Ok(o)
+    }
+
+    fn f64_array<'py>(py: Python<'py>, v: &[f64]) -> Bound<'py, PyArray1<f64>> {
+        PyArray1::from_slice(py, v)
+    }
+}
+
+/// The serialisable form of a [`Report`] (for pickling).
+#[derive(Serialize, Deserialize)]
+struct ReportState {
+    status: Status,
+    accepted: bool,
+    requested: Method,
+    method: Method,
+    choice: Choice,
+    fallback: Option<Fallback>,
+    message: Option<String>,
+    iterations: usize,
+    energy: f64,
+    certificate: Certificate,
+    tolerance: f64,
+    history: Vec<IterationRecord>,
+    phases: Vec<(String, f64)>,
+    solver_phases: Vec<(String, f64)>,
+}
+
+/// The small part of a pickled result, as TOML.
+#[derive(Serialize, Deserialize)]
+struct Meta {
+    label: String,
+    case: String,
+    summary: Summary,
+    report: ReportState,
+    warnings: Vec<String>,
+    seconds: f64,
+}
+
+fn phases_out(p: &[Phase]) -> Vec<(String, f64)> {
+    p.iter().map(|p| (p.name.clone(), p.seconds)).collect()
+}
+
+fn phases_in(p: Vec<(String, f64)>) -> Vec<Phase> {
+    p.into_iter()
+        .map(|(name, seconds)| Phase { name, seconds })
+        .collect()
+}
+
+const FIELD_NAMES: [&str; 5] = ["u", "phi", "penetration", "pressure", "contact_force"];
+
+#[pymethods]
+impl PyResult_ {
+    /// The deflection u at every vertex (u = 0 on the boundary), in the mesh's vertex order.
+    #[getter]
+    fn u<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        Self::f64_array(py, &self.data.fields.u)
+    }
+
+    /// The sampled obstacle surface φₙ at every vertex.
+    #[getter]
+    fn phi<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        Self::f64_array(py, &self.data.fields.phi)
+    }
+
+    /// The penetration (u − φ)⁺ at every vertex (0 where the obstacle cannot touch).
+    #[getter]
+    fn penetration<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        Self::f64_array(py, &self.data.fields.penetration)
+    }
+
+    /// The contact pressure h (u − φ)⁺ (rigid obstacle: contact force per nodal area).
+    #[getter]
+    fn pressure<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        Self::f64_array(py, &self.data.fields.pressure)
+    }
+
+    /// The nodal contact force X₁ = D − SU on M (0 elsewhere).
+    #[getter]
+    fn contact_force<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        Self::f64_array(py, &self.data.fields.contact_force)
+    }
+
+    /// The vertex state: −1 clear, 0 touching (U = φ), 1 penetrating (int8).
+    #[getter]
+    fn state<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<i8>> {
+        PyArray1::from_slice(py, &self.data.fields.state)
+    }
+
+    /// How the solve ended: "converged", "rounding_floor", "iteration_limit", "stalled"
+    /// or "numerical_failure".
+    #[getter]
+    fn status(&self) -> &'static str {
+        self.data.report.status.name()
+    }
+
+    /// Whether the certificate reached the tolerance.
+    #[getter]
+    fn converged(&self) -> bool {
+        self.data.report.status.is_converged()
+    }
+
+    /// Whether the settings accept the outcome: converged, or at the rounding floor of
+    /// double precision when the settings allow it (what `solve` checks).
+    #[getter]
+    fn accepted(&self) -> bool {
+        self.data.report.accepted
+    }
+
+    /// What went wrong, for a solve that was not accepted (None otherwise).
+    #[getter]
+    fn message(&self) -> Option<String> {
+        self.data.report.error().map(|e| e.to_string())
+    }
+
+    /// The method that produced the answer.
+    #[getter]
+    fn method(&self) -> &'static str {
+        self.data.report.method.name()
+    }
+
+    /// Iterations of that method.
+    #[getter]
+    fn iterations(&self) -> usize {
+        self.data.report.iterations
+    }
+
+    /// J(U), the energy of Problem 2b.
+    #[getter]
+    fn energy(&self) -> f64 {
+        self.data.report.energy
+    }
+
+    /// The scaled KKT residual (the larger of the residuals of 2e and 2f).
+    #[getter]
+    fn kkt_residual(&self) -> f64 {
+        self.data.report.certificate.kkt()
+    }
+
+    /// The report: status, requested and used method and why, iterations, energy,
+    /// certificate, tolerance, history, phase times (a new dict).
+    #[getter]
+    fn report<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        to_py(py, &self.data.report)
+    }
+
+    /// The scalars of `summary.json` (the same keys; `files` is filled in by `write`).
+    #[getter]
+    fn summary<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        to_py(py, &self.data.summary)
+    }
+
+    /// The solved mesh.
+    #[getter]
+    fn mesh(&self) -> PyMesh {
+        self.data.mesh.clone()
+    }
+
+    /// The case solved.
+    #[getter]
+    fn case(&self) -> PyCase {
+        PyCase {
+            case: self.data.case.clone(),
+            label: self.data.label.clone(),
+        }
+    }
+
+    /// Warnings from reading the mesh.
+    #[getter]
+    fn warnings(&self) -> Vec<String> {
+        self.data.warnings.clone()
+    }
+
+    /// Writes the result set the command-line tool writes (`solution.vtu`, `nodes.csv`,
+    /// the pictures of the case's `[output] plots` unless `pictures` is false, and
+    /// `summary.json`) into `directory`, atomically; `vtu` ("binary" or "ascii") defaults
+    /// to the case's `[output] vtu`. A directory holding other files is refused unless
+    /// `force`. Returns the summary written.
+    #[pyo3(signature = (directory, force=false, vtu=None, pictures=true))]
+    fn write<'py>(
+        &self,
+        py: Python<'py>,
+        directory: PathBuf,
+        force: bool,
+        vtu: Option<&str>,
+        pictures: bool,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let vtu = match vtu {
+            None => self.data.case.output.vtu,
+            Some("binary") => VtuFormat::Binary,
+            Some("ascii") => VtuFormat::Ascii,
+            Some(other) => {
+                return Err(PyValueError::new_err(format!(
+                    "vtu: \"{other}\" is unknown (choose binary or ascii)"
+                )))
+            }
+        };
+        let summary = py
+            .detach(|| {
+                let outcome = self.outcome()?;
+                let mut plots = plot_options(&self.data.case, &self.data.label);
+                if !pictures {
+                    plots.plots.clear();
+                }
+                let now = Instant::now();
+                let options = WriteOptions {
+                    label: self.data.label.clone(),
+                    vtu,
+                    force,
+                    started: now
+                        .checked_sub(Duration::from_secs_f64(self.data.seconds))
+                        .unwrap_or(now),
+                    plot_options: serde_json::to_value(&plots).ok(),
+                };
+                let mesh = outcome.mesh();
+                let mut draw = |dir: &std::path::Path, fields: &NodalFields| {
+                    if plots.plots.is_empty() {
+                        return Ok(Vec::new());
+                    }
+                    let data = PlotData {
+                        points: &mesh.points,
+                        triangles: &mesh.triangles,
+                        u: &fields.u,
+                        phi: &fields.phi,
+                        state: &fields.state,
+                        pressure: &fields.pressure,
+                        covered: &fields.covered,
+                    };
+                    let files = draw_all(dir, &data, &plots)
+                        .map_err(|e| memcontact::Error::Data(format!("pictures: {e}")))?;
+                    Ok(files
+                        .iter()
+                        .filter_map(|f| f.file_name().map(|n| n.to_string_lossy().into_owned()))
+                        .collect())
+                };
+                write_result_set(&directory, &outcome, &self.data.case, &options, &mut draw)
+            })
+            .map_err(py_err)?;
+        to_py(py, &summary)
+    }
+
+    fn __repr__(&self) -> String {
+        let r = &self.data.report;
+        format!(
+            "Result({}, {} vertices, method {}, {} iterations, KKT {:.2e})",
+            r.status.name(),
+            self.data.fields.u.len(),
+            r.method.name(),
+            r.iterations,
+            r.certificate.kkt()
+        )
+    }
+
+    /// Pickling: the fields, the iterate, the mesh levels and (as TOML) the case, summary
+    /// and report.
+    fn __reduce__<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyTuple>> {
+        let d = &self.data;
+        let r = &d.report;
+        let meta = Meta {
+            label: d.label.clone(),
+            case: d.case.to_toml_string().map_err(py_err)?,
+            summary: d.summary.clone(),
+            report: ReportState {
+                status: r.status,
+                accepted: r.accepted,
+                requested: r.requested,
+                method: r.method,
+                choice: r.choice,
+                fallback: r.fallback.clone(),
+                message: r.message.clone(),
+                iterations: r.iterations,
+                energy: r.energy,
+                certificate: r.certificate,
+                tolerance: r.tolerance,
+                history: r.history.clone(),
+                phases: phases_out(&r.phases),
+                solver_phases: phases_out(&r.solver_phases),
+            },
+            warnings: d.warnings.clone(),
+            seconds: d.seconds,
+        };
+        let state = PyDict::new(py);
+        // TOML, not JSON: it keeps NaN (residuals that were not computed).
+        state.set_item(
+            "meta",
+            toml::to_string(&meta)
+                .map_err(|e| PyValueError::new_err(format!("cannot pickle: {e}")))?,
+        )?;
+        let f = &d.fields;
+        for (name, v) in
+            FIELD_NAMES
+                .iter()
+                .zip([&f.u, &f.phi, &f.penetration, &f.pressure, &f.contact_force])
+        {
+            state.set_item(*name, Self::f64_array(py, v))?;
+        }
+        state.set_item("state", PyArray1::from_slice(py, &f.state))?;
+        state.set_item("covered", PyArray1::from_slice(py, &f.covered))?;
+        state.set_item("u_dofs", Self::f64_array(py, &r.u))?;
+        if let Some(m) = &r.multipliers {
+            state.set_item("x1", Self::f64_array(py, &m.x1))?;
+            state.set_item("x2", Self::f64_array(py, &m.x2))?;
+        }
+        state.set_item("mesh", mesh_state(py, &d.mesh.hierarchy)?)?;
+        let rebuild = py
+            .import("memcontact._memcontact")?
+            .getattr("_result_from_state")?;
+        PyTuple::new(py, [rebuild, PyTuple::new(py, [state])?.into_any()])
+    }
+}
+
+fn vec_bool(a: &Bound<'_, PyAny>) -> PyResult<Vec<bool>> {
+    let a: PyReadonlyArray1<'_, bool> = a.extract()?;
+    Ok(a.as_array().to_vec())
+}
+
+/// The pictures of `case` as the command-line tool draws them (`[output]`, `[units]`),
+/// titled with `label`.
+fn plot_options(case: &Case, label: &str) -> PlotOptions {
+    PlotOptions {
+        plots: case
+            .output
+            .pictures()
+            .into_iter()
+            .map(|k| match k {
+                PictureKind::Deflection => PlotKind::Deflection,
+                PictureKind::Pressure => PlotKind::Pressure,
+                PictureKind::Liftoff => PlotKind::Liftoff,
+                PictureKind::Profile => PlotKind::Profile,
+            })
+            .collect(),
+        allowable_pressure: case.output.allowable_pressure,
+        profile: case.output.profile,
+        units: Units {
+            length: case.units.length.clone(),
+            force: case.units.force.clone(),
+        },
+        title: Some(label.to_string()),
+    }
+}
+
+/// Rebuilds a pickled result.
+#[pyfunction]
+pub fn _result_from_state(state: &Bound<'_, PyDict>) -> PyResult<PyResult_> {
+    let get = |k: &str| -> PyResult<Bound<'_, PyAny>> {
+        state
+            .get_item(k)?
+            .ok_or_else(|| PyValueError::new_err(format!("result state without '{k}'")))
+    };
+    let vec = |k: &str| -> PyResult<Vec<f64>> {
+        let a: PyReadonlyArray1<'_, f64> = get(k)?.extract()?;
+        Ok(a.as_array().to_vec())
+    };
+    let meta: Meta = toml::from_str(&get("meta")?.extract::<String>()?)
+        .map_err(|e| PyValueError::new_err(format!("cannot unpickle a result: {e}")))?;
+    let case = Case::from_toml_str(&meta.case, None).map_err(py_err)?;
+    let state_arr: PyReadonlyArray1<'_, i8> = get("state")?.extract()?;
+    let fields = NodalFields {
+        covered: vec_bool(&get("covered")?)?,
+        u: vec("u")?,
+        phi: vec("phi")?,
+        penetration: vec("penetration")?,
+        pressure: vec("pressure")?,
+        contact_force: vec("contact_force")?,
+        state: state_arr.as_array().to_vec(),
+    };
+    let multipliers = match state.get_item("x1")? {
+        Some(_) => Some(Multipliers {
+            x1: vec("x1")?,
+            x2: vec("x2")?,
+        }),
+        None => None,
+    };
+    let s = meta.report;
+    let report = Report {
+        status: s.status,
+        accepted: s.accepted,
+        requested: s.requested,
+        method: s.method,
+        choice: s.choice,
+        fallback: s.fallback,
+        message: s.message,
+        iterations: s.iterations,
+        energy: s.energy,
+        certificate: s.certificate,
+        tolerance: s.tolerance,
+        history: s.history,
+        phases: phases_in(s.phases),
+        solver_phases: phases_in(s.solver_phases),
+        u: vec("u_dofs")?,
+        multipliers,
+    };
+    let mesh = PyMesh::new_from(hierarchy_from_state(&get("mesh")?)?);
+    Ok(PyResult_ {
+        data: Arc::new(ResultData {
+            label: meta.label,
+            case,
+            mesh,
+            fields,
+            summary: meta.summary,
+            report,
+            warnings: meta.warnings,
+            seconds: meta.seconds,
+        }),
+        outcome: Mutex::new(None),
+    })
+}
