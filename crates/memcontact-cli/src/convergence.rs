@@ -312,6 +312,15 @@ pub fn run(args: &Args) -> Result<()> {
         );
     }
     if args.h_sweep {
+        let base = memcontact::resources::MeshSize::of(hierarchy.finest());
+        memcontact::resources::check_mesh_fits(
+            base,
+            args.levels,
+            &format!(
+                "--h-sweep --levels {} on a mesh of {:.0} triangles",
+                args.levels, base.triangles
+            ),
+        )?;
         hierarchy.refine(args.levels);
         let hs: Vec<f64> = if args.h_values.is_empty() {
             DEFAULT_SWEEP.to_vec()

@@ -282,6 +282,16 @@ impl PyMesh {
                 memcontact::problem::MAX_REFINE
             )));
         }
+        let base = memcontact::resources::MeshSize::of(self.finest());
+        memcontact::resources::check_mesh_fits(
+            base,
+            times,
+            &format!(
+                "refine({times}) of a mesh of {} triangles",
+                self.finest().n_triangles()
+            ),
+        )
+        .map_err(|e| PyValueError::new_err(e.to_string()))?;
         let mut h = (*self.hierarchy).clone();
         py.detach(|| h.refine(times));
         Ok(PyMesh::new_from(h))

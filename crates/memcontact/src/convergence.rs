@@ -190,6 +190,15 @@ pub fn run(
             "a convergence study needs at least one refinement level (levels ≥ 1)".into(),
         ));
     }
+    let base = crate::resources::MeshSize::of(hierarchy.finest());
+    crate::resources::check_mesh_fits(
+        base,
+        settings.levels,
+        &format!(
+            "a convergence study of {} levels on a mesh of {:.0} triangles",
+            settings.levels, base.triangles
+        ),
+    )?;
     let base_depth = hierarchy.depth();
     let mut rows: Vec<LevelResult> = Vec::with_capacity(settings.levels + 1);
     // Vertex solutions of every level (kept only when compared with a discrete reference).
@@ -204,7 +213,7 @@ pub fn run(
         let refine_seconds = t0.elapsed().as_secs_f64();
         let mesh = hierarchy.finest();
         let t1 = Instant::now();
-        let model = Model::assemble(mesh, data).map_err(|e| at_level(level, e))?;
+        let model = crate::checks::assemble(mesh, data).map_err(|e| at_level(level, e))?;
         let assembly_seconds = t1.elapsed().as_secs_f64();
         let t2 = Instant::now();
         let (solution, note) =
@@ -332,8 +341,30 @@ fn at_level(level: usize, e: Error) -> Error {
 }
 
 /// Solves one level with `settings` on the finest mesh of `hierarchy` (see
-/// [`StudySettings::solver`] for the multigrid fallback of [`Method::Auto`]).
+/// [`StudySettings::solver`] for the multigrid fallback of [`Method::Auto`]), after the
+/// memory check of its solver; an answer whose J or certificate is not finite is refused
+/// ([`crate::checks::check_solution`]).
 fn solve_level(
+    model: &Model,
+    hierarchy: &Hierarchy,
+    settings: &Settings,
+) -> Result<(Solution, Option<String>)> {
+    let method = match settings.method {
+        Method::Auto => solve::auto_method(model, Some(hierarchy)),
+        m => m,
+    };
+    crate::resources::check_solver_fits(method, model.n())?;
+    let (solution, note) = solve_level_unchecked(model, hierarchy, settings)?;
+    crate::checks::check_solution(
+        solution.energy,
+        solution.certificate.kkt(),
+        model.is_rigid(),
+    )?;
+    Ok((solution, note))
+}
+
+/// [`solve_level`] without its checks.
+fn solve_level_unchecked(
     model: &Model,
     hierarchy: &Hierarchy,
     settings: &Settings,
@@ -509,7 +540,7 @@ pub fn rigid_limit_sweep(
         stiffness: Stiffness::Rigid,
         ..*data
     };
-    let rigid_model = Model::assemble(mesh, &rigid_data)?;
+    let rigid_model = crate::checks::assemble(mesh, &rigid_data)?;
     let (rigid, _) = solve_level(&rigid_model, hierarchy, solver)?;
     let rigid_u = rigid_model.dofs.to_vertices(&rigid.u, 0.0);
     let rigid_contact = contact_estimate(mesh, &rigid_model, &rigid.u);
@@ -519,7 +550,7 @@ pub fn rigid_limit_sweep(
             stiffness: Stiffness::Elastic(&h),
             ..*data
         };
-        let model = Model::assemble(mesh, &d)?;
+        let model = crate::checks::assemble(mesh, &d)?;
         let t = Instant::now();
         let (s, _) = solve_level(&model, hierarchy, solver)?;
         let solve_seconds = t.elapsed().as_secs_f64();

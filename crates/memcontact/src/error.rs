@@ -16,8 +16,9 @@ pub enum Error {
         /// What is wrong with it (with line or section where known).
         message: String,
     },
-    /// An expression does not parse or uses an unknown name.
-    #[error("expression `{expr}`: {message}")]
+    /// An expression does not parse or uses an unknown name (a long expression is shown
+    /// by its beginning).
+    #[error("expression `{}`: {message}", excerpt(expr))]
     Expr {
         /// The expression text.
         expr: String,
@@ -80,6 +81,22 @@ fn case_message(
     }
     s.push_str(message);
     s
+}
+
+/// The longest text quoted whole in a message (characters).
+const EXCERPT_CHARS: usize = 80;
+
+/// `text` for a message: whole when short, else its beginning and its length, so that a
+/// 400 KB expression or token does not fill the terminal.
+pub fn excerpt(text: &str) -> std::borrow::Cow<'_, str> {
+    match text.char_indices().nth(EXCERPT_CHARS) {
+        None => std::borrow::Cow::Borrowed(text),
+        Some((cut, _)) => std::borrow::Cow::Owned(format!(
+            "{}… ({} characters)",
+            &text[..cut],
+            text.chars().count()
+        )),
+    }
 }
 
 /// Shorthand for results of this library.

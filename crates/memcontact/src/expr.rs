@@ -35,6 +35,7 @@
 //! `max`, `sign`, `step` and the condition of `if` all return NaN when an operand they
 //! look at is NaN, so that the data checks of [`crate::field`] catch it.
 
+use crate::error::excerpt;
 use crate::{Error, Result};
 use std::fmt;
 
@@ -378,6 +379,10 @@ enum Node {
     Un(UnOp, Box<Node>),
     Bin(BinOp, Box<Node>, Box<Node>),
     If(Box<Node>, Box<Node>, Box<Node>),
+    /// `a op₁ b op₂ c …` evaluated from left to right (a flat sum, product or `min`/`max`
+    /// of many terms): the same operations in the same order as the nested
+    /// left-associative tree, without its depth.
+    Chain(Box<Node>, Vec<(BinOp, Node)>),
 }
 
 /// Constant folding: every operation whose operands are all numbers is computed now, and
@@ -400,6 +405,26 @@ fn fold(node: Node) -> Node {
             Node::Num(_) => fold(*b),
             c => Node::If(Box::new(c), Box::new(fold(*a)), Box::new(fold(*b))),
         },
+        Node::Chain(first, rest) => {
+            // Constants fold while everything before them is constant: later ones stay
+            // in place (floating-point operations do not reassociate).
+            let mut acc = fold(*first);
+            let mut kept: Vec<(BinOp, Node)> = Vec::new();
+            for (f, b) in rest {
+                match (&acc, fold(b), kept.is_empty()) {
+                    (Node::Num(u), Node::Num(v), true) => acc = Node::Num(f.apply(*u, v)),
+                    (_, b, _) => kept.push((f, b)),
+                }
+            }
+            match kept.len() {
+                0 => acc,
+                1 => {
+                    let (f, b) = kept.pop().expect("one term");
+                    fold(Node::Bin(f, Box::new(acc), Box::new(b)))
+                }
+                _ => Node::Chain(Box::new(acc), kept),
+            }
+        }
         leaf => leaf,
     }
 }
@@ -441,6 +466,18 @@ fn compile(node: &Node, out: &mut Vec<Op>) {
             let end_at = out.len() as u32;
             out[branch] = Op::Branch { else_at, end_at };
             out[jump] = Op::Jump(end_at);
+        }
+        Node::Chain(first, rest) => {
+            compile(first, out);
+            for (f, b) in rest {
+                match b {
+                    Node::Num(c) => out.push(Op::BinC(*f, *c)),
+                    b => {
+                        compile(b, out);
+                        out.push(Op::Bin(*f));
+                    }
+                }
+            }
         }
     }
 }
@@ -485,8 +522,8 @@ impl Token {
     fn describe(&self) -> String {
         match self.kind {
             Kind::End => "end of expression".to_string(),
-            Kind::Num(_) => format!("number '{}' at column {}", self.text, self.col),
-            Kind::Ident => format!("name '{}' at column {}", self.text, self.col),
+            Kind::Num(_) => format!("number '{}' at column {}", excerpt(&self.text), self.col),
+            Kind::Ident => format!("name '{}' at column {}", excerpt(&self.text), self.col),
             _ => format!("'{}' at column {}", self.text, self.col),
         }
     }
@@ -531,7 +568,12 @@ fn lex(src: &str) -> std::result::Result<Vec<Token>, String> {
             let text: String = chars[start..i].iter().collect();
             match text.parse::<f64>() {
                 Ok(v) if v.is_finite() => Kind::Num(v),
-                _ => return Err(format!("number '{text}' at column {col} is out of range")),
+                _ => {
+                    return Err(format!(
+                        "number '{}' at column {col} is out of range",
+                        excerpt(&text)
+                    ))
+                }
             }
         } else if c.is_alphabetic() || c == '_' {
             while i < chars.len() && (chars[i].is_alphanumeric() || chars[i] == '_') {
@@ -662,6 +704,29 @@ fn bin(f: BinOp, a: Sub, b: Sub, col: usize) -> PResult {
     checked(Node::Bin(f, Box::new(a.node), Box::new(b.node)), depth, col)
 }
 
+/// `first op₁ b op₂ c …` (left to right) as one flat node: its depth is that of its
+/// deepest term plus one, whatever the number of terms.
+fn chain(first: Sub, rest: Vec<(BinOp, Sub)>, col: usize) -> PResult {
+    let mut depth = first.depth;
+    let mut terms = Vec::with_capacity(rest.len());
+    for (f, b) in rest {
+        depth = depth.max(b.depth);
+        terms.push((f, b.node));
+    }
+    match terms.len() {
+        0 => Ok(first),
+        1 => {
+            let (f, b) = terms.pop().expect("one term");
+            checked(
+                Node::Bin(f, Box::new(first.node), Box::new(b)),
+                depth + 1,
+                col,
+            )
+        }
+        _ => checked(Node::Chain(Box::new(first.node), terms), depth + 1, col),
+    }
+}
+
 fn cond(c: Sub, a: Sub, b: Sub, col: usize) -> PResult {
     let depth = c.depth.max(a.depth).max(b.depth) + 1;
     checked(
@@ -790,31 +855,35 @@ impl Parser {
         bin(f, a, b, op.col)
     }
 
+    /// Terms joined by `+` and `-`: one flat chain, however many.
     fn sum(&mut self) -> PResult {
-        let mut a = self.product()?;
+        let col = self.peek().col;
+        let a = self.product()?;
+        let mut rest = Vec::new();
         loop {
             let f = match self.peek().kind {
                 Kind::Plus => BinOp::Add,
                 Kind::Minus => BinOp::Sub,
-                _ => return Ok(a),
+                _ => return chain(a, rest, col),
             };
-            let col = self.next().col;
-            let b = self.product()?;
-            a = bin(f, a, b, col)?;
+            self.next();
+            rest.push((f, self.product()?));
         }
     }
 
+    /// Factors joined by `*` and `/`: one flat chain, however many.
     fn product(&mut self) -> PResult {
-        let mut a = self.unary()?;
+        let col = self.peek().col;
+        let a = self.unary()?;
+        let mut rest = Vec::new();
         loop {
             let f = match self.peek().kind {
                 Kind::Star => BinOp::Mul,
                 Kind::Slash => BinOp::Div,
-                _ => return Ok(a),
+                _ => return chain(a, rest, col),
             };
-            let col = self.next().col;
-            let b = self.unary()?;
-            a = bin(f, a, b, col)?;
+            self.next();
+            rest.push((f, self.unary()?));
         }
     }
 
@@ -870,7 +939,7 @@ impl Parser {
             }
             Kind::End => {
                 let after = match self.previous() {
-                    Some(p) => format!(" after '{}' at column {}", p.text, p.col),
+                    Some(p) => format!(" after '{}' at column {}", excerpt(&p.text), p.col),
                     None => String::new(),
                 };
                 Err(format!(
@@ -923,7 +992,8 @@ impl Parser {
                 }
                 _ => {
                     return Err(format!(
-                        "unknown variable '{name}' at column {} ({NAMES_HINT})",
+                        "unknown variable '{}' at column {} ({NAMES_HINT})",
+                        excerpt(name),
                         t.col
                     ))
                 }
@@ -936,7 +1006,8 @@ impl Parser {
                     t.col
                 ),
                 _ => format!(
-                    "unknown function '{name}' at column {} ({FUNCTIONS_HINT})",
+                    "unknown function '{}' at column {} ({FUNCTIONS_HINT})",
+                    excerpt(name),
                     t.col
                 ),
             });
@@ -975,13 +1046,10 @@ impl Parser {
                 _ => arity_error("3 arguments (condition, value if true, value if false)"),
             },
             Function::Fold(f) => {
-                let Some(mut acc) = args.next() else {
+                let Some(first) = args.next() else {
                     return arity_error("at least 1 argument");
                 };
-                for b in args {
-                    acc = bin(f, acc, b, t.col)?;
-                }
-                Ok(acc)
+                chain(first, args.map(|b| (f, b)).collect(), t.col)
             }
         }
     }
@@ -1308,8 +1376,28 @@ mod tests {
         assert_err(&format!("{}1", "-".repeat(n)), &["nested too deeply"]);
         assert_err(&format!("{}1", "2^".repeat(n)), &["nested too deeply"]);
         assert_err(&format!("{}1", "sin(".repeat(n)), &["nested too deeply"]);
-        assert_err(&format!("{}1", "1+".repeat(n)), &["too large"]);
-        assert_err(&format!("min({}1)", "1,".repeat(n)), &["too large"]);
+        // Flat sums, products and min/max of any length are chains, not deep trees.
+        assert_eq!(c(&format!("{}1", "1+".repeat(n))), (n + 1) as f64);
+        assert_eq!(
+            v(&format!("{}x", "x+".repeat(n)), 2.0, 0.0),
+            2.0 * (n + 1) as f64
+        );
+        assert_eq!(v(&format!("{}1", "x*".repeat(n)), 1.0, 0.0), 1.0);
+        assert_eq!(v(&format!("min({}x)", "1,".repeat(n)), 0.5, 0.0), 0.5);
+        assert_eq!(v(&format!("x{}", "-1+2".repeat(n)), 0.0, 0.0), n as f64);
+        // The deep nesting left is refused, with a message that quotes the beginning
+        // of the expression only.
+        let deep = format!("{}1{}", "(1+".repeat(1001), ")".repeat(1001));
+        let e = Expr::parse(&deep).unwrap_err().to_string();
+        assert!(e.contains("too") && e.len() < 400, "{e}");
+        let long = format!("{}q", "x+".repeat(200_000));
+        let e = Expr::parse(&long).unwrap_err().to_string();
+        assert!(e.contains("unknown variable 'q'") && e.len() < 400, "{e}");
+        assert!(e.contains("400001 characters"), "{e}");
+        let e = Expr::parse(&format!("1{}", "1".repeat(400)))
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("out of range") && e.len() < 400, "{e}");
         // Within the limits all is well.
         let ok = format!("{}x{}", "(".repeat(100), ")".repeat(100));
         assert_eq!(v(&ok, 2.0, 0.0), 2.0);

@@ -10,6 +10,7 @@
 
 pub mod bench;
 pub mod certificate;
+pub mod checks;
 pub mod convergence;
 pub mod error;
 pub mod errors;
@@ -24,6 +25,7 @@ pub mod nodal;
 pub mod output;
 pub mod problem;
 pub mod quadrature;
+pub mod resources;
 pub mod results;
 pub mod run;
 pub mod solve;

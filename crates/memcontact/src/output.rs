@@ -128,7 +128,13 @@ pub fn write_files(
     extra: &mut dyn FnMut(&Path, &NodalFields) -> Result<Vec<String>>,
 ) -> Result<Summary> {
     let t0 = Instant::now();
-    let (fields, totals) = outcome.fields();
+    let (fields, totals) = outcome.checked_fields()?;
+    let r = &outcome.report;
+    crate::checks::check_solution(
+        r.energy,
+        r.certificate.kkt(),
+        outcome.discretization.model.is_rigid(),
+    )?;
     write_fields(dir, outcome, &fields, options.vtu)?;
     let mut names = vec!["solution.vtu".to_string(), "nodes.csv".to_string()];
     names.extend(extra(dir, &fields)?);

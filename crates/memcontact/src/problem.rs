@@ -11,16 +11,17 @@ use crate::field::{Field, Stiffness};
 use crate::mesh::generate::{self, Diagonal, PolygonSpec, RectangleSpec};
 use crate::mesh::refine::Hierarchy;
 use crate::model::{Foundation, Sampling};
+use crate::resources::{check_mesh_fits, MeshSize};
 use crate::solve::Settings;
 use crate::{Error, Result};
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 
-/// The largest case file read (bytes): a case is a few kilobytes of text.
-pub const CASE_FILE_CAP: u64 = 16 << 20;
+pub use crate::resources::CASE_FILE_CAP;
 
 /// The largest number of uniform refinements accepted (each multiplies the triangles by
-/// four); the size of the refined mesh is checked separately against the memory limit.
+/// four); the size of the refined mesh is checked separately against the memory available
+/// ([`crate::resources::check_mesh_fits`], before refining).
 pub const MAX_REFINE: usize = 12;
 
 /// A whole case: the problem, how to solve it, what to write, and (optionally) its exact
@@ -454,6 +455,13 @@ impl From<MeshSpec> for MeshTable {
     }
 }
 
+/// The expected counts of a Delaunay mesh of `area` with elements of `size` (equilateral
+/// triangles, two per vertex).
+fn delaunay_size(area: f64, size: f64) -> MeshSize {
+    let triangles = (area / (size * size * 3f64.sqrt() / 4.0)).max(1.0);
+    MeshSize::simply_connected(triangles / 2.0, triangles)
+}
+
 /// The case-file name of a rectangle diagonal.
 fn diagonal_name(d: Diagonal) -> &'static str {
     match d {
@@ -483,9 +491,51 @@ impl MeshSpec {
         }
     }
 
+    /// The counts of the base mesh before it is built, where the generator knows them:
+    /// exactly for the rectangle, from the area and the element size for the disc
+    /// (`None` for a file or a polygon, counted once built).
+    fn expected_size(&self) -> Option<MeshSize> {
+        match &self.source {
+            MeshSource::File(_) => None,
+            &MeshSource::Rectangle {
+                nx, ny, diagonal, ..
+            } => {
+                let cells = nx as f64 * ny as f64;
+                let (vertices, triangles) = match diagonal {
+                    Diagonal::Crossed => {
+                        ((nx as f64 + 1.0) * (ny as f64 + 1.0) + cells, 4.0 * cells)
+                    }
+                    _ => ((nx as f64 + 1.0) * (ny as f64 + 1.0), 2.0 * cells),
+                };
+                Some(MeshSize::simply_connected(vertices, triangles))
+            }
+            &MeshSource::Disk { radius, size, .. } => {
+                Some(delaunay_size(std::f64::consts::PI * radius * radius, size))
+            }
+            // The polygon's triangles are counted once generated (at most
+            // `generate::MAX_TRIANGLES`).
+            MeshSource::Polygon { .. } => None,
+        }
+    }
+
+    /// What [`MeshSpec::build`] would make, named for messages.
+    fn describe_refinement(&self, base: &MeshSize) -> String {
+        format!(
+            "mesh.refine = {} on a {} mesh of {:.0} triangles",
+            self.refine,
+            self.kind(),
+            base.triangles
+        )
+    }
+
     /// Builds the mesh and its hierarchy of levels; warnings (from a Gmsh import) are
-    /// returned for the caller to show.
+    /// returned for the caller to show. The memory the run on the refined mesh needs is
+    /// checked before the base mesh is generated (when its size is known beforehand) and
+    /// again, exactly, before it is refined.
     pub fn build(&self) -> Result<(Hierarchy, Vec<String>)> {
+        if let Some(base) = self.expected_size() {
+            check_mesh_fits(base, self.refine, &self.describe_refinement(&base))?;
+        }
         let mut warnings = Vec::new();
         let mut hierarchy = match &self.source {
             MeshSource::File(path) => {
@@ -533,6 +583,8 @@ impl MeshSpec {
             })?),
         };
         if self.refine > 0 {
+            let base = MeshSize::of(hierarchy.finest());
+            check_mesh_fits(base, self.refine, &self.describe_refinement(&base))?;
             hierarchy.refine(self.refine);
         }
         Ok((hierarchy, warnings))
@@ -993,29 +1045,13 @@ impl Case {
 
 /// Reads a case file: a regular file, at most [`CASE_FILE_CAP`] bytes, UTF-8.
 fn read_case_text(path: &Path) -> Result<String> {
-    let file_err = |message: String| Error::File {
+    let bytes = crate::resources::read_input(path, crate::resources::CASE_FILE)?;
+    String::from_utf8(bytes).map_err(|e| Error::File {
         path: path.to_path_buf(),
-        message,
-    };
-    let meta = std::fs::metadata(path).map_err(|e| file_err(format!("cannot read: {e}")))?;
-    if !meta.is_file() {
-        return Err(file_err(
-            "is not a regular file (a case file must be a TOML text file)".into(),
-        ));
-    }
-    if meta.len() > CASE_FILE_CAP {
-        return Err(file_err(format!(
-            "is {} bytes, more than a case file can be ({} bytes)",
-            meta.len(),
-            CASE_FILE_CAP
-        )));
-    }
-    let bytes = std::fs::read(path).map_err(|e| file_err(format!("cannot read: {e}")))?;
-    String::from_utf8(bytes).map_err(|e| {
-        file_err(format!(
+        message: format!(
             "is not UTF-8 text (invalid byte at offset {})",
             e.utf8_error().valid_up_to()
-        ))
+        ),
     })
 }
 

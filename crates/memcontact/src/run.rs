@@ -14,13 +14,13 @@
 use crate::field::{BoundField, Stiffness as FieldStiffness};
 use crate::mesh::refine::Hierarchy;
 use crate::mesh::Mesh;
-use crate::model::{Certificate, FoundationMatrix, Model, ProblemData, Stiffness};
+use crate::model::{Certificate, Model, ProblemData, Stiffness};
 use crate::problem::{Invalid, Problem};
 use crate::results::{derive_from, NodalFields, Totals};
 use crate::solve::{
     self, Choice, Fallback, IterationRecord, Method, Observer, Settings, Solution, Status,
 };
-use crate::{Error, Result};
+use crate::Result;
 use std::time::Instant;
 
 /// The problem's data f, φ, h bound to a mesh's regions.
@@ -122,9 +122,7 @@ impl Discretization {
         let t0 = Instant::now();
         let mesh = hierarchy.finest();
         let bound = BoundData::new(problem, mesh)?;
-        check_boundary_data(mesh, &bound)?;
-        let model = Model::assemble(mesh, &bound.data(problem))?;
-        check_overflow(mesh, &model)?;
+        let model = crate::checks::assemble(mesh, &bound.data(problem))?;
         let seconds = t0.elapsed().as_secs_f64();
         observer.phase_finished("assembly", seconds);
         Ok(Discretization {
@@ -166,9 +164,19 @@ impl Discretization {
         start: Option<&[f64]>,
         observer: &mut dyn Observer,
     ) -> Result<Report> {
+        let method = match settings.method {
+            Method::Auto => self.auto_choice().0,
+            m => m,
+        };
+        crate::resources::check_solver_fits(method, self.model.n())?;
         observer.phase_started("solve");
         let t0 = Instant::now();
         let a = solve::attempt_from(&self.model, self.levels(), settings, start, observer)?;
+        crate::checks::check_solution(
+            a.solution.energy,
+            a.solution.certificate.kkt(),
+            self.model.is_rigid(),
+        )?;
         let seconds = t0.elapsed().as_secs_f64();
         observer.phase_finished("solve", seconds);
         let mut phases = self.phases.clone();
@@ -200,103 +208,6 @@ impl Discretization {
             multipliers: s.multipliers,
         })
     }
-}
-
-/// Checks the data where assembly does not sample it: f on the boundary vertices (a load
-/// singular on the boundary, like `1/x` on x = 0, is refused), and, for the rigid obstacle,
-/// that φ is not below the fixed boundary (`u = 0 > φ` there: no continuous solution).
-fn check_boundary_data(mesh: &Mesh, data: &BoundData) -> Result<()> {
-    let boundary = mesh.boundary_vertices();
-    let adj = crate::fem::VertexTriangles::new(mesh);
-    for (v, &on) in boundary.iter().enumerate() {
-        if !on {
-            continue;
-        }
-        let p = mesh.points[v];
-        for &k in adj.of(v) {
-            let region = mesh.regions[k as usize];
-            let f = data.load.eval(p, region);
-            if !f.is_finite() {
-                return Err(Error::Data(format!(
-                    "membrane.load f is not finite on the boundary at ({}, {}) (f = {f}): the \
-                     load must be bounded on the closed domain",
-                    p[0], p[1]
-                )));
-            }
-            if data.stiffness.is_none() {
-                let phi = data.shape.eval(p, region);
-                if phi < 0.0 {
-                    return Err(Error::Data(format!(
-                        "obstacle.shape φ = {phi} at the boundary point ({}, {}) lies below \
-                         the fixed boundary (u = 0 there): with a rigid obstacle (u ≤ φ) the \
-                         problem has no continuous solution; raise φ to at least 0 on the \
-                         boundary or give the obstacle a finite stiffness",
-                        p[0], p[1]
-                    )));
-                }
-            }
-        }
-    }
-    Ok(())
-}
-
-/// Refuses a model whose matrices or data overflowed double precision, naming the data.
-fn check_overflow(mesh: &Mesh, model: &Model) -> Result<()> {
-    let smallest_area = (0..mesh.n_triangles())
-        .map(|k| mesh.area(k).abs())
-        .fold(f64::INFINITY, f64::min);
-    if !model.s.is_finite() {
-        return Err(Error::Data(format!(
-            "the stiffness matrix S overflows double precision: tension t = {:e} on triangles \
-             as small as {smallest_area:e} (S grows like t × edge² / area); rescale the \
-             problem (units) so that t and the mesh are moderate",
-            model.tension
-        )));
-    }
-    if let FoundationMatrix::Consistent(l) = &model.l {
-        if !l.is_finite() {
-            return Err(Error::Data(
-                "the foundation matrix L = ∫h gᵢgⱼ overflows double precision: \
-                 obstacle.stiffness h is too large (use stiffness = \"rigid\" for a rigid \
-                 body)"
-                    .into(),
-            ));
-        }
-    }
-    if let FoundationMatrix::Lumped(d) = &model.l {
-        if d.iter().any(|v| !v.is_finite()) {
-            return Err(Error::Data(
-                "the lumped foundation lᵢ = ∫h gᵢ overflows double precision: \
-                 obstacle.stiffness h is too large (use stiffness = \"rigid\" for a rigid \
-                 body)"
-                    .into(),
-            ));
-        }
-    }
-    if let Some(i) = model.phi.iter().position(|v| !v.is_finite()) {
-        let p = mesh.points[model.dofs.vertex[i] as usize];
-        return Err(Error::Data(format!(
-            "obstacle.shape φ is not finite at ({}, {})",
-            p[0], p[1]
-        )));
-    }
-    if !model.total_load.is_finite() {
-        return Err(Error::Data(
-            "the total load ∫f overflows double precision: membrane.load f is too large".into(),
-        ));
-    }
-    // J = ½UᵀSU − UᵀD with U of the size D/S: the products must stay finite.
-    let d_max = crate::sparse::norm_inf(&model.d);
-    let s_min = model.s.diag().into_iter().fold(f64::INFINITY, f64::min);
-    let u_size = d_max / s_min * (model.n() as f64).sqrt();
-    if !(d_max * u_size * model.n() as f64).is_finite() {
-        return Err(Error::Data(format!(
-            "the energy J would overflow double precision: the nodal loads |D| reach \
-             {d_max:e} against a stiffness of {s_min:e} (membrane.load is too large for the \
-             tension); rescale the problem (units)"
-        )));
-    }
-    Ok(())
 }
 
 /// How a solve went, with its iterate: the status, the method used and why, iterations,
@@ -409,6 +320,14 @@ impl Outcome {
             &self.discretization.model,
             &self.report.u,
         )
+    }
+
+    /// [`Outcome::fields`], refused when a field or total is not a finite number
+    /// ([`crate::checks::check_results`]): what result files are written from.
+    pub fn checked_fields(&self) -> Result<(NodalFields, Totals)> {
+        let (fields, totals) = self.fields();
+        crate::checks::check_results(self.mesh(), &fields, &totals)?;
+        Ok((fields, totals))
     }
 }
 

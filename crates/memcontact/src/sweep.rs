@@ -289,6 +289,18 @@ fn scale_load(m: &mut Model, k: f64) {
     m.total_load *= k;
 }
 
+/// Names the step (its directory name and value) in an error about its data.
+fn at_step(step: &StepSpec, case: &Case, e: Error) -> Error {
+    let what = match &case.sweep {
+        Some(s) => format!("{} = {:e}", s.parameter.name(), step.value),
+        None => format!("load_factor = {:e}", step.value),
+    };
+    match e {
+        Error::Data(m) => Error::Data(format!("{} ({what}): {m}", step.name)),
+        other => other,
+    }
+}
+
 /// What a step produced, for `sweep.csv`.
 #[derive(Debug, Clone, Serialize)]
 pub struct StepRow {
@@ -382,17 +394,23 @@ pub fn run_sweep(
             }
             scale_load(&mut current.model, step.value);
         }
-        let report = current.solve_from(
-            &case.settings,
-            if warm { start.as_deref() } else { None },
-            observer,
-        )?;
+        crate::checks::check_model(current.mesh(), &current.model)
+            .map_err(|e| at_step(step, case, e))?;
+        let report = current
+            .solve_from(
+                &case.settings,
+                if warm { start.as_deref() } else { None },
+                observer,
+            )
+            .map_err(|e| at_step(step, case, e))?;
         let seconds = t0.elapsed().as_secs_f64();
         let outcome = Outcome {
             discretization: current,
             report,
         };
-        let (_, t) = outcome.fields();
+        let (_, t) = outcome
+            .checked_fields()
+            .map_err(|e| at_step(step, case, e))?;
         let r = &outcome.report;
         let row = StepRow {
             step: step.index,

@@ -35,11 +35,17 @@ pub fn read_msh(path: &Path) -> Result<(Mesh, Vec<String>)> {
         path: path.to_path_buf(),
         message,
     };
-    let bytes = std::fs::read(path).map_err(|e| file_err(format!("cannot read the file: {e}")))?;
-    let raw = parse(&bytes).map_err(file_err)?;
+    let bytes = crate::resources::read_input(path, crate::resources::MESH_FILE)?;
+    parse_msh(&bytes).map_err(file_err)
+}
+
+/// [`read_msh`] on the bytes of a file: the mesh and warnings, or what is wrong (with the
+/// line or section).
+pub fn parse_msh(bytes: &[u8]) -> std::result::Result<(Mesh, Vec<String>), String> {
+    let raw = parse(bytes)?;
     raw.into_mesh().map_err(|e| match e {
-        ParseOrMesh::Parse(m) => file_err(m),
-        ParseOrMesh::Mesh(e, warnings) => file_err(format!(
+        ParseOrMesh::Parse(m) => m,
+        ParseOrMesh::Mesh(e, warnings) => format!(
             "{e} (triangles are numbered from 0 in file order, vertices from 0 in node \
              order){}",
             if warnings.is_empty() {
@@ -47,7 +53,7 @@ pub fn read_msh(path: &Path) -> Result<(Mesh, Vec<String>)> {
             } else {
                 format!("; warnings: {}", warnings.join("; "))
             }
-        )),
+        ),
     })
 }
 
@@ -205,6 +211,7 @@ impl Raw {
                 nodes.len()
             ));
         }
+        warnings.extend(crate::field::region_name_warnings(&names, &regions));
         match Mesh::new(points, tris, regions, names) {
             Ok(mesh) => Ok((mesh, warnings)),
             Err(e) => Err(ParseOrMesh::Mesh(e, warnings)),
@@ -322,9 +329,12 @@ impl<'a> Cursor<'a> {
         }
     }
 
-    /// A count that must fit in memory: no more than one item per remaining byte.
-    fn check_count(&self, n: u64, what: &str) -> Parse<usize> {
-        if n > (self.buf.len() - self.pos.min(self.buf.len())) as u64 + 1 {
+    /// A count the rest of the file can hold, each item taking at least `min_bytes` bytes
+    /// (separators included): what is reserved for the items is bounded by a small multiple
+    /// of the file's size, never by a declared count alone.
+    fn check_count(&self, n: u64, min_bytes: u64, what: &str) -> Parse<usize> {
+        let rest = (self.buf.len() - self.pos.min(self.buf.len())) as u64 + 1;
+        if n > rest / min_bytes.max(1) {
             return Err(format!(
                 "{}: {what} = {n} is more than the file can hold (truncated or corrupt file?)",
                 self.section
@@ -534,7 +544,9 @@ fn read_entities(
         } else {
             c.parse(&format!("the number of {what}"))?
         };
-        counts[k] = c.check_count(n, &format!("the number of {what}"))?;
+        // An entity is at least a tag and a bounding box.
+        let min = if binary { 28 } else { 8 };
+        counts[k] = c.check_count(n, min, &format!("the number of {what}"))?;
     }
     let mut surfaces = BTreeMap::new();
     for (dim, &count) in counts.iter().enumerate() {
@@ -557,7 +569,11 @@ fn read_entities(
             } else {
                 c.parse("the number of physical tags")?
             };
-            let n_phys = c.check_count(n_phys, "the number of physical tags")?;
+            let n_phys = c.check_count(
+                n_phys,
+                if binary { 4 } else { 2 },
+                "the number of physical tags",
+            )?;
             let mut phys = Vec::with_capacity(n_phys);
             for _ in 0..n_phys {
                 phys.push(if binary {
@@ -572,7 +588,11 @@ fn read_entities(
                 } else {
                     c.parse("the number of bounding entities")?
                 };
-                let n_bound = c.check_count(n_bound, "the number of bounding entities")?;
+                let n_bound = c.check_count(
+                    n_bound,
+                    if binary { 4 } else { 2 },
+                    "the number of bounding entities",
+                )?;
                 for _ in 0..n_bound {
                     if binary {
                         c.int("a bounding entity tag")?;
@@ -598,7 +618,8 @@ fn read_entities(
 
 fn read_nodes_v2(c: &mut Cursor, binary: bool, raw: &mut Raw) -> Parse<()> {
     let n: u64 = c.parse("the number of nodes")?;
-    let n = c.check_count(n, "the number of nodes")?;
+    // A node is a tag and three coordinates: "1 0 0 0\n", or 4 + 3 × 8 bytes.
+    let n = c.check_count(n, if binary { 28 } else { 8 }, "the number of nodes")?;
     raw.nodes.reserve(n);
     if binary {
         c.end_line();
@@ -632,8 +653,8 @@ fn read_nodes_v4(c: &mut Cursor, binary: bool, raw: &mut Raw) -> Parse<()> {
             c.parse(what)?
         };
     }
-    let blocks = c.check_count(head[0], "the number of node blocks")?;
-    let total = c.check_count(head[1], "the number of nodes")?;
+    let blocks = c.check_count(head[0], 8, "the number of node blocks")?;
+    let total = c.check_count(head[1], 8, "the number of nodes")?;
     raw.nodes.reserve(total);
     for _ in 0..blocks {
         let (dim, parametric, n) = if binary {
@@ -651,7 +672,7 @@ fn read_nodes_v4(c: &mut Cursor, binary: bool, raw: &mut Raw) -> Parse<()> {
                 c.parse("the number of nodes in the block")?,
             )
         };
-        let n = c.check_count(n, "the number of nodes in the block")?;
+        let n = c.check_count(n, 8, "the number of nodes in the block")?;
         let params = if parametric != 0 {
             dim.max(0) as usize
         } else {
@@ -696,7 +717,7 @@ fn read_nodes_v4(c: &mut Cursor, binary: bool, raw: &mut Raw) -> Parse<()> {
 
 fn read_elements_v2(c: &mut Cursor, binary: bool, raw: &mut Raw) -> Parse<()> {
     let n: u64 = c.parse("the number of elements")?;
-    let n = c.check_count(n, "the number of elements")?;
+    let n = c.check_count(n, if binary { 8 } else { 6 }, "the number of elements")?;
     if binary {
         c.end_line();
         let mut done = 0;
@@ -805,7 +826,7 @@ fn read_elements_v4(
             c.parse(what)?
         };
     }
-    let blocks = c.check_count(head[0], "the number of element blocks")?;
+    let blocks = c.check_count(head[0], 8, "the number of element blocks")?;
     for _ in 0..blocks {
         let (dim, entity, ty, n) = if binary {
             (
@@ -822,7 +843,11 @@ fn read_elements_v4(
                 c.parse::<u64>("the number of elements in the block")?,
             )
         };
-        let n = c.check_count(n, "the number of elements in the block")?;
+        let n = c.check_count(
+            n,
+            if binary { 8 } else { 2 },
+            "the number of elements in the block",
+        )?;
         let phys = if dim == 2 {
             entities
                 .get(&entity)
