@@ -4,7 +4,10 @@ use crate::output;
 use crate::progress::{Progress, Verbosity};
 use anyhow::{bail, Result};
 use memcontact::io::result_set::ResultSet;
-use memcontact::output::{write_files, write_result_set, write_sweep_csv, WriteOptions};
+use memcontact::output::{
+    input_hash, new_run_id, write_files, write_manifest, write_result_set, write_sweep_csv,
+    WriteOptions,
+};
 use memcontact::{Case, Discretization, Outcome};
 use std::path::Path;
 use std::time::Instant;
@@ -64,6 +67,7 @@ pub fn solve(case_path: &Path, flags: &SolveFlags) -> Result<()> {
         force: flags.force,
         started,
         plot_options: serde_json::to_value(&plots).ok(),
+        run_id: None,
     };
     let summary = {
         let mut pictures = output::pictures(&outcome, &plots);
@@ -97,6 +101,7 @@ fn sweep(case_path: &Path, case: &Case, flags: &SolveFlags, started: Instant) ->
     let label = case_path.display().to_string();
     let plots = output::plot_options(case, &label);
     let set = ResultSet::begin(flags.out, flags.force)?;
+    let run_id = new_run_id();
     let steps = memcontact::sweep::steps(case)?;
     let total = steps.len();
     let mut progress = Progress::new(flags.verbosity);
@@ -119,6 +124,7 @@ fn sweep(case_path: &Path, case: &Case, flags: &SolveFlags, started: Instant) ->
                 force: false,
                 started: Instant::now(),
                 plot_options: serde_json::to_value(&plots).ok(),
+                run_id: Some(run_id.clone()),
             };
             let mut step_plots = plots.clone();
             step_plots.title = Some(options.label.clone());
@@ -160,6 +166,7 @@ fn sweep(case_path: &Path, case: &Case, flags: &SolveFlags, started: Instant) ->
             }],
         },
     )?;
+    write_manifest(set.dir(), tag, &run_id, &input_hash(case))?;
     set.commit()?;
     println!("memcontact: {label} ({tag}: {total} steps, {value_name})");
     println!(
@@ -182,7 +189,7 @@ fn sweep(case_path: &Path, case: &Case, flags: &SolveFlags, started: Instant) ->
     let iterations: usize = rows.iter().map(|r| r.iterations).sum();
     println!(
         "  total        {iterations} iterations, {:.3} s; wrote {}/{{{} step directories, \
-         sweep.csv, sweep.png}}",
+         sweep.csv, sweep.png, manifest.json}}",
         started.elapsed().as_secs_f64(),
         flags.out.display(),
         written

@@ -13,6 +13,7 @@ use memcontact::io::result_set::ResultSet;
 use memcontact::io::vtu::DataArray;
 use memcontact::mesh::refine::Hierarchy;
 use memcontact::model::{Foundation, ProblemData, Sampling};
+use memcontact::output::{input_hash, new_run_id, write_manifest, MANIFEST};
 use memcontact::problem::{ExactSpec, ManufacturedDomain, MeshSource};
 use memcontact::run::BoundData;
 use memcontact::Case;
@@ -349,10 +350,11 @@ pub fn run(args: &Args) -> Result<()> {
             v,
             set.dir(),
         )?);
+        write_manifest(set.dir(), "h sweep", &new_run_id(), &input_hash(&case))?;
         set.commit()?;
         let _ = writeln!(
             out,
-            "  wrote        {}/{{h_sweep.csv, h_sweep.png}}",
+            "  wrote        {}/{{h_sweep.csv, h_sweep.png, manifest.json}}",
             args.output.display()
         );
         print!("{out}");
@@ -458,6 +460,8 @@ pub fn run(args: &Args) -> Result<()> {
         &[1.0, 2.0],
     )?;
     written.push("convergence.png".into());
+    write_manifest(set.dir(), "convergence", &new_run_id(), &input_hash(&case))?;
+    written.push(MANIFEST.into());
     set.commit()?;
     let _ = writeln!(
         out,

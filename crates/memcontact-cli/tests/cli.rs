@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 mod common;
 use common::{examples, run, text};
 
-fn tmp(name: &str) -> PathBuf {
+fn tmp(name: &str) -> common::Tmp {
     common::tmp_in("e2e", name)
 }
 

@@ -8,7 +8,7 @@ use std::path::{Path, PathBuf};
 mod common;
 use common::{examples, run, text};
 
-fn tmp(name: &str) -> PathBuf {
+fn tmp(name: &str) -> common::Tmp {
     common::tmp_in("conv", name)
 }
 
@@ -99,13 +99,29 @@ fn disc_study_writes_the_table_csv_and_png() {
     let l_n = column(&header, &rows, "l_n");
     assert!((l_n[1] / l_n[0] - 0.5).abs() < 0.05, "{l_n:?}");
     assert_png(&out.join("convergence.png"));
-    // Nothing but the two outputs (atomic writes leave no temporary file).
+    // Nothing but the two outputs and the manifest that binds them to the run (atomic
+    // writes leave no temporary file).
     let mut names: Vec<String> = std::fs::read_dir(&out)
         .unwrap()
         .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
         .collect();
     names.sort();
-    assert_eq!(names, ["convergence.csv", "convergence.png"]);
+    assert_eq!(
+        names,
+        ["convergence.csv", "convergence.png", "manifest.json"]
+    );
+    let manifest: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("manifest.json")).unwrap()).unwrap();
+    assert_eq!(manifest["kind"], "convergence");
+    assert_eq!(manifest["run_id"].as_str().unwrap().len(), 32);
+    for name in ["convergence.csv", "convergence.png"] {
+        let bytes = std::fs::read(out.join(name)).unwrap();
+        assert_eq!(
+            manifest["files"][name]["bytes"],
+            bytes.len() as u64,
+            "{name}"
+        );
+    }
 }
 
 #[test]

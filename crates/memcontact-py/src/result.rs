@@ -309,6 +309,7 @@ impl PyResult_ {
                         .checked_sub(Duration::from_secs_f64(self.data.seconds))
                         .unwrap_or(now),
                     plot_options: serde_json::to_value(&plots).ok(),
+                    run_id: None,
                 };
                 let mesh = outcome.mesh();
                 let mut draw = |dir: &std::path::Path, fields: &NodalFields| {

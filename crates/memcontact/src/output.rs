@@ -2,11 +2,17 @@
 //! `solution.vtu` (ParaView), `nodes.csv` (one row per vertex), any extra files of the
 //! caller (pictures), and `summary.json` (the [`Summary`], with the run id, the input's hash
 //! and the size and hash of every other file, so a mixed directory is detectable).
+//!
+//! Every file of a set carries the set's run id: `summary.json` (or `manifest.json` for a
+//! sweep or a convergence study, [`write_manifest`]) records it, `solution.vtu` holds it in
+//! its `FieldData` array `run_id`, and the CSV files and pictures, whose formats have no
+//! room for it (the CSV header lines are contracts), are bound to it by their hashes in
+//! the summary or manifest.
 
 use crate::io::csv::write_columns_csv;
 use crate::io::json::write_json;
 use crate::io::result_set::ResultSet;
-use crate::io::vtu::{write_vtu, DataArray, VtuEncoding};
+use crate::io::vtu::{write_vtu_with_field_data, DataArray, VtuEncoding};
 use crate::problem::{Case, VtuFormat};
 use crate::results::NodalFields;
 use crate::run::Outcome;
@@ -40,6 +46,9 @@ pub struct WriteOptions {
     pub started: Instant,
     /// The options of the pictures, recorded in `summary.json` so they can be redrawn.
     pub plot_options: Option<serde_json::Value>,
+    /// The run id the files carry (`None`: a fresh one, [`new_run_id`]); the steps of a
+    /// sweep share their sweep's.
+    pub run_id: Option<String>,
 }
 
 /// A fresh random run identifier (32 hex digits).
@@ -60,10 +69,19 @@ pub fn new_run_id() -> String {
     format!("{:016x}{:016x}", parts[0], parts[1])
 }
 
-/// The hash of a case: XXH3-64 of its canonical JSON (16 hex digits).
+/// The hash of a case: XXH3-64 of its canonical JSON and, for a mesh file, of the file's
+/// bytes (16 hex digits), so that a changed mesh file under the same name is another input.
 pub fn input_hash(case: &Case) -> String {
     let json = serde_json::to_string(case).unwrap_or_default();
-    format!("{:016x}", xxhash_rust::xxh3::xxh3_64(json.as_bytes()))
+    let mut h = xxhash_rust::xxh3::Xxh3::new();
+    h.update(json.as_bytes());
+    if let crate::problem::MeshSource::File(path) = &case.problem.mesh.source {
+        match crate::resources::read_input(path, crate::resources::MESH_FILE) {
+            Ok(bytes) => h.update(&bytes),
+            Err(_) => h.update(b"(the mesh file could not be read)"),
+        }
+    }
+    format!("{:016x}", h.digest())
 }
 
 /// The size and hash of a written file.
@@ -78,12 +96,14 @@ pub fn file_record(path: &Path) -> Result<FileRecord> {
     })
 }
 
-/// Writes `solution.vtu` and `nodes.csv` of `fields` on the outcome's mesh into `dir`.
+/// Writes `solution.vtu` (with `run_id` in its field data) and `nodes.csv` of `fields` on
+/// the outcome's mesh into `dir`.
 pub fn write_fields(
     dir: &Path,
     outcome: &Outcome,
     fields: &NodalFields,
     vtu: VtuFormat,
+    run_id: &str,
 ) -> Result<()> {
     let mesh = outcome.mesh();
     let region: Vec<i32> = mesh.regions.iter().map(|&r| r as i32).collect();
@@ -99,7 +119,7 @@ pub fn write_fields(
     ];
     let mut vtu_points = point_data.to_vec();
     vtu_points.push(("covered", DataArray::I32(&covered)));
-    write_vtu(
+    write_vtu_with_field_data(
         &dir.join("solution.vtu"),
         mesh,
         &vtu_points,
@@ -108,6 +128,7 @@ pub fn write_fields(
             VtuFormat::Binary => VtuEncoding::Binary,
             VtuFormat::Ascii => VtuEncoding::Ascii,
         },
+        &[("run_id", run_id)],
     )?;
     let x: Vec<f64> = mesh.points.iter().map(|p| p[0]).collect();
     let y: Vec<f64> = mesh.points.iter().map(|p| p[1]).collect();
@@ -135,12 +156,13 @@ pub fn write_files(
         r.certificate.kkt(),
         outcome.discretization.model.is_rigid(),
     )?;
-    write_fields(dir, outcome, &fields, options.vtu)?;
+    let run_id = options.run_id.clone().unwrap_or_else(new_run_id);
+    write_fields(dir, outcome, &fields, options.vtu, &run_id)?;
     let mut names = vec!["solution.vtu".to_string(), "nodes.csv".to_string()];
     names.extend(extra(dir, &fields)?);
     let quality = outcome.mesh().quality();
     let mut summary = Summary::new(&options.label, outcome, &quality, &totals);
-    summary.run_id = new_run_id();
+    summary.run_id = run_id;
     summary.input_hash = input_hash(case);
     summary.plot_options = options.plot_options.clone();
     for name in names {
@@ -193,3 +215,52 @@ pub fn write_sweep_csv(path: &Path, rows: &[StepRow]) -> Result<()> {
     }
     crate::io::write_atomic(path, |w| w.write_all(text.as_bytes()))
 }
+
+/// `manifest.json` of a sweep or a convergence study: the run id, the input's hash, and
+/// the size and hash of every other file of the set (by path relative to the set, step
+/// directories included), so that a directory mixing two runs is detectable.
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct Manifest {
+    /// What wrote the set: `sweep`, `load cases`, `convergence` or `h sweep`.
+    pub kind: String,
+    /// The run id shared by the set's files.
+    pub run_id: String,
+    /// The hash of the case ([`input_hash`]).
+    pub input_hash: String,
+    /// Every other file of the set, by relative path (`/`-separated).
+    pub files: std::collections::BTreeMap<String, FileRecord>,
+}
+
+/// Writes `manifest.json` into the result-set directory `dir`, listing every other regular
+/// file under it. Returns the manifest written.
+pub fn write_manifest(dir: &Path, kind: &str, run_id: &str, input_hash: &str) -> Result<Manifest> {
+    let mut files = std::collections::BTreeMap::new();
+    let mut pending = vec![(dir.to_path_buf(), String::new())];
+    while let Some((d, prefix)) = pending.pop() {
+        let io = |source| Error::Io {
+            path: d.clone(),
+            source,
+        };
+        for entry in std::fs::read_dir(&d).map_err(io)? {
+            let entry = entry.map_err(io)?;
+            let name = format!("{prefix}{}", entry.file_name().to_string_lossy());
+            let kind = entry.file_type().map_err(io)?;
+            if kind.is_dir() {
+                pending.push((entry.path(), format!("{name}/")));
+            } else if kind.is_file() && name != MANIFEST {
+                files.insert(name, file_record(&entry.path())?);
+            }
+        }
+    }
+    let manifest = Manifest {
+        kind: kind.to_string(),
+        run_id: run_id.to_string(),
+        input_hash: input_hash.to_string(),
+        files,
+    };
+    write_json(&dir.join(MANIFEST), &manifest)?;
+    Ok(manifest)
+}
+
+/// The file name of a [`Manifest`].
+pub const MANIFEST: &str = "manifest.json";

@@ -176,6 +176,7 @@ fn a_result_set_is_written_and_read_back_without_the_cli() {
         force: false,
         started: Instant::now(),
         plot_options: None,
+        run_id: None,
     };
     let written =
         write_result_set(&out, &outcome, &case, &options, &mut |_, _| Ok(vec![])).unwrap();

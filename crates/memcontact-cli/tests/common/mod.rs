@@ -3,6 +3,7 @@
 #![allow(dead_code)]
 
 use std::path::{Path, PathBuf};
+
 use std::process::{Command, Output};
 
 /// The binary under test.
@@ -29,10 +30,34 @@ pub fn text(o: &Output) -> String {
     )
 }
 
-/// A fresh, empty temporary directory for test `name` of suite `suite`.
-pub fn tmp_in(suite: &str, name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("memcontact-{suite}-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
+/// A fresh, empty temporary directory, removed when the value is dropped; it derefs to
+/// its path.
+pub struct Tmp(tempfile::TempDir);
+
+impl std::ops::Deref for Tmp {
+    type Target = Path;
+    fn deref(&self) -> &Path {
+        self.0.path()
+    }
+}
+
+impl AsRef<Path> for Tmp {
+    fn as_ref(&self) -> &Path {
+        self.0.path()
+    }
+}
+
+impl AsRef<std::ffi::OsStr> for Tmp {
+    fn as_ref(&self) -> &std::ffi::OsStr {
+        self.0.path().as_os_str()
+    }
+}
+
+/// A fresh, empty temporary directory for test `name` of suite `suite` (removed when
+/// dropped).
+pub fn tmp_in(suite: &str, name: &str) -> Tmp {
+    Tmp(tempfile::Builder::new()
+        .prefix(&format!("memcontact-{suite}-{name}-"))
+        .tempdir()
+        .expect("a temporary directory"))
 }

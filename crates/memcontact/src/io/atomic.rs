@@ -45,8 +45,8 @@ mod tests {
 
     #[test]
     fn failed_write_leaves_nothing() {
-        let dir = std::env::temp_dir().join(format!("mc-atomic-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
+        let tmp = tempfile::tempdir().unwrap();
+        let dir = tmp.path();
         let p = dir.join("a.txt");
         write_atomic(&p, |w| w.write_all(b"hello")).unwrap();
         assert_eq!(std::fs::read_to_string(&p).unwrap(), "hello");
@@ -57,7 +57,6 @@ mod tests {
         });
         assert!(r.is_err());
         assert!(!q.exists());
-        assert_eq!(std::fs::read_dir(&dir).unwrap().count(), 1);
-        std::fs::remove_dir_all(&dir).unwrap();
+        assert_eq!(std::fs::read_dir(dir).unwrap().count(), 1);
     }
 }

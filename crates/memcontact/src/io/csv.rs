@@ -156,10 +156,8 @@ fn push_int(buf: &mut Vec<u8>, x: i64) {
 pub(crate) mod tests {
     use super::*;
 
-    fn tmp(name: &str) -> std::path::PathBuf {
-        let dir = std::env::temp_dir().join(format!("mc-csv-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
-        dir.join(name)
+    fn tmp(name: &str) -> crate::io::TmpPath {
+        crate::io::TmpPath::new(name)
     }
 
     /// Parses a field written by these writers back to f64 (empty = NaN).

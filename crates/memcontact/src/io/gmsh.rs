@@ -1118,10 +1118,8 @@ mod tests {
             .join(name)
     }
 
-    fn temp(name: &str) -> PathBuf {
-        let dir = std::env::temp_dir().join(format!("mc-gmsh-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
-        dir.join(name)
+    fn temp(name: &str) -> crate::io::TmpPath {
+        crate::io::TmpPath::new(name)
     }
 
     /// The triangles as sorted triples of corner coordinates (bit patterns) with their
@@ -1301,7 +1299,7 @@ $Elements
 $EndElements
 ";
 
-    fn write_text(name: &str, text: &str) -> PathBuf {
+    fn write_text(name: &str, text: &str) -> crate::io::TmpPath {
         let p = temp(name);
         std::fs::write(&p, text).unwrap();
         p

@@ -26,10 +26,8 @@ mod tests {
     use super::*;
     use serde_json::json;
 
-    fn tmp(name: &str) -> std::path::PathBuf {
-        let dir = std::env::temp_dir().join(format!("mc-json-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
-        dir.join(name)
+    fn tmp(name: &str) -> crate::io::TmpPath {
+        crate::io::TmpPath::new(name)
     }
 
     #[test]

@@ -38,7 +38,24 @@ pub enum Existing {
 }
 
 /// The file names that mark a directory as a memcontact result.
-const MARKERS: [&str; 3] = ["summary.json", "convergence.csv", "sweep.csv"];
+const MARKERS: [&str; 5] = [
+    "summary.json",
+    "manifest.json",
+    "convergence.csv",
+    "sweep.csv",
+    "h_sweep.csv",
+];
+
+/// A temporary file of the per-file atomic writes of earlier versions, `.NAME.tmpPID`,
+/// left in a result directory by a killed run: it does not make the directory foreign,
+/// and it goes with the directory when a new set replaces it.
+fn is_legacy_temporary(name: &str) -> bool {
+    name.strip_prefix('.')
+        .and_then(|rest| rest.rsplit_once(".tmp"))
+        .is_some_and(|(base, pid)| {
+            !base.is_empty() && !pid.is_empty() && pid.bytes().all(|b| b.is_ascii_digit())
+        })
+}
 
 /// What is at `target` now.
 pub fn existing(target: &Path) -> Result<Existing> {
@@ -64,7 +81,7 @@ pub fn existing(target: &Path) -> Result<Existing> {
         if MARKERS.contains(&name.as_ref()) {
             return Ok(Existing::Result);
         }
-        any = true;
+        any |= !is_legacy_temporary(&name);
     }
     Ok(if any {
         Existing::Other
@@ -345,6 +362,27 @@ mod tests {
         write(set.dir(), "summary.json", "1");
         set.commit().unwrap();
         assert!(!out.join("notes.txt").exists());
+    }
+
+    #[test]
+    fn legacy_temporary_files_are_not_foreign_and_are_removed() {
+        assert!(is_legacy_temporary(".solution.vtu.tmp1234"));
+        assert!(!is_legacy_temporary("solution.vtu.tmp1234"));
+        assert!(!is_legacy_temporary(".solution.vtu.tmp"));
+        assert!(!is_legacy_temporary(".a.tmpx1"));
+        let root = tempfile::tempdir().unwrap();
+        let out = root.path().join("out");
+        std::fs::create_dir(&out).unwrap();
+        write(&out, ".solution.vtu.tmp4242", "half of an old write");
+        assert_eq!(existing(&out).unwrap(), Existing::Empty);
+        let set = ResultSet::begin(&out, false).unwrap();
+        write(set.dir(), "summary.json", "1");
+        set.commit().unwrap();
+        let names: Vec<_> = std::fs::read_dir(&out)
+            .unwrap()
+            .map(|e| e.unwrap().file_name())
+            .collect();
+        assert_eq!(names, ["summary.json"]);
     }
 
     #[test]

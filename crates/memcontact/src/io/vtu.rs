@@ -71,7 +71,23 @@ pub fn write_vtu(
     cell_data: &[(&str, DataArray)],
     encoding: VtuEncoding,
 ) -> Result<()> {
-    write_vtu_impl(path, mesh, None, point_data, cell_data, encoding)
+    write_vtu_impl(path, mesh, None, point_data, cell_data, encoding, &[])
+}
+
+/// As [`write_vtu`], with text `field_data` (name, value) stored in the file's
+/// `<FieldData>` as `UInt8` arrays of the text's bytes (how a result set's run id travels
+/// with its `solution.vtu`: `bytes(array).decode()` reads it back).
+pub fn write_vtu_with_field_data(
+    path: &Path,
+    mesh: &Mesh,
+    point_data: &[(&str, DataArray)],
+    cell_data: &[(&str, DataArray)],
+    encoding: VtuEncoding,
+    field_data: &[(&str, &str)],
+) -> Result<()> {
+    write_vtu_impl(
+        path, mesh, None, point_data, cell_data, encoding, field_data,
+    )
 }
 
 /// As [`write_vtu`], but vertex `i` is placed at height `z[i]` (e.g. the deflection), so
@@ -84,7 +100,7 @@ pub fn write_vtu_warped(
     cell_data: &[(&str, DataArray)],
     encoding: VtuEncoding,
 ) -> Result<()> {
-    write_vtu_impl(path, mesh, Some(z), point_data, cell_data, encoding)
+    write_vtu_impl(path, mesh, Some(z), point_data, cell_data, encoding, &[])
 }
 
 /// One array of the file, user-supplied or derived from the mesh.
@@ -350,6 +366,7 @@ fn write_vtu_impl(
     point_data: &[(&str, DataArray)],
     cell_data: &[(&str, DataArray)],
     encoding: VtuEncoding,
+    field_data: &[(&str, &str)],
 ) -> Result<()> {
     let n_points = mesh.points.len();
     let n_cells = mesh.triangles.len();
@@ -421,6 +438,20 @@ fn write_vtu_impl(
             r#"<VTKFile type="UnstructuredGrid" version="1.0" byte_order="LittleEndian"{header_type}>"#
         )?;
         writeln!(w, "  <UnstructuredGrid>")?;
+        if !field_data.is_empty() {
+            writeln!(w, "    <FieldData>")?;
+            for (name, text) in field_data {
+                let codes: Vec<String> = text.bytes().map(|b| b.to_string()).collect();
+                writeln!(
+                    w,
+                    r#"      <DataArray type="UInt8" Name="{}" NumberOfTuples="{}" format="ascii">{}</DataArray>"#,
+                    xml_escape(name),
+                    codes.len(),
+                    codes.join(" ")
+                )?;
+            }
+            writeln!(w, "    </FieldData>")?;
+        }
         writeln!(
             w,
             r#"    <Piece NumberOfPoints="{n_points}" NumberOfCells="{n_cells}">"#
@@ -659,10 +690,8 @@ mod tests {
         }
     }
 
-    fn tmp(name: &str) -> std::path::PathBuf {
-        let dir = std::env::temp_dir().join(format!("mc-vtu-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
-        dir.join(name)
+    fn tmp(name: &str) -> crate::io::TmpPath {
+        crate::io::TmpPath::new(name)
     }
 
     fn round_trip(encoding: VtuEncoding, warped: bool) {
