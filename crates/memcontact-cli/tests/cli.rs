@@ -333,3 +333,57 @@ fn every_example_case_solves_with_a_certificate() {
     }
     assert!(n >= 5);
 }
+
+#[test]
+fn ambiguous_gmsh_region_names_are_warned_about_and_refused() {
+    // Four triangles around a centre vertex: physical surfaces 2 ("clay"), 5 (named "2",
+    // which is also surface 2's tag) and 6 (named "default").
+    let d = tmp("region-names");
+    let msh = "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$PhysicalNames\n3\n2 2 \"clay\"\n\
+               2 5 \"2\"\n2 6 \"default\"\n$EndPhysicalNames\n$Nodes\n5\n1 0 0 0\n2 1 0 0\n\
+               3 1 1 0\n4 0 1 0\n5 0.5 0.5 0\n$EndNodes\n$Elements\n4\n1 2 2 2 2 1 2 5\n\
+               2 2 2 2 2 2 3 5\n3 2 2 5 5 3 4 5\n4 2 2 6 6 4 1 5\n$EndElements\n";
+    std::fs::write(d.join("square.msh"), msh).unwrap();
+    let case = |stiffness: &str| {
+        case_file(
+            &d,
+            &format!(
+                "[mesh]\nfile = \"square.msh\"\n[membrane]\ntension = 1\nload = 8\n\
+                 [obstacle]\nshape = 0.01\nstiffness = {stiffness}\n[output]\nplot = false\n"
+            ),
+        )
+    };
+    let p = case("{ clay = 10, \"5\" = 20, \"6\" = 30 }");
+    let o = run(&["check", p.to_str().unwrap()]);
+    let t = text(&o);
+    assert!(o.status.success(), "{t}");
+    assert!(
+        t.contains("warning: physical surface 5 is named \"2\"") && t.contains("ambiguous"),
+        "{t}"
+    );
+    assert!(
+        t.contains("warning: physical surface 6 is named \"default\""),
+        "{t}"
+    );
+    let out = d.join("out");
+    let o = run(&[
+        "solve",
+        p.to_str().unwrap(),
+        "-q",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", text(&o));
+    // The key "2" could be surface 2 (by tag) or surface 5 (by name): refused.
+    let p = case("{ \"2\" = 10, default = 1 }");
+    let o = run(&[
+        "solve",
+        p.to_str().unwrap(),
+        "-q",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    let t = text(&o);
+    assert_eq!(o.status.code(), Some(1), "{t}");
+    assert!(t.contains("'2' is ambiguous") && t.contains("clay"), "{t}");
+}

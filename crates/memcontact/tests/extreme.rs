@@ -9,13 +9,25 @@ use memcontact::run::Discretization;
 use memcontact::solve::{Method, Silent, Status};
 use memcontact::{Case, Error, Report};
 
-/// The methods every class is tried with (multigrid needs the rectangle's hierarchy).
-const METHODS: [Method; 4] = [
+/// The methods every class is tried with (multigrid needs the rectangle's hierarchy;
+/// `auto` picks multigrid there; `linear` applies only without contact, see
+/// [`linear_refused`]).
+const METHODS: [Method; 5] = [
+    Method::Auto,
     Method::ActiveSet,
     Method::Multigrid,
     Method::Qp,
     Method::Coordinate,
 ];
+
+/// `linear` refuses a problem where the body can touch, naming why.
+fn linear_refused(what: &str, case: &Case) {
+    let e = solve(case, Method::Linear)
+        .err()
+        .unwrap_or_else(|| panic!("{what}"));
+    let m = e.to_string();
+    assert!(m.contains("linear") && m.contains("touch"), "{what}: {m}");
+}
 
 /// The methods that need no mesh hierarchy.
 const ANY_MESH: [Method; 3] = [Method::ActiveSet, Method::Qp, Method::Coordinate];
@@ -99,6 +111,7 @@ fn a_far_obstacle_gives_the_free_membrane() {
         let e = max_diff(&u_of(&d, &r), &u_free);
         assert!(e <= 1e-8, "{}: {e:.3e} from the free membrane", m.name());
     }
+    linear_refused("far obstacle", &far);
     // The start U = 0 is not a solution, whatever the obstacle's L|φ|.
     let (d, _) = solve(&far, Method::ActiveSet).unwrap();
     assert!(d.model.certificate(&vec![0.0; d.model.n()]).kkt() > 0.1);
@@ -120,6 +133,7 @@ fn a_near_rigid_soil_gives_the_rigid_limit_or_a_refusal() {
             "tension = 1\nload = 8",
             &format!("shape = 0.1\nstiffness = {h:e}"),
         );
+        linear_refused("near-rigid", &case);
         for m in METHODS {
             let what = format!("h = {h:e}, {}", m.name());
             let (d, r) = solve(&case, m).unwrap_or_else(|e| panic!("{what}: {e}"));
@@ -142,6 +156,7 @@ fn a_small_load_on_a_stiff_soil_scales_with_the_load() {
     let (du, ru) = solve(&unit, Method::ActiveSet).unwrap();
     accepted("unit load", &ru);
     let u1: Vec<f64> = u_of(&du, &ru).iter().map(|v| 1e-4 * v).collect();
+    linear_refused("small load", &small);
     for m in METHODS {
         let (d, r) = solve(&small, m).unwrap();
         accepted(m.name(), &r);
@@ -163,6 +178,7 @@ fn a_stiff_region_beside_a_free_one_is_solved_by_every_method_alike() {
     let u0 = u_of(&d0, &r0);
     // The free half deflects (the load is not carried by a zero solution there).
     assert!(max_abs(&u0) > 0.1);
+    linear_refused("stiff beside free", &case);
     for m in METHODS {
         let (d, r) = solve(&case, m).unwrap();
         accepted(m.name(), &r);
@@ -201,12 +217,20 @@ fn scales_from_tiny_to_huge_are_certified() {
 
 #[test]
 fn zero_load_far_below_and_the_free_solution_as_obstacle() {
-    // f = 0, body above: u = 0 is the answer (and certified at once).
-    let case = square(8, "tension = 1\nload = 0", "shape = 0.2\nstiffness = 100");
-    for m in METHODS {
-        let (_, r) = solve(&case, m).unwrap();
-        accepted(m.name(), &r);
-        assert!(r.u.iter().all(|&v| v == 0.0), "{}", m.name());
+    // f = 0, body above: u = 0 is the answer (and certified at once), also where the
+    // interior-point method stops without progress from it (16 × 16).
+    for n in [8, 16] {
+        let case = square(n, "tension = 1\nload = 0", "shape = 0.2\nstiffness = 100");
+        for m in METHODS {
+            let (_, r) = solve(&case, m).unwrap();
+            accepted(m.name(), &r);
+            assert!(r.u.iter().all(|&v| v == 0.0), "{}", m.name());
+        }
+        // Without a body, the linear problem: u = 0 too.
+        let free = square(n, "tension = 1\nload = 0", "shape = 0.2\nstiffness = 0");
+        let (_, r) = solve(&free, Method::Linear).unwrap();
+        accepted("linear", &r);
+        assert!(r.u.iter().all(|&v| v == 0.0));
     }
     // A body far below (φ = −10⁶, h = 1) pushes the membrane down: certified by every
     // method and equal among them.
@@ -303,7 +327,7 @@ fn overflowing_data_is_refused_naming_it() {
     ];
     for (membrane, obstacle, needle) in cases {
         let case = square(8, membrane, obstacle);
-        for m in METHODS {
+        for m in METHODS.into_iter().chain([Method::Linear]) {
             let e = solve(&case, m)
                 .err()
                 .unwrap_or_else(|| panic!("{membrane}"));

@@ -422,6 +422,21 @@ fn run_method(
             };
             let u = active_set::feasible_start(model);
             let certificate = model.certificate(&u);
+            // The start may be the answer (f = 0 with the body clear, say), which the
+            // method failed to confirm: the certificate, not the method, decides.
+            if certificate.kkt() <= settings.tolerance {
+                let solution = Solution {
+                    energy: model.energy(&u),
+                    u,
+                    method,
+                    iterations: 0,
+                    certificate,
+                    multipliers: None,
+                    history: Vec::new(),
+                    phases: Vec::new(),
+                };
+                return Ok((solution, Status::Converged, None));
+            }
             let solution = Solution {
                 energy: model.energy(&u),
                 u,
