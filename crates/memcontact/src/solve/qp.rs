@@ -131,14 +131,16 @@ pub fn solve_with_report(model: &Model, settings: &Settings) -> Result<QpReport>
     timer.time("interior point", || solver.solve());
     let sol = &solver.solution;
     let iterations = sol.iterations as usize;
-    // At the iteration limit the iterate is still polished and certified: the status of
-    // the solve follows from its certificate.
+    // At the iteration limit, or when the interior-point method stops making progress
+    // (often with residuals near the rounding of its own scaling), the iterate is still
+    // polished and certified: the status of the solve follows from its certificate.
     if !matches!(
         sol.status,
         SolverStatus::Solved
             | SolverStatus::AlmostSolved
             | SolverStatus::MaxIterations
             | SolverStatus::MaxTime
+            | SolverStatus::InsufficientProgress
     ) {
         return Err(Error::Solver {
             solver: "qp".into(),
