@@ -903,6 +903,12 @@ impl Problem {
 }
 
 impl Case {
+    /// Whether the case has steps to solve in turn (a `[sweep]` or `[[load_case]]`
+    /// entries): then it is run by [`crate::sweep::run_sweep`], not [`crate::run`].
+    pub fn is_sweep(&self) -> bool {
+        self.sweep.is_some() || !self.load_cases.is_empty()
+    }
+
     /// Checks the whole case (problem, settings, output, exact solution) without the mesh.
     pub fn validate(&self) -> std::result::Result<(), Invalid> {
         self.problem.validate()?;
