@@ -644,6 +644,61 @@ stiffness = 300
     }
 
     #[test]
+    fn load_case_errors_name_the_load_case() {
+        let case = |t: &str| Case::from_toml_str(&format!("{BASE}{t}"), None);
+        let e = case("[[load_case]]\nname = \"a\"\nstiffness = -2\n").unwrap_err();
+        assert!(e.to_string().contains("load_case.0.stiffness"), "{e}");
+        let e = case("[[load_case]]\nname = \"a\"\nload = nan\n").unwrap_err();
+        assert!(e.to_string().contains("load_case.0.load"), "{e}");
+        // A region the mesh lacks: found on the mesh, before any step.
+        let c = case(
+            "[[load_case]]\nname = \"a\"\n[[load_case]]\nname = \"b\"\n\
+             shape = { clay = 0.2 }\n",
+        )
+        .unwrap();
+        let d = Discretization::new(&c.problem, &mut Silent).unwrap();
+        for assemble in [false, true] {
+            let e = check_on_mesh(&c, d.mesh(), assemble)
+                .unwrap_err()
+                .to_string();
+            assert!(e.contains("load_case.1.shape") && e.contains("clay"), "{e}");
+        }
+        let mut solved = 0;
+        let e = run_sweep(&c, true, &mut Silent, &mut |_, _, _| {
+            solved += 1;
+            Ok(())
+        })
+        .unwrap_err();
+        assert!(e.to_string().contains("load_case.1.shape"), "{e}");
+        assert_eq!(solved, 0, "no step was solved");
+    }
+
+    #[test]
+    fn a_rebuilt_step_has_the_model_it_was_solved_on() {
+        for steps in [
+            "[sweep]\nparameter = \"obstacle_offset\"\nvalues = [0, -0.05]\n",
+            "[[load_case]]\nname = \"a\"\nload_factor = 2\n\
+             [[load_case]]\nname = \"b\"\nload = \"5 + y\"\nload_factor = 0.5\n",
+        ] {
+            let case = Case::from_toml_str(&format!("{BASE}{steps}"), None).unwrap();
+            let mut models = Vec::new();
+            run_sweep(&case, true, &mut Silent, &mut |_, o, _| {
+                models.push(o.discretization.model.clone());
+                Ok(())
+            })
+            .unwrap();
+            let (hierarchy, _) = case.problem.mesh.build().unwrap();
+            for (k, m) in models.iter().enumerate() {
+                let d = step_discretization(&case, k, hierarchy.clone(), &mut Silent).unwrap();
+                assert_eq!(d.model.d, m.d, "{steps} step {k}: D");
+                assert_eq!(d.model.phi, m.phi, "{steps} step {k}: φ");
+                assert_eq!(d.model.s.val, m.s.val, "{steps} step {k}: S");
+                assert_eq!(d.model.h_vertices, m.h_vertices, "{steps} step {k}: h");
+            }
+        }
+    }
+
+    #[test]
     fn warm_and_cold_sweeps_give_the_same_answers() {
         let case = Case::from_toml_str(
             &format!("{BASE}[sweep]\nparameter = \"load_factor\"\nvalues = [0.5, 1, 2, 4]\n"),
