@@ -11,9 +11,9 @@ use memcontact::solve::Silent;
 use memcontact::sweep::{run_sweep_on, steps, StepRow, StepSpec};
 use memcontact::{Case, Discretization, Error};
 use memcontact_plot::write::{check_on_mesh, SweepWriter};
-use pyo3::exceptions::PyIndexError;
+use pyo3::exceptions::{PyIndexError, PyValueError};
 use pyo3::prelude::*;
-use pyo3::types::PyList;
+use pyo3::types::{PyDict, PyList};
 use std::path::PathBuf;
 
 /// The solved steps of a sweep (or of load cases): one `Result` per step, the rows of
@@ -117,10 +117,21 @@ impl PySweep {
         PyList::new(py, self.results.iter().map(|r| r.clone_ref(py)))
     }
 
-    /// The rows of `sweep.csv` (dicts with its columns), one per step solved.
+    /// The rows of `sweep.csv` (dicts with its columns, in its order), one per step
+    /// solved.
     #[getter]
-    fn rows<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
-        to_py(py, &self.rows)
+    fn rows<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyList>> {
+        let list = PyList::empty(py);
+        for r in &self.rows {
+            let value = serde_json::to_value(r)
+                .map_err(|e| PyValueError::new_err(format!("cannot convert a row: {e}")))?;
+            let row = PyDict::new(py);
+            for column in StepRow::HEADER {
+                row.set_item(column, to_py(py, &value[column])?)?;
+            }
+            list.append(row)?;
+        }
+        Ok(list)
     }
 
     /// The columns of `sweep.csv`, in order.
