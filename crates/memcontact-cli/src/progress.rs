@@ -122,8 +122,17 @@ impl Observer for Progress {
     fn iteration(&mut self, r: &IterationRecord) {
         match self.verbosity {
             Verbosity::Verbose => eprintln!(
-                "  {}iteration {:>5}  J = {:+.12e}  KKT = {:.3e}",
-                self.prefix, r.iteration, r.energy, r.residual
+                "  {}iteration {:>5}  J = {:+.12e}  KKT = {:.3e} (2e {:.3e}, 2f {:.3e})  \
+                 clear {} touching {} penetrating {}",
+                self.prefix,
+                r.iteration,
+                r.energy,
+                r.residual,
+                r.residual_2e,
+                r.residual_2f,
+                r.states.clear,
+                r.states.touching,
+                r.states.penetrating
             ),
             _ => {
                 if let Some(b) = &self.bar {

@@ -700,41 +700,55 @@ stiffness = 300
 
     #[test]
     fn warm_and_cold_sweeps_give_the_same_answers() {
-        let case = Case::from_toml_str(
-            &format!("{BASE}[sweep]\nparameter = \"load_factor\"\nvalues = [0.5, 1, 2, 4]\n"),
-            None,
-        )
-        .unwrap();
-        let mut warm_u = Vec::new();
-        let warm = run_sweep(&case, true, &mut Silent, &mut |_, o, _| {
-            warm_u.push(o.report.u.clone());
-            Ok(())
-        })
-        .unwrap();
-        let mut k = 0;
-        let cold = run_sweep(&case, false, &mut Silent, &mut |s, o, _| {
-            // Each step equals the base case solved with the scaled load.
-            let scaled = Case::from_toml_str(
-                &BASE.replace("\"10 + x\"", &format!("\"{}*(10 + x)\"", s.value)),
+        // Multigrid (the 8 × 8 rectangle has a hierarchy) and the active-set method.
+        for method in ["auto", "active-set"] {
+            let case = Case::from_toml_str(
+                &format!(
+                    "{BASE}[solver]\nmethod = \"{method}\"\n[sweep]\n\
+                     parameter = \"load_factor\"\nvalues = [0.5, 1, 1.5, 2, 2.5]\n"
+                ),
                 None,
             )
             .unwrap();
-            let direct = crate::run(&scaled.problem, &scaled.settings, &mut Silent).unwrap();
-            for (a, b) in o.report.u.iter().zip(&direct.report.u) {
-                assert!((a - b).abs() <= 1e-9 * b.abs().max(1e-3));
-            }
-            for (a, b) in o.report.u.iter().zip(&warm_u[k]) {
-                assert!((a - b).abs() <= 1e-9 * b.abs().max(1e-3));
-            }
-            k += 1;
-            Ok(())
-        })
-        .unwrap();
-        assert_eq!(warm.len(), 4);
-        assert_eq!(cold.len(), 4);
-        // Load up, deflection up.
-        assert!(warm
-            .windows(2)
-            .all(|w| w[1].max_deflection > w[0].max_deflection));
+            let mut warm_u = Vec::new();
+            let warm = run_sweep(&case, true, &mut Silent, &mut |_, o, _| {
+                warm_u.push(o.report.u.clone());
+                Ok(())
+            })
+            .unwrap();
+            let mut k = 0;
+            let cold = run_sweep(&case, false, &mut Silent, &mut |s, o, _| {
+                // Each step equals the base case solved with the scaled load.
+                let scaled = Case::from_toml_str(
+                    &BASE.replace("\"10 + x\"", &format!("\"{}*(10 + x)\"", s.value)),
+                    None,
+                )
+                .unwrap();
+                let direct = crate::run(&scaled.problem, &scaled.settings, &mut Silent).unwrap();
+                for (a, b) in o.report.u.iter().zip(&direct.report.u) {
+                    assert!((a - b).abs() <= 1e-9 * b.abs().max(1e-3));
+                }
+                for (a, b) in o.report.u.iter().zip(&warm_u[k]) {
+                    assert!((a - b).abs() <= 1e-9 * b.abs().max(1e-3));
+                }
+                k += 1;
+                Ok(())
+            })
+            .unwrap();
+            assert_eq!(warm.len(), 5);
+            assert_eq!(cold.len(), 5);
+            // Load up, deflection up.
+            assert!(warm
+                .windows(2)
+                .all(|w| w[1].max_deflection > w[0].max_deflection));
+            // Warm starts save iterations.
+            let total = |rows: &[StepRow]| rows.iter().map(|r| r.iterations).sum::<usize>();
+            assert!(
+                total(&warm) < total(&cold),
+                "{method}: warm {} cold {}",
+                total(&warm),
+                total(&cold)
+            );
+        }
     }
 }
