@@ -139,11 +139,10 @@ fn sweep(
     };
     let written = writer.steps_written();
     writer.finish(&rows)?;
-    let what = match &case.sweep {
-        Some(s) => format!("sweep of {}", s.parameter.name().replace('_', " ")),
-        None => "load cases".to_string(),
-    };
-    println!("memcontact: {label} ({what}: {total} steps)");
+    println!(
+        "memcontact: {label} ({}: {total} steps)",
+        write::steps_kind(case)
+    );
     println!(
         "  {:>5} {:>16} {:>12} {:>12} {:>12} {:>12} {:>6} {:>10}",
         "step", "name", "value", "max |u|", "contact area", "force", "iters", "KKT"
@@ -214,6 +213,16 @@ pub fn check(case_path: &Path, sets: &[String]) -> Result<()> {
         d.model.foundation.name(),
         if d.model.is_rigid() { ", rigid" } else { "" }
     );
+    if case.is_sweep() {
+        let steps = memcontact::sweep::steps(&case)?;
+        let names: Vec<&str> = steps.iter().map(|s| s.name.as_str()).collect();
+        println!(
+            "  steps        {} ({}): {}",
+            steps.len(),
+            write::steps_kind(&case),
+            names.join(", ")
+        );
+    }
     let (method, choice) = d.auto_choice();
     println!(
         "  solver       {} (auto picks {}: {})",

@@ -19,6 +19,15 @@ use std::time::{Duration, Instant};
 /// The file name of the force-deflection picture of a sweep.
 pub const SWEEP_PICTURE: &str = "sweep.png";
 
+/// What the steps of `case` are, for titles and reports: `sweep of load factor`, or
+/// `load cases`.
+pub fn steps_kind(case: &Case) -> String {
+    match &case.sweep {
+        Some(s) => format!("sweep of {}", s.parameter.name().replace('_', " ")),
+        None => "load cases".into(),
+    }
+}
+
 /// The picture options of `case` (its `[output]` and `[units]` keys), titled `label`.
 pub fn plot_options(case: &Case, label: &str) -> PlotOptions {
     PlotOptions {
@@ -162,10 +171,7 @@ impl SweepWriter {
             label: label.to_string(),
             vtu,
             plots,
-            what: match &case.sweep {
-                Some(s) => format!("sweep of {}", s.parameter.name().replace('_', " ")),
-                None => "load cases".into(),
-            },
+            what: steps_kind(case),
         })
     }
 
