@@ -42,9 +42,9 @@ pub struct Progress {
 }
 
 /// The spinner: phase, iteration and certificate, no known end.
-const SPINNER: &str = "{spinner} {elapsed:>4} {prefix}{msg}";
+const SPINNER: &str = "{spinner} {elapsed:>4} {prefix}{wide_msg}";
 /// The bar, where the number of steps is known (sweep steps, refinement levels).
-const BAR: &str = "{spinner} {elapsed:>4} [{bar:24}] {pos}/{len} {prefix}{msg}";
+const BAR: &str = "{spinner} {elapsed:>4} [{bar:20}] {pos}/{len} {prefix}{wide_msg}";
 
 impl Progress {
     /// A progress display for `verbosity`.
