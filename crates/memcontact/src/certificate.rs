@@ -125,13 +125,27 @@ impl FloorWatch {
     }
 }
 
-/// A certificate with the energy at the same iterate.
+/// How many unknowns are in each vertex state at an iterate: clear (`U_i < φ_i`, or off
+/// M), touching (`U_i = φ_i` on M) and penetrating (`U_i > φ_i` on M).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+pub struct StateCounts {
+    /// `U_i < φ_i`, or the vertex cannot touch.
+    pub clear: usize,
+    /// `U_i = φ_i` on M.
+    pub touching: usize,
+    /// `U_i > φ_i` on M.
+    pub penetrating: usize,
+}
+
+/// A certificate with the energy and the state counts at the same iterate.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Evaluation {
     /// The residuals.
     pub certificate: Certificate,
     /// J(U); `+∞` for a rigid obstacle violated.
     pub energy: f64,
+    /// The vertex states.
+    pub states: StateCounts,
 }
 
 /// Per-block accumulators.
@@ -151,6 +165,9 @@ struct Acc {
     foundation: f64,
     /// Some vertex violates the rigid constraint.
     infeasible: bool,
+    /// Touching and penetrating unknowns.
+    touching: usize,
+    penetrating: usize,
 }
 
 impl Acc {
@@ -162,6 +179,8 @@ impl Acc {
         self.quad += o.quad;
         self.foundation += o.foundation;
         self.infeasible |= o.infeasible;
+        self.touching += o.touching;
+        self.penetrating += o.penetrating;
         self
     }
 }
@@ -230,6 +249,11 @@ fn evaluate_with(
                 acc.scale = acc.scale.max(lp.abs());
                 let p = (vi - fi).max(0.0);
                 acc.foundation += p * lp;
+                if vi == fi {
+                    acc.touching += 1;
+                } else if vi > fi {
+                    acc.penetrating += 1;
+                }
                 // Left and right derivatives of J along coordinate i.
                 let (left, right) = if vi < fi {
                     (r, r)
@@ -311,6 +335,11 @@ fn evaluate_with(
             rounding_floor: finite(FLOOR_ULPS * f64::EPSILON * tot.size / scale),
         },
         energy,
+        states: StateCounts {
+            clear: n - tot.touching - tot.penetrating,
+            touching: tot.touching,
+            penetrating: tot.penetrating,
+        },
     }
 }
 

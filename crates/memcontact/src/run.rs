@@ -120,9 +120,7 @@ impl Discretization {
     ) -> Result<Discretization> {
         observer.phase_started("assembly");
         let t0 = Instant::now();
-        let mesh = hierarchy.finest();
-        let bound = BoundData::new(problem, mesh)?;
-        let model = crate::checks::assemble(mesh, &bound.data(problem))?;
+        let model = assemble_model(problem, hierarchy.finest())?;
         let seconds = t0.elapsed().as_secs_f64();
         observer.phase_finished("assembly", seconds);
         Ok(Discretization {
@@ -208,6 +206,22 @@ impl Discretization {
             multipliers: s.multipliers,
         })
     }
+}
+
+/// Binds the problem's data to `mesh`, checks it (on the boundary, and for overflow:
+/// [`crate::checks::assemble`]) and assembles the model S, L, D, φₙ, M of the paper's §2.
+/// `problem.mesh` is not used.
+pub fn assemble_model(problem: &Problem, mesh: &Mesh) -> Result<Model> {
+    let bound = BoundData::new(problem, mesh)?;
+    crate::checks::assemble(mesh, &bound.data(problem))
+}
+
+/// Binds the problem's data to `mesh` and checks it where assembly does not sample it (on
+/// the boundary): the checks of [`assemble_model`] that need no assembly.
+pub fn bind_and_check(problem: &Problem, mesh: &Mesh) -> Result<BoundData> {
+    let bound = BoundData::new(problem, mesh)?;
+    crate::checks::check_boundary_data(mesh, &bound.data(problem))?;
+    Ok(bound)
 }
 
 /// How a solve went, with its iterate: the status, the method used and why, iterations,

@@ -18,13 +18,13 @@
 //! so the iteration converges from any start, and once the states are right the Newton
 //! step lands on U exactly (finite termination in exact arithmetic).
 
-use super::line_search::{apply_step, exact_step, Line};
+use super::line_search::{apply_step, exact_step, line_data};
 use super::local::sweep_forward;
+use super::newton::{newton_system, unit_diagonal_on_truncated, NewtonStates};
 use super::{IterationRecord, Method, Observer, PhaseTimer, Settings, Solution};
-use crate::model::{FoundationMatrix, Model};
-use crate::sparse::{dot, Cholesky, Csr};
+use crate::model::Model;
+use crate::sparse::{Cholesky, Csr};
 use crate::{Error, Result};
-use rayon::prelude::*;
 
 /// Default iteration limit.
 pub(crate) const MAX_ITERATIONS: usize = 500;
@@ -51,136 +51,33 @@ pub fn start_from(model: &Model, start: Option<&[f64]>) -> Vec<f64> {
     v
 }
 
-/// The states of the truncated Newton step at V: which vertices are held (touching, or at
-/// the rigid obstacle) and which penetrate.
-#[derive(Debug, Clone)]
-pub struct NewtonStates {
-    /// Held fixed on φ_i: `V_i = φ_i` on M.
-    pub truncated: Vec<bool>,
-    /// `V_i > φ_i` on M (elastic obstacle only).
-    pub penetrating: Vec<bool>,
-}
-
-impl NewtonStates {
-    /// The states of V.
-    pub fn of(model: &Model, v: &[f64]) -> NewtonStates {
-        let n = model.n();
-        let mut truncated = vec![false; n];
-        let mut penetrating = vec![false; n];
-        for i in 0..n {
-            if model.can_touch[i] {
-                truncated[i] = v[i] == model.phi[i];
-                penetrating[i] = !model.is_rigid() && v[i] > model.phi[i];
-            }
-        }
-        NewtonStates {
-            truncated,
-            penetrating,
-        }
-    }
-}
-
-/// The gradient of the smooth piece of J selected by the states: `S V − D + E_P L p`, zero
-/// on truncated vertices. Also returns `SV − D`.
-pub fn piece_gradient(model: &Model, v: &[f64], st: &NewtonStates) -> (Vec<f64>, Vec<f64>) {
-    let r = model.residual(v);
-    let p = model.penetration(v);
-    let mut g: Vec<f64> = vec![0.0; model.n()];
-    g.par_iter_mut()
-        .enumerate()
-        .with_min_len(4096)
-        .for_each(|(i, gi)| {
-            if st.truncated[i] {
-                return;
-            }
-            *gi = r[i];
-            if st.penetrating[i] {
-                *gi += model.l.row_dot(i, &p);
-            }
-        });
-    (g, r)
-}
-
-/// Fills `a` (on the pattern of S) with the truncated Hessian of the piece: `S + E_P L E_P`
-/// with the rows and columns of truncated vertices replaced by the identity.
-pub fn fill_truncated_hessian(model: &Model, st: &NewtonStates, a: &mut Csr) {
-    let pat = model.s.pattern.clone();
-    let rows: Vec<(usize, usize)> = (0..pat.n())
-        .map(|i| (pat.row_ptr[i], pat.row_ptr[i + 1]))
-        .collect();
-    let sval = &model.s.val;
-    let lumped = match &model.l {
-        FoundationMatrix::Lumped(d) => Some(d),
-        _ => None,
-    };
-    let consistent = match &model.l {
-        FoundationMatrix::Consistent(l) => Some(&l.val),
-        _ => None,
-    };
-    // Each row is written independently.
-    let mut chunks: Vec<&mut [f64]> = Vec::with_capacity(rows.len());
-    let mut rest: &mut [f64] = &mut a.val;
-    for &(s, e) in &rows {
-        let (h, t) = rest.split_at_mut(e - s);
-        chunks.push(h);
-        rest = t;
-    }
-    chunks
-        .par_iter_mut()
-        .enumerate()
-        .with_min_len(2048)
-        .for_each(|(i, row)| {
-            let (s, e) = rows[i];
-            let cols = &pat.col[s..e];
-            for (k, &j) in cols.iter().enumerate() {
-                let j = j as usize;
-                row[k] = if st.truncated[i] || st.truncated[j] {
-                    if i == j {
-                        1.0
-                    } else {
-                        0.0
-                    }
-                } else {
-                    let mut v = sval[s + k];
-                    if st.penetrating[i] && st.penetrating[j] {
-                        if let Some(l) = consistent {
-                            v += l[s + k];
-                        } else if let Some(d) = lumped {
-                            if i == j {
-                                v += d[i];
-                            }
-                        }
-                    }
-                    v
-                };
-            }
-        });
-}
-
-/// One globalised step from `v` along `dir` (exact line search); returns the step length
-/// (0 when `dir` is not a descent direction).
+/// One globalised step from `v` along `dir` (the exact line search on J); returns the step
+/// length (0 when `dir` is not a descent direction). `r = SV − D` at `v`.
 pub fn line_step(model: &Model, v: &mut [f64], dir: &[f64], r: &[f64]) -> f64 {
-    let sd = model.s.mul(dir);
-    let line = Line {
-        v,
-        dir,
-        g0: dot(dir, r),
-        s2: dot(dir, &sd),
-    };
-    match exact_step(model, &line) {
-        Some(alpha) if alpha > 0.0 => {
+    let (g0, s2) = line_data(model, dir, r);
+    match exact_step(model, v, dir, g0, s2) {
+        Some(alpha) => {
             apply_step(model, v, dir, alpha);
             alpha
         }
-        _ => 0.0,
+        None => 0.0,
     }
 }
 
-/// Solves Problem 2f by the globalised semismooth Newton method described above.
-pub fn solve(model: &Model, settings: &Settings, observer: &mut dyn Observer) -> Result<Solution> {
+/// Solves Problem 2f by the globalised semismooth Newton method described above, from
+/// `start` (a warm start) or from zero.
+pub fn solve(
+    model: &Model,
+    settings: &Settings,
+    start: Option<&[f64]>,
+    observer: &mut dyn Observer,
+) -> Result<Solution> {
     let mut timer = PhaseTimer::default();
     let max = settings.max_iterations.unwrap_or(MAX_ITERATIONS);
-    let mut v = feasible_start(model);
+    let mut v = start_from(model, start);
+    let n = model.n();
+    let (mut rhs, mut r) = (vec![0.0; n], vec![0.0; n]);
+    let mut st = NewtonStates::of(model, &v);
     let mut a = Csr::zeros(model.s.pattern.clone());
     let mut chol: Option<Cholesky> = None;
     let mut history = Vec::new();
@@ -195,10 +92,10 @@ pub fn solve(model: &Model, settings: &Settings, observer: &mut dyn Observer) ->
         iterations += 1;
         let before = v.clone();
         timer.time("smoothing", || sweep_forward(model, &mut v));
-        let st = NewtonStates::of(model, &v);
-        let (mut rhs, r) = timer.time("newton system", || {
-            fill_truncated_hessian(model, &st, &mut a);
-            piece_gradient(model, &v, &st)
+        timer.time("newton system", || {
+            st.update(model, &v);
+            newton_system(model, &v, &st, &mut a, None, &mut rhs, &mut r);
+            unit_diagonal_on_truncated(&mut a, &st);
         });
         timer.time("factorisation", || -> Result<()> {
             match &mut chol {
@@ -236,12 +133,9 @@ pub fn solve(model: &Model, settings: &Settings, observer: &mut dyn Observer) ->
                 }
             }
         });
-        certificate = timer.time("certificate", || model.certificate(&v));
-        let record = IterationRecord {
-            iteration: iterations,
-            energy: model.energy(&v),
-            residual: certificate.kkt(),
-        };
+        let ev = timer.time("certificate", || crate::certificate::evaluate(model, &v));
+        certificate = ev.certificate;
+        let record = IterationRecord::new(iterations, &ev);
         observer.iteration(&record);
         history.push(record);
         if v == before {

@@ -39,12 +39,9 @@ pub fn solve_from(
             }
         });
         sweeps += todo;
-        certificate = timer.time("certificate", || model.certificate(&v));
-        let record = IterationRecord {
-            iteration: sweeps,
-            energy: model.energy(&v),
-            residual: certificate.kkt(),
-        };
+        let ev = timer.time("certificate", || crate::certificate::evaluate(model, &v));
+        certificate = ev.certificate;
+        let record = IterationRecord::new(sweeps, &ev);
         observer.iteration(&record);
         history.push(record);
         if certificate.settled(settings.tolerance) || watch.stuck(&certificate) {

@@ -18,6 +18,7 @@ pub mod line_search;
 pub mod linear;
 pub mod local;
 pub mod multigrid;
+pub mod newton;
 pub mod qp;
 
 use crate::mesh::refine::Hierarchy;
@@ -149,6 +150,29 @@ pub struct IterationRecord {
     pub energy: f64,
     /// The scaled KKT residual after the iteration (NaN when not computed).
     pub residual: f64,
+    /// The scaled residual of 2e after the iteration.
+    #[serde(default)]
+    pub residual_2e: f64,
+    /// The scaled residual of 2f after the iteration.
+    #[serde(default)]
+    pub residual_2f: f64,
+    /// The vertex states after the iteration.
+    #[serde(default, flatten)]
+    pub states: crate::certificate::StateCounts,
+}
+
+impl IterationRecord {
+    /// The record of iteration `iteration` from the evaluation of its iterate.
+    pub fn new(iteration: usize, ev: &crate::certificate::Evaluation) -> IterationRecord {
+        IterationRecord {
+            iteration,
+            energy: ev.energy,
+            residual: ev.certificate.kkt(),
+            residual_2e: ev.certificate.residual_2e,
+            residual_2f: ev.certificate.residual_2f,
+            states: ev.states,
+        }
+    }
 }
 
 /// Receives progress from a run (the CLI draws it; the library never prints).
@@ -366,7 +390,7 @@ fn run_method(
 ) -> Result<(Solution, Status, Option<String>)> {
     let result = match method {
         Method::Linear => linear::solve(model, settings),
-        Method::ActiveSet => active_set::solve(model, settings, observer),
+        Method::ActiveSet => active_set::solve(model, settings, start, observer),
         Method::Qp => qp::solve(model, settings),
         Method::Coordinate => coordinate::solve_from(model, settings, start, observer),
         Method::Multigrid => {
@@ -377,7 +401,7 @@ fn run_method(
                           choose method = \"active-set\""
                     .into(),
             })?;
-            multigrid::solve(model, h, settings, observer)
+            multigrid::solve(model, h, settings, start, observer)
         }
         Method::Auto => unreachable!("resolved by the caller"),
     };
@@ -489,8 +513,9 @@ pub fn attempt(
     attempt_from(model, hierarchy, settings, None, observer)
 }
 
-/// [`attempt`] from a given iterate (a warm start; methods without one ignore it). A start
-/// of the wrong length is an error.
+/// [`attempt`] from a given iterate (a warm start: the active-set, multigrid and
+/// coordinate methods begin there; `linear` and `qp`, which need no start, ignore it). A
+/// start of the wrong length is an error.
 pub fn attempt_from(
     model: &Model,
     hierarchy: Option<&Hierarchy>,

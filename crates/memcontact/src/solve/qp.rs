@@ -63,7 +63,7 @@
 //! 1e-7…3e-4 relative to max |X| (h = 1e6 worst), because `V₂ ≥ 0` is degenerate at clear
 //! vertices (`V₂ = X₂ = 0`) and the interior point leaves both at `O(√μ)` there.
 
-use super::active_set::{fill_truncated_hessian, NewtonStates};
+use super::newton::{truncated_hessian, NewtonStates};
 use super::{Method, Multipliers, PhaseTimer, Settings, Solution};
 use crate::model::{Certificate, FoundationMatrix, Model};
 use crate::sparse::{Cholesky, Csr};
@@ -436,7 +436,7 @@ fn solve_piece(
     a: &mut Csr,
     chol: &mut Option<Cholesky>,
 ) -> Result<Vec<f64>> {
-    fill_truncated_hessian(model, st, a);
+    truncated_hessian(model, st, a);
     let factor = match chol {
         Some(c) => {
             c.refactor(a)?;
@@ -605,7 +605,7 @@ mod tests {
         let rep = solve_with_report(model, &settings()).unwrap();
         let s = &rep.solution;
         let reference =
-            active_set::solve(model, &settings(), &mut Silent).expect("active set converges");
+            active_set::solve(model, &settings(), None, &mut Silent).expect("active set converges");
         let diff = rel_diff(&s.u, &reference.u);
         eprintln!(
             "{name}: m = {}, |M| = {}, status {:?}, {} IPM iterations, raw certificate \
@@ -721,7 +721,7 @@ mod tests {
                 penetrating: vec![false; n],
             };
             let p = polish(&model, clear, 1e-11).expect("the piece solves succeed");
-            let reference = active_set::solve(&model, &settings(), &mut Silent).unwrap();
+            let reference = active_set::solve(&model, &settings(), None, &mut Silent).unwrap();
             eprintln!(
                 "wrong guess: {} rounds, certificate {:.2e}, |U − U_as|/|U| {:.2e}",
                 p.rounds,
@@ -791,7 +791,7 @@ mod tests {
         ];
         for (name, model) in &cases {
             let t0 = std::time::Instant::now();
-            let reference = active_set::solve(model, &settings(), &mut Silent).unwrap();
+            let reference = active_set::solve(model, &settings(), None, &mut Silent).unwrap();
             let t_as = t0.elapsed().as_secs_f64();
             let rep = solve_with_report(model, &settings()).unwrap();
             let s = &rep.solution;

@@ -14,8 +14,7 @@
 //!    solved *approximately* by one linear multigrid V-cycle ([`cycle`]) on the truncated
 //!    hierarchy: Galerkin coarse operators `PᵀAP` of the truncated matrix, recomputed every
 //!    iteration in the rows whose states changed;
-//! 3. an **exact line search** on J along δ ([`line`], the search of
-//!    [`super::line_search`] with one pass per Newton step), which keeps J
+//! 3. an **exact line search** on J along δ ([`super::line_search`]), which keeps J
 //!    monotone and snaps vertices onto φ where the minimiser is a kink (for the rigid
 //!    obstacle, δ is first projected so that `V + δ ≤ φ`);
 //! 4. the certificates of 2e and 2f; stop at `settings.tolerance`.
@@ -28,26 +27,23 @@
 //! coarse vertices), and each solution prolongated as the start of the next level.
 
 pub mod cycle;
-pub mod line;
 pub mod transfer;
 
 #[cfg(test)]
-mod tests;
+pub(crate) mod tests;
 
 pub use cycle::{linear_solve, poisson_solve, Levels, LinearSolve, Multigrid};
 pub use transfer::Transfer;
 
-use super::active_set::{feasible_start, NewtonStates};
-#[cfg(doc)]
-use super::active_set::{fill_truncated_hessian, piece_gradient};
-use super::line_search::apply_step;
+use super::active_set::start_from;
+use super::line_search::{apply_step, exact_step, line_data};
 use super::local::sweep_forward;
+use super::newton::{mark_dirty, newton_system, NewtonStates};
 use super::{IterationRecord, Method, Observer, PhaseTimer, Settings, Solution};
 use crate::mesh::refine::Hierarchy;
 use crate::model::{Certificate, FoundationMatrix, Model};
-use crate::sparse::{Csr, Pattern};
+use crate::sparse::Csr;
 use crate::Result;
-use rayon::prelude::*;
 use std::time::Instant;
 
 /// Default iteration limit on each level.
@@ -106,14 +102,25 @@ pub struct Report {
 }
 
 /// Solves Problem 2b by TNNMG with the default [`Options`]. `hierarchy` must end with the
-/// mesh the model was assembled on; anything else is an error.
+/// mesh the model was assembled on; anything else is an error. With a `start` (a warm
+/// start, e.g. the answer of a neighbouring load step) the iteration begins there on the
+/// finest level, without nested iteration.
 pub fn solve(
     model: &Model,
     hierarchy: &Hierarchy,
     settings: &Settings,
+    start: Option<&[f64]>,
     observer: &mut dyn Observer,
 ) -> Result<Solution> {
-    solve_with(model, hierarchy, settings, &Options::default(), observer).map(|r| r.0)
+    solve_with(
+        model,
+        hierarchy,
+        settings,
+        &Options::default(),
+        start,
+        observer,
+    )
+    .map(|r| r.0)
 }
 
 /// [`solve`] with explicit options, also returning the per-level report.
@@ -122,6 +129,7 @@ pub fn solve_with(
     hierarchy: &Hierarchy,
     settings: &Settings,
     options: &Options,
+    start: Option<&[f64]>,
     observer: &mut dyn Observer,
 ) -> Result<(Solution, Report)> {
     let mut timer = PhaseTimer::default();
@@ -134,7 +142,11 @@ pub fn solve_with(
     let mut history = Vec::new();
 
     // Nested iteration: the Galerkin models of the coarser levels, coarsest first.
-    let first = if options.nested { 0 } else { top };
+    let first = if options.nested && start.is_none() {
+        0
+    } else {
+        top
+    };
     let mut models: Vec<Model> = Vec::new();
     if first < top {
         timer.time("setup", || {
@@ -149,7 +161,11 @@ pub fn solve_with(
         });
     }
     let mut final_certificate = None;
-    let mut v = feasible_start(if first < top { &models[0] } else { model });
+    let mut v = if first < top {
+        start_from(&models[0], None)
+    } else {
+        start_from(model, start)
+    };
     for k in first..=top {
         let m = models.get(k).unwrap_or(model);
         if k > first {
@@ -321,11 +337,7 @@ fn level_solve(ls: LevelSolve) -> Result<(usize, f64, Option<Certificate>)> {
         let ev = timer.time("certificate", || crate::certificate::evaluate(model, v));
         kkt = ev.certificate.kkt();
         if iterations > 0 {
-            let record = IterationRecord {
-                iteration: iterations,
-                energy: ev.energy,
-                residual: kkt,
-            };
+            let record = IterationRecord::new(iterations, &ev);
             observer.iteration(&record);
             if let Some(h) = history.as_deref_mut() {
                 h.push(record);
@@ -376,8 +388,8 @@ fn level_solve(ls: LevelSolve) -> Result<(usize, f64, Option<Certificate>)> {
             }
         });
         timer.time("line search", || {
-            let (g0, s2) = line::line_data(model, &delta, &r);
-            if let Some(alpha) = line::exact_step(model, v, &delta, g0, s2) {
+            let (g0, s2) = line_data(model, &delta, &r);
+            if let Some(alpha) = exact_step(model, v, &delta, g0, s2) {
                 apply_step(model, v, &delta, alpha);
             }
         });
@@ -389,121 +401,6 @@ fn level_solve(ls: LevelSolve) -> Result<(usize, f64, Option<Certificate>)> {
         }
     }
     Ok((iterations, kkt, certificate))
-}
-
-/// The truncated Newton system of TNNMG at V for the states `st`: the Hessian of the
-/// smooth piece, `S + E_P L E_P`, with the rows and columns of the truncated vertices
-/// *zero* (they are decoupled, and the multigrid leaves zero rows alone), and the gradient
-/// of the piece `g = SV − D + E_P L p`, zero on truncated vertices; also `r = SV − D`.
-///
-/// This is the system of [`fill_truncated_hessian`] and [`piece_gradient`] (a test checks
-/// that they agree), in one pass without allocation, refilling only the matrix rows
-/// flagged in `rows` (those whose states or whose neighbours' states changed).
-fn newton_system(
-    model: &Model,
-    v: &[f64],
-    st: &NewtonStates,
-    a: &mut Csr,
-    rows: Option<&[bool]>,
-    g: &mut [f64],
-    r: &mut [f64],
-) {
-    const CHUNK: usize = 1024;
-    let pat = model.s.pattern.clone();
-    let sval = &model.s.val;
-    let pen = |j: usize| {
-        if model.can_touch[j] {
-            (v[j] - model.phi[j]).max(0.0)
-        } else {
-            0.0
-        }
-    };
-    let row = |i: usize, arow: &mut [f64], gi: &mut f64, ri: &mut f64| {
-        let (s, e) = (pat.row_ptr[i], pat.row_ptr[i + 1]);
-        let cols = &pat.col[s..e];
-        let mut sv = 0.0;
-        for (&j, &sij) in cols.iter().zip(&sval[s..e]) {
-            sv += sij * v[j as usize];
-        }
-        *ri = sv - model.d[i];
-        *gi = if st.truncated[i] {
-            0.0
-        } else if st.penetrating[i] {
-            *ri + match &model.l {
-                FoundationMatrix::Consistent(l) => {
-                    let mut lp = 0.0;
-                    for (&j, &lij) in cols.iter().zip(&l.val[s..e]) {
-                        lp += lij * pen(j as usize);
-                    }
-                    lp
-                }
-                FoundationMatrix::Lumped(d) => d[i] * pen(i),
-                FoundationMatrix::Rigid => 0.0,
-            }
-        } else {
-            *ri
-        };
-        if !rows.is_none_or(|d| d[i]) {
-            return;
-        }
-        for (k, &j) in cols.iter().enumerate() {
-            let j = j as usize;
-            arow[k] = if st.truncated[i] || st.truncated[j] {
-                0.0
-            } else if st.penetrating[i] && st.penetrating[j] {
-                match &model.l {
-                    FoundationMatrix::Consistent(l) => sval[s + k] + l.val[s + k],
-                    FoundationMatrix::Lumped(d) if i == j => sval[s + k] + d[i],
-                    _ => sval[s + k],
-                }
-            } else {
-                sval[s + k]
-            };
-        }
-    };
-    let blocks = transfer::row_chunks(&pat, &mut a.val, CHUNK);
-    type Block<'a> = ((usize, &'a mut [f64]), (&'a mut [f64], &'a mut [f64]));
-    let work = |((start, vals), (gc, rc)): Block| {
-        let mut off = 0;
-        for (k, (gi, ri)) in gc.iter_mut().zip(rc.iter_mut()).enumerate() {
-            let i = start + k;
-            let len = pat.row_ptr[i + 1] - pat.row_ptr[i];
-            row(i, &mut vals[off..off + len], gi, ri);
-            off += len;
-        }
-    };
-    if v.len() >= transfer::PAR_ROWS {
-        blocks
-            .into_par_iter()
-            .zip(g.par_chunks_mut(CHUNK).zip(r.par_chunks_mut(CHUNK)))
-            .for_each(work);
-    } else {
-        blocks
-            .into_iter()
-            .zip(g.chunks_mut(CHUNK).zip(r.chunks_mut(CHUNK)))
-            .for_each(work);
-    }
-}
-
-/// Flags the rows of the truncated Hessian that differ between two state sets: a row
-/// changes when its vertex or a neighbour changed state. Returns the number of dirty rows.
-fn mark_dirty(
-    pattern: &Pattern,
-    old: &NewtonStates,
-    new: &NewtonStates,
-    changed: &mut [bool],
-    dirty: &mut [bool],
-) -> usize {
-    transfer::par_rows(changed, |i, c| {
-        *c = old.truncated[i] != new.truncated[i] || old.penetrating[i] != new.penetrating[i];
-    });
-    let changed: &[bool] = changed;
-    transfer::par_rows(dirty, |i, d| {
-        *d = pattern.col[pattern.row_ptr[i]..pattern.row_ptr[i + 1]]
-            .iter()
-            .any(|&j| changed[j as usize]);
-    });
-    dirty.iter().filter(|&&d| d).count()
 }
 
 /// Wall-clock and CPU (all threads) milliseconds per call of the kernels of one TNNMG
@@ -573,10 +470,10 @@ pub fn kernel_timings(
         }
     }
     let mut gs = (0.0, 0.0);
-    time("line data", &mut || gs = line::line_data(model, &delta, &r));
+    time("line data", &mut || gs = line_data(model, &delta, &r));
     let mut alpha = None;
     time("exact step", &mut || {
-        alpha = line::exact_step(model, &v, &delta, gs.0, gs.1)
+        alpha = exact_step(model, &v, &delta, gs.0, gs.1)
     });
     let mut w = v.clone();
     time("apply step", &mut || {

@@ -167,7 +167,7 @@ fn poisson_v_cycles_converge_independently_of_the_mesh() {
 fn agree(h: Option<f64>, foundation: Foundation) {
     let hier = square_hierarchy(4, 4); // 32 × 32
     let model = bench_model(hier.finest(), h, foundation);
-    let reference = active_set::solve(&model, &settings(1e-11), &mut Silent).unwrap();
+    let reference = active_set::solve(&model, &settings(1e-11), None, &mut Silent).unwrap();
     let mg = crate::solve::solve(&model, Some(&hier), &settings(1e-11), &mut Silent).unwrap();
     assert_eq!(mg.method, Method::Multigrid);
     let d = rel_diff(&mg.u, &reference.u);
@@ -214,7 +214,8 @@ fn tnnmg_without_nested_iteration_converges_from_zero() {
             nested: false,
             ..Options::default()
         };
-        let (sol, rep) = solve_with(&model, &hier, &settings(1e-10), &opts, &mut Silent).unwrap();
+        let (sol, rep) =
+            solve_with(&model, &hier, &settings(1e-10), &opts, None, &mut Silent).unwrap();
         assert!(sol.certificate.kkt() <= 1e-10, "{f:?} {h:?}");
         assert_eq!(rep.levels.len(), 1);
         assert!(sol.iterations < 40, "{f:?} {h:?}: {}", sol.iterations);
@@ -236,7 +237,7 @@ fn iteration_counts_do_not_grow_under_refinement() {
             // 16 × 16 ... 128 × 128 from a 2 × 2 coarse grid.
             let hier = square_hierarchy(2, levels);
             let model = bench_model(hier.finest(), h, f);
-            let sol = solve(&model, &hier, &settings(1e-10), &mut Silent).unwrap();
+            let sol = solve(&model, &hier, &settings(1e-10), None, &mut Silent).unwrap();
             counts.push(sol.iterations);
         }
         // The certificate is relative to the forces of the iterate (O(h²) per vertex), so
@@ -252,73 +253,29 @@ fn a_hierarchy_of_another_mesh_is_an_error() {
     let hier = square_hierarchy(4, 3);
     let other = square_hierarchy(3, 3);
     let model = bench_model(hier.finest(), Some(1000.0), Foundation::Lumped);
-    let e = solve(&model, &other, &settings(1e-10), &mut Silent).unwrap_err();
+    let e = solve(&model, &other, &settings(1e-10), None, &mut Silent).unwrap_err();
     assert!(e.to_string().contains("finest level"), "{e}");
     // A hierarchy with a broken refinement relation.
     let mut broken = hier.clone();
     broken.refinements[1].parents.pop();
-    let e = solve(&model, &broken, &settings(1e-10), &mut Silent).unwrap_err();
+    let e = solve(&model, &broken, &settings(1e-10), None, &mut Silent).unwrap_err();
     assert!(e.to_string().contains("refinement"), "{e}");
     let mut broken = hier.clone();
     broken.refinements[0].parents[3] = [10_000, 0];
-    let e = solve(&model, &broken, &settings(1e-10), &mut Silent).unwrap_err();
+    let e = solve(&model, &broken, &settings(1e-10), None, &mut Silent).unwrap_err();
     assert!(e.to_string().contains("parent"), "{e}");
     let mut broken = hier;
     broken.refinements.pop();
-    assert!(solve(&model, &broken, &settings(1e-10), &mut Silent).is_err());
+    assert!(solve(&model, &broken, &settings(1e-10), None, &mut Silent).is_err());
 }
 
 #[test]
 fn one_level_is_a_direct_truncated_newton() {
     let hier = square_hierarchy(16, 1);
     let model = bench_model(hier.finest(), Some(1000.0), Foundation::Consistent);
-    let sol = solve(&model, &hier, &settings(1e-11), &mut Silent).unwrap();
-    let reference = active_set::solve(&model, &settings(1e-11), &mut Silent).unwrap();
+    let sol = solve(&model, &hier, &settings(1e-11), None, &mut Silent).unwrap();
+    let reference = active_set::solve(&model, &settings(1e-11), None, &mut Silent).unwrap();
     assert!(rel_diff(&sol.u, &reference.u) < 1e-8);
-}
-
-#[test]
-fn fused_newton_system_is_the_active_set_system() {
-    use crate::solve::active_set::{fill_truncated_hessian, piece_gradient};
-    let hier = square_hierarchy(4, 3);
-    for (h, f) in [
-        (Some(1000.0), Foundation::Consistent),
-        (Some(1000.0), Foundation::Lumped),
-        (None, Foundation::Lumped),
-    ] {
-        let model = bench_model(hier.finest(), h, f);
-        // An iterate with clear, touching and penetrating vertices.
-        let mut v: Vec<f64> = (0..model.n())
-            .map(|i| model.phi[i] + 0.05 * ((i as f64) * 0.7).sin())
-            .collect();
-        for i in (0..model.n()).step_by(5) {
-            v[i] = model.phi[i];
-        }
-        if h.is_none() {
-            for (x, p) in v.iter_mut().zip(&model.phi) {
-                *x = x.min(*p);
-            }
-        }
-        let st = NewtonStates::of(&model, &v);
-        let mut reference = Csr::zeros(model.s.pattern.clone());
-        fill_truncated_hessian(&model, &st, &mut reference);
-        let (g_ref, r_ref) = piece_gradient(&model, &v, &st);
-        let mut a = Csr::zeros(model.s.pattern.clone());
-        let (mut g, mut r) = (vec![0.0; model.n()], vec![0.0; model.n()]);
-        newton_system(&model, &v, &st, &mut a, None, &mut g, &mut r);
-        for i in 0..model.n() {
-            assert!((g[i] - g_ref[i]).abs() < 1e-14 && (r[i] - r_ref[i]).abs() < 1e-14);
-            for j in 0..model.n() {
-                // The same matrix, except that truncated rows are zero instead of identity.
-                let expect = if st.truncated[i] {
-                    0.0
-                } else {
-                    reference.get(i, j)
-                };
-                assert_eq!(a.get(i, j), expect, "{f:?} ({i}, {j})");
-            }
-        }
-    }
 }
 
 #[test]

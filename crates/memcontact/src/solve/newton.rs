@@ -1,0 +1,281 @@
+//! The truncated Newton system of the smooth piece of J (Problems 2b/2f), the one home of
+//! that formula for every solver: the active-set method factorises it, TNNMG solves it by a
+//! multigrid cycle, the QP polish solves it with its own right-hand side.
+//!
+//! At an iterate V, the vertex states select a piece of J on which it is quadratic:
+//! *truncated* vertices (`V_i = φ_i` on M: touching, or at the rigid obstacle) are held,
+//! *penetrating* ones (`V_i > φ_i`, elastic obstacle) carry the foundation term. The
+//! Hessian of the piece is `S + E_P L E_P` on the free vertices, its gradient
+//! `g = SV − D + E_P L p` (`p = (V − φ)⁺`), zero on truncated vertices.
+
+use super::multigrid::transfer::{par_rows, row_chunks, PAR_ROWS};
+use crate::model::{FoundationMatrix, Model};
+use crate::sparse::{Csr, Pattern};
+use rayon::prelude::*;
+
+/// The states of the truncated Newton step at V: which vertices are held (touching, or at
+/// the rigid obstacle) and which penetrate.
+#[derive(Debug, Clone)]
+pub struct NewtonStates {
+    /// Held fixed on φ_i: `V_i = φ_i` on M.
+    pub truncated: Vec<bool>,
+    /// `V_i > φ_i` on M (elastic obstacle only).
+    pub penetrating: Vec<bool>,
+}
+
+impl NewtonStates {
+    /// The states of V.
+    pub fn of(model: &Model, v: &[f64]) -> NewtonStates {
+        let n = model.n();
+        let mut st = NewtonStates {
+            truncated: vec![false; n],
+            penetrating: vec![false; n],
+        };
+        st.update(model, v);
+        st
+    }
+
+    /// Recomputes the states of V in place (no allocation).
+    pub fn update(&mut self, model: &Model, v: &[f64]) {
+        let rigid = model.is_rigid();
+        let fill = |i: usize| -> (bool, bool) {
+            if model.can_touch[i] {
+                (v[i] == model.phi[i], !rigid && v[i] > model.phi[i])
+            } else {
+                (false, false)
+            }
+        };
+        par_rows(&mut self.truncated, |i, t| *t = fill(i).0);
+        par_rows(&mut self.penetrating, |i, p| *p = fill(i).1);
+    }
+}
+
+/// Rows per block of the parallel fill.
+const CHUNK: usize = 1024;
+
+/// The truncated Newton system at V for the states `st`: the Hessian of the piece,
+/// `S + E_P L E_P`, into `a` (on the pattern of S) with the rows and columns of the
+/// truncated vertices *zero* (they are decoupled; multigrid leaves zero rows alone, and
+/// [`unit_diagonal_on_truncated`] makes the matrix definite for a factorisation), the
+/// gradient of the piece `g = SV − D + E_P L p`, zero on truncated vertices, and
+/// `r = SV − D`. One pass without allocation; only the matrix rows flagged in `rows` are
+/// refilled when given (those whose states or whose neighbours' states changed, see
+/// [`mark_dirty`]); `g` and `r` are always complete.
+pub fn newton_system(
+    model: &Model,
+    v: &[f64],
+    st: &NewtonStates,
+    a: &mut Csr,
+    rows: Option<&[bool]>,
+    g: &mut [f64],
+    r: &mut [f64],
+) {
+    let pat = model.s.pattern.clone();
+    let sval = &model.s.val;
+    let pen = |j: usize| {
+        if model.can_touch[j] {
+            (v[j] - model.phi[j]).max(0.0)
+        } else {
+            0.0
+        }
+    };
+    let row = |i: usize, arow: &mut [f64], gi: &mut f64, ri: &mut f64| {
+        let (s, e) = (pat.row_ptr[i], pat.row_ptr[i + 1]);
+        let cols = &pat.col[s..e];
+        let mut sv = 0.0;
+        for (&j, &sij) in cols.iter().zip(&sval[s..e]) {
+            sv += sij * v[j as usize];
+        }
+        *ri = sv - model.d[i];
+        *gi = if st.truncated[i] {
+            0.0
+        } else if st.penetrating[i] {
+            *ri + match &model.l {
+                FoundationMatrix::Consistent(l) => {
+                    let mut lp = 0.0;
+                    for (&j, &lij) in cols.iter().zip(&l.val[s..e]) {
+                        lp += lij * pen(j as usize);
+                    }
+                    lp
+                }
+                FoundationMatrix::Lumped(d) => d[i] * pen(i),
+                FoundationMatrix::Rigid => 0.0,
+            }
+        } else {
+            *ri
+        };
+        if !rows.is_none_or(|d| d[i]) {
+            return;
+        }
+        for (k, &j) in cols.iter().enumerate() {
+            let j = j as usize;
+            arow[k] = if st.truncated[i] || st.truncated[j] {
+                0.0
+            } else if st.penetrating[i] && st.penetrating[j] {
+                match &model.l {
+                    FoundationMatrix::Consistent(l) => sval[s + k] + l.val[s + k],
+                    FoundationMatrix::Lumped(d) if i == j => sval[s + k] + d[i],
+                    _ => sval[s + k],
+                }
+            } else {
+                sval[s + k]
+            };
+        }
+    };
+    let blocks = row_chunks(&pat, &mut a.val, CHUNK);
+    type Block<'a> = ((usize, &'a mut [f64]), (&'a mut [f64], &'a mut [f64]));
+    let work = |((start, vals), (gc, rc)): Block| {
+        let mut off = 0;
+        for (k, (gi, ri)) in gc.iter_mut().zip(rc.iter_mut()).enumerate() {
+            let i = start + k;
+            let len = pat.row_ptr[i + 1] - pat.row_ptr[i];
+            row(i, &mut vals[off..off + len], gi, ri);
+            off += len;
+        }
+    };
+    if v.len() >= PAR_ROWS {
+        blocks
+            .into_par_iter()
+            .zip(g.par_chunks_mut(CHUNK).zip(r.par_chunks_mut(CHUNK)))
+            .for_each(work);
+    } else {
+        blocks
+            .into_iter()
+            .zip(g.chunks_mut(CHUNK).zip(r.chunks_mut(CHUNK)))
+            .for_each(work);
+    }
+}
+
+/// Puts 1 on the diagonal of the truncated rows of a matrix filled by [`newton_system`], so
+/// that it is positive definite (for a Cholesky factorisation); with `g = 0` there, the
+/// truncated components of the Newton step are 0.
+pub fn unit_diagonal_on_truncated(a: &mut Csr, st: &NewtonStates) {
+    let pat = a.pattern.clone();
+    for (i, _) in st.truncated.iter().enumerate().filter(|(_, &t)| t) {
+        if let Some(k) = pat.find(i, i) {
+            a.val[k] = 1.0;
+        }
+    }
+}
+
+/// The truncated Hessian alone, positive definite (unit diagonal on the truncated rows),
+/// for callers that bring their own right-hand side (the QP polish).
+pub fn truncated_hessian(model: &Model, st: &NewtonStates, a: &mut Csr) {
+    let n = model.n();
+    let (mut g, mut r) = (vec![0.0; n], vec![0.0; n]);
+    newton_system(model, &model.phi, st, a, None, &mut g, &mut r);
+    unit_diagonal_on_truncated(a, st);
+}
+
+/// Flags the rows of the truncated Hessian that differ between two state sets: a row
+/// changes when its vertex or a neighbour changed state. Returns the number of dirty rows.
+pub fn mark_dirty(
+    pattern: &Pattern,
+    old: &NewtonStates,
+    new: &NewtonStates,
+    changed: &mut [bool],
+    dirty: &mut [bool],
+) -> usize {
+    par_rows(changed, |i, c| {
+        *c = old.truncated[i] != new.truncated[i] || old.penetrating[i] != new.penetrating[i];
+    });
+    let changed: &[bool] = changed;
+    par_rows(dirty, |i, d| {
+        *d = pattern.col[pattern.row_ptr[i]..pattern.row_ptr[i + 1]]
+            .iter()
+            .any(|&j| changed[j as usize]);
+    });
+    dirty.iter().filter(|&&d| d).count()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::model::Foundation;
+    use crate::solve::multigrid::tests::{bench_model, square_hierarchy};
+
+    /// The Hessian and gradient of the piece, entry by entry from their definitions: J on
+    /// the piece is `½VᵀSV − VᵀD + ½(V − φ)_Pᵀ L_PP (V − φ)_P` with the truncated
+    /// coordinates fixed.
+    #[test]
+    #[allow(clippy::needless_range_loop)] // (i, j) index matrices and vectors alike
+    fn system_is_the_hessian_and_gradient_of_the_piece() {
+        let hier = square_hierarchy(4, 2);
+        for (h, f) in [
+            (Some(1000.0), Foundation::Consistent),
+            (Some(1000.0), Foundation::Lumped),
+            (None, Foundation::Lumped),
+        ] {
+            let model = bench_model(hier.finest(), h, f);
+            let n = model.n();
+            let mut v: Vec<f64> = (0..n)
+                .map(|i| model.phi[i] + 0.05 * ((i as f64) * 0.7).sin())
+                .collect();
+            for i in (0..n).step_by(5) {
+                v[i] = model.phi[i];
+            }
+            if h.is_none() {
+                for (x, p) in v.iter_mut().zip(&model.phi) {
+                    *x = x.min(*p);
+                }
+            }
+            let st = NewtonStates::of(&model, &v);
+            let mut a = Csr::zeros(model.s.pattern.clone());
+            let (mut g, mut r) = (vec![0.0; n], vec![0.0; n]);
+            newton_system(&model, &v, &st, &mut a, None, &mut g, &mut r);
+            let lij = |i: usize, j: usize| match &model.l {
+                FoundationMatrix::Consistent(l) => l.get(i, j),
+                FoundationMatrix::Lumped(d) => {
+                    if i == j {
+                        d[i]
+                    } else {
+                        0.0
+                    }
+                }
+                FoundationMatrix::Rigid => 0.0,
+            };
+            for i in 0..n {
+                let mut ri = -model.d[i];
+                let mut lp = 0.0;
+                for j in 0..n {
+                    ri += model.s.get(i, j) * v[j];
+                    if st.penetrating[j] {
+                        lp += lij(i, j) * (v[j] - model.phi[j]);
+                    }
+                }
+                assert!((r[i] - ri).abs() < 1e-12, "r {i}");
+                let gi = if st.truncated[i] {
+                    0.0
+                } else if st.penetrating[i] {
+                    ri + lp
+                } else {
+                    ri
+                };
+                assert!((g[i] - gi).abs() < 1e-12, "g {i}");
+                for j in 0..n {
+                    let expect = if st.truncated[i] || st.truncated[j] {
+                        0.0
+                    } else if st.penetrating[i] && st.penetrating[j] {
+                        model.s.get(i, j) + lij(i, j)
+                    } else {
+                        model.s.get(i, j)
+                    };
+                    assert_eq!(a.get(i, j), expect, "{f:?} ({i}, {j})");
+                }
+            }
+            // Only the flagged rows are refilled.
+            let mut b = a.clone();
+            b.val.iter_mut().for_each(|x| *x = -7.0);
+            let rows: Vec<bool> = (0..n).map(|i| i % 3 == 0).collect();
+            newton_system(&model, &v, &st, &mut b, Some(&rows), &mut g, &mut r);
+            for i in 0..n {
+                let (s, e) = (b.pattern.row_ptr[i], b.pattern.row_ptr[i + 1]);
+                if rows[i] {
+                    assert_eq!(&b.val[s..e], &a.val[s..e]);
+                } else {
+                    assert!(b.val[s..e].iter().all(|&x| x == -7.0));
+                }
+            }
+        }
+    }
+}
