@@ -664,11 +664,36 @@ impl MeshSpec {
             }
             MeshSource::Polygon {
                 outer,
+                holes,
                 size,
                 min_angle,
                 regions,
-                ..
             } => {
+                let rings = std::iter::once(("outer".to_string(), outer))
+                    .chain(
+                        holes
+                            .iter()
+                            .enumerate()
+                            .map(|(i, h)| (format!("holes[{i}]"), h)),
+                    )
+                    .chain(
+                        regions
+                            .iter()
+                            .enumerate()
+                            .map(|(i, r)| (format!("regions[{i}].polygon"), &r.polygon)),
+                    );
+                for (key, ring) in rings {
+                    if let Some((i, p)) = ring
+                        .iter()
+                        .enumerate()
+                        .find(|(_, p)| !(p[0].is_finite() && p[1].is_finite()))
+                    {
+                        return bad(
+                            &key,
+                            format!("vertex {i} must have finite coordinates, got {p:?}"),
+                        );
+                    }
+                }
                 if outer.len() < 3 {
                     return bad(
                         "outer",
@@ -1250,6 +1275,20 @@ stiffness = 100
         assert!(e.to_string().contains("membrane.load"), "{e}");
         let e = err(&DISK.replace("stiffness = 100", "stiffness = -3"));
         assert!(e.to_string().contains("obstacle.stiffness"), "{e}");
+        // Found by fuzzing: a NaN polygon vertex passed validation (and its JSON, null,
+        // did not read back).
+        let polygon = DISK.replace(
+            "generator = \"disk\"\nradius = 1\nsize = 0.2",
+            "generator = \"polygon\"\nouter = [[0, 0], [2, 0], [2, 2], [0, 2]]\n\
+             holes = [[[nan, 1.0], [1.2, 0.8], [1.2, 1.2]]]\nsize = 0.2",
+        );
+        let e = err(&polygon);
+        assert!(e.to_string().contains("mesh.holes[0]"), "{e}");
+        assert!(e.to_string().contains("finite"), "{e}");
+        let e = err(&polygon
+            .replace("[[[nan, 1.0]", "[[[1.0, 1.0]")
+            .replace("[0, 2]]", "[0, inf]]"));
+        assert!(e.to_string().contains("mesh.outer"), "{e}");
         // A key inside an array of tables points at its own line.
         let e = err(&format!(
             "{DISK}\n[[load_case]]\nname = \"a\"\n\n[[load_case]]\nname = \"b\"\n\
