@@ -201,6 +201,7 @@ pub fn check(case_path: &Path, sets: &[String]) -> Result<()> {
     let d = Discretization::new(&case.problem, &mut Progress::new(Verbosity::Quiet))?;
     write::check_on_mesh(&case, d.mesh())?;
     memcontact::sweep::check_on_mesh(&case, d.mesh(), true)?;
+    d.check_memory(&case.settings)?;
     print_warnings(&d);
     let mesh = d.mesh();
     println!("case {}: valid", case_path.display());
@@ -230,6 +231,12 @@ pub fn check(case_path: &Path, sets: &[String]) -> Result<()> {
         case.settings.method.name(),
         method.name(),
         choice.reason()
+    );
+    let (available, source) = memcontact::resources::available_memory();
+    println!(
+        "  memory       about {} to solve ({} available: {source})",
+        memcontact::resources::human_bytes(d.memory_estimate(&case.settings)),
+        memcontact::resources::human_bytes(available as f64)
     );
     Ok(())
 }

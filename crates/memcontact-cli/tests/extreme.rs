@@ -461,6 +461,41 @@ fn resources_beyond_the_machine_are_refused_before_allocation() {
         .unwrap()
         .status
         .success());
+    // A direct solver's factorisation is checked too, by check as by solve.
+    let square = case(
+        &dir,
+        "square64",
+        "generator = \"rectangle\"\nnx = 64",
+        "tension = 1\nload = 8",
+        "shape = 0.1\nstiffness = 100",
+    );
+    for command in ["check", "solve"] {
+        let mut c = bin();
+        c.env("MEMCONTACT_MEMORY_LIMIT", "8M")
+            .arg(command)
+            .arg(&square)
+            .args(["--set", "solver.method=qp"]);
+        if command == "solve" {
+            c.arg("-o").arg(dir.join("qp"));
+        }
+        let o = c.output().unwrap();
+        let t = text(&o);
+        assert_eq!(o.status.code(), Some(1), "{command}: {t}");
+        assert!(
+            t.contains("solver qp: its factorisation") && t.contains("8.00 MB"),
+            "{t}"
+        );
+        assert!(!dir.join("qp").exists());
+    }
+    let o = bin()
+        .env("MEMCONTACT_MEMORY_LIMIT", "8M")
+        .arg("check")
+        .arg(&square)
+        .args(["--set", "solver.method=active-set"])
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", text(&o));
+    assert!(text(&o).contains("memory       about"), "{}", text(&o));
     // The convergence study of a disc to 9 levels.
     let disc = case(
         &dir,

@@ -149,6 +149,27 @@ impl Discretization {
         solve::auto_choice(&self.model, self.levels())
     }
 
+    /// The method `settings` resolve to on this problem (`auto`'s choice).
+    pub fn method_for(&self, settings: &Settings) -> Method {
+        match settings.method {
+            Method::Auto => self.auto_choice().0,
+            m => m,
+        }
+    }
+
+    /// Refuses a solve with `settings` whose factorisation would not fit in the memory
+    /// available ([`crate::resources::check_solver_fits`]); `solve` and `check` call it.
+    pub fn check_memory(&self, settings: &Settings) -> Result<()> {
+        crate::resources::check_solver_fits(self.method_for(settings), self.model.n())
+    }
+
+    /// The estimated peak memory of solving with `settings` (bytes): the run's data on
+    /// this mesh and the solver's factorisation ([`crate::resources`]).
+    pub fn memory_estimate(&self, settings: &Settings) -> f64 {
+        crate::resources::run_bytes(crate::resources::MeshSize::of(self.mesh()))
+            + crate::resources::solver_bytes(self.method_for(settings), self.model.n())
+    }
+
     /// Solves the discrete problem with `settings`.
     pub fn solve(&self, settings: &Settings, observer: &mut dyn Observer) -> Result<Report> {
         self.solve_from(settings, None, observer)
@@ -162,11 +183,7 @@ impl Discretization {
         start: Option<&[f64]>,
         observer: &mut dyn Observer,
     ) -> Result<Report> {
-        let method = match settings.method {
-            Method::Auto => self.auto_choice().0,
-            m => m,
-        };
-        crate::resources::check_solver_fits(method, self.model.n())?;
+        self.check_memory(settings)?;
         observer.phase_started("solve");
         let t0 = Instant::now();
         let a = solve::attempt_from(&self.model, self.levels(), settings, start, observer)?;
