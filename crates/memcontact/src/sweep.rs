@@ -71,6 +71,13 @@ impl SweepSpec {
     pub fn values(&self) -> std::result::Result<Vec<f64>, Invalid> {
         let values = match (&self.values, self.from, self.to, self.steps) {
             (Some(v), None, None, None) => v.clone(),
+            // The count is checked before anything is allocated for it.
+            (None, Some(_), Some(_), Some(n)) if n > MAX_STEPS => {
+                return Err(Invalid::new(
+                    "sweep.steps",
+                    format!("{n} steps is more than {MAX_STEPS}"),
+                ))
+            }
             (None, Some(a), Some(b), Some(n)) if n >= 2 => (0..n)
                 .map(|k| a + (b - a) * k as f64 / (n - 1) as f64)
                 .collect(),
@@ -653,6 +660,8 @@ stiffness = 300
             "parameter = \"load_factor\"\nfrom = 1\nto = 2",
             "parameter = \"load_factor\"\nvalues = [1]\nsteps = 3",
             "parameter = \"gravity\"\nvalues = [1]",
+            // A declared count far beyond the limit is refused before any allocation.
+            "parameter = \"load_factor\"\nfrom = 0\nto = 1\nsteps = 100000000000",
         ] {
             let e = Case::from_toml_str(&format!("{BASE}[sweep]\n{bad}\n"), None).unwrap_err();
             assert!(e.to_string().contains("sweep"), "{bad}: {e}");

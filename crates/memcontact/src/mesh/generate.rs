@@ -499,6 +499,22 @@ pub fn polygon(spec: &PolygonSpec) -> Result<Mesh> {
              about {estimate:.2e} triangles, more than the limit {MAX_TRIANGLES:.0e}"
         )));
     }
+    // The boundary points the subdivision will make, counted before any is made: a long
+    // thin polygon can need far more of them than its area suggests.
+    let boundary_points: f64 = std::iter::once(&spec.outer)
+        .chain(spec.holes.iter())
+        .chain(spec.regions.iter().map(|r| &r.1))
+        .flat_map(|ring| {
+            (0..ring.len())
+                .map(|i| (super::dist(ring[i], ring[(i + 1) % ring.len()]) / size).ceil())
+        })
+        .sum();
+    if boundary_points > MAX_TRIANGLES {
+        return Err(Error::Mesh(format!(
+            "polygon: size {size} is too small for the length of the boundary: about \
+             {boundary_points:.2e} boundary points, more than the limit {MAX_TRIANGLES:.0e}"
+        )));
+    }
     let mut vertices = Vec::new();
     let mut segments = Vec::new();
     let rings = std::iter::once(&spec.outer)
@@ -1126,6 +1142,19 @@ mod tests {
         // where refinement on both sides of the boundary split them further).
         let nb = m.boundary_edges().len();
         assert!((90..180).contains(&nb), "{nb}");
+    }
+
+    #[test]
+    fn a_long_thin_polygon_is_refused_before_its_boundary_is_subdivided() {
+        // Area 1, boundary 2e9: 2e12 boundary points at size 1e-3.
+        let e = polygon(&PolygonSpec {
+            outer: vec![[0.0, 0.0], [1e9, 0.0], [1e9, 1e-9], [0.0, 1e-9]],
+            size: 1e-3,
+            min_angle: 25.0,
+            ..PolygonSpec::default()
+        })
+        .unwrap_err();
+        assert!(e.to_string().contains("boundary points"), "{e}");
     }
 
     #[test]
