@@ -71,6 +71,12 @@ pub fn obstacle(p: [f64; 2]) -> f64 {
 /// The benchmark's mesh: the unit square, `n × n` cells, "right" diagonals, with the
 /// hierarchy the rectangle generator builds.
 pub fn mesh(n: usize) -> Result<crate::mesh::refine::Hierarchy> {
+    let cells = n as f64 * n as f64;
+    crate::resources::check_mesh_fits(
+        crate::resources::MeshSize::simply_connected((n as f64 + 1.0).powi(2), 2.0 * cells),
+        0,
+        &format!("the benchmark's {n} × {n} square"),
+    )?;
     rectangle(&RectangleSpec {
         x0: 0.0,
         y0: 0.0,
