@@ -176,7 +176,9 @@ impl Discretization {
     }
 
     /// Solves the discrete problem with `settings`, starting from `start` (U over the
-    /// unknowns, e.g. the answer of a neighbouring load step) when given.
+    /// unknowns, e.g. the answer of a neighbouring load step) when given. Refused first
+    /// when the solver would not fit in memory, and afterwards when J, the certificate,
+    /// the fields or the totals of the answer are not finite ([`crate::checks`]).
     pub fn solve_from(
         &self,
         settings: &Settings,
@@ -192,6 +194,10 @@ impl Discretization {
             a.solution.certificate.kkt(),
             self.model.is_rigid(),
         )?;
+        // The fields and totals of the answer (pressures, forces, areas) must be finite
+        // too: refused here, before any caller reports or writes them.
+        let (fields, totals) = derive_from(self.mesh(), &self.model, &a.solution.u);
+        crate::checks::check_results(self.mesh(), &fields, &totals)?;
         let seconds = t0.elapsed().as_secs_f64();
         observer.phase_finished("solve", seconds);
         let mut phases = self.phases.clone();

@@ -555,9 +555,6 @@ pub fn run_sweep_on(
             discretization: current,
             report,
         };
-        outcome
-            .checked_fields()
-            .map_err(|e| at_step(step, case, e))?;
         let row = StepRow::of(step, &outcome, seconds);
         on_step(step, &outcome, &row)?;
         rows.push(row);
