@@ -366,23 +366,19 @@ fn ambiguous_gmsh_region_names_are_warned_about_and_refused() {
         "{t}"
     );
     let out = d.join("out");
-    let o = run(&[
-        "solve",
-        p.to_str().unwrap(),
-        "-q",
-        "-o",
-        out.to_str().unwrap(),
-    ]);
+    let solve = |p: &Path| {
+        run(&[
+            "solve",
+            p.to_str().unwrap(),
+            "-q",
+            "-o",
+            out.to_str().unwrap(),
+        ])
+    };
+    let o = solve(&p);
     assert!(o.status.success(), "{}", text(&o));
     // The key "2" could be surface 2 (by tag) or surface 5 (by name): refused.
-    let p = case("{ \"2\" = 10, default = 1 }");
-    let o = run(&[
-        "solve",
-        p.to_str().unwrap(),
-        "-q",
-        "-o",
-        out.to_str().unwrap(),
-    ]);
+    let o = solve(&case("{ \"2\" = 10, default = 1 }"));
     let t = text(&o);
     assert_eq!(o.status.code(), Some(1), "{t}");
     assert!(t.contains("'2' is ambiguous") && t.contains("clay"), "{t}");

@@ -188,25 +188,9 @@ mod tests {
     use crate::field::Field;
     use crate::model::{Foundation, Sampling};
 
-    fn square() -> Mesh {
-        crate::mesh::generate::rectangle(&crate::mesh::generate::RectangleSpec {
-            x0: 0.0,
-            y0: 0.0,
-            x1: 1.0,
-            y1: 1.0,
-            nx: 4,
-            ny: 4,
-            diagonal: crate::mesh::generate::Diagonal::Right,
-        })
-        .unwrap()
-        .levels
-        .pop()
-        .unwrap()
-    }
-
     #[test]
     fn loads_singular_on_the_boundary_and_rigid_bodies_below_it_are_refused() {
-        let mesh = square();
+        let mesh = crate::solve::tests::square(4);
         let bind = |f: &str| {
             Field::parse(f)
                 .unwrap()

@@ -448,19 +448,11 @@ fn run_method(
             let certificate = model.certificate(&u);
             // The start may be the answer (f = 0 with the body clear, say), which the
             // method failed to confirm: the certificate, not the method, decides.
-            if certificate.kkt() <= settings.tolerance {
-                let solution = Solution {
-                    energy: model.energy(&u),
-                    u,
-                    method,
-                    iterations: 0,
-                    certificate,
-                    multipliers: None,
-                    history: Vec::new(),
-                    phases: Vec::new(),
-                };
-                return Ok((solution, Status::Converged, None));
-            }
+            let (status, message) = if certificate.kkt() <= settings.tolerance {
+                (Status::Converged, None)
+            } else {
+                (Status::NumericalFailure, Some(message))
+            };
             let solution = Solution {
                 energy: model.energy(&u),
                 u,
@@ -471,7 +463,7 @@ fn run_method(
                 history: Vec::new(),
                 phases: Vec::new(),
             };
-            Ok((solution, Status::NumericalFailure, Some(message)))
+            Ok((solution, status, message))
         }
         Err(e) => Err(e),
     }
