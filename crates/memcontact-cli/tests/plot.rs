@@ -69,6 +69,29 @@ fn plot_redraws_a_result_directory() {
     let o = run(&["plot", empty.to_str().unwrap()]);
     assert!(!o.status.success());
     assert!(text(&o).contains("solution.vtu"), "{}", text(&o));
+    // A directory mixing two runs (another run's solution.vtu beside this summary.json)
+    // is refused, not redrawn.
+    let other = tmp_in("plot", "other");
+    let o = run(&[
+        "solve",
+        examples().join("disk.toml").to_str().unwrap(),
+        "-q",
+        "-o",
+        other.join("r").to_str().unwrap(),
+        "--set",
+        "membrane.load=9",
+        "--set",
+        "output.plot=false",
+    ]);
+    assert!(o.status.success(), "{}", text(&o));
+    std::fs::copy(other.join("r/solution.vtu"), dir.join("solution.vtu")).unwrap();
+    let o = run(&["plot", dir.to_str().unwrap()]);
+    assert!(!o.status.success());
+    assert!(
+        text(&o).contains("mixes the files of two runs"),
+        "{}",
+        text(&o)
+    );
     let _ = std::fs::remove_dir_all(&dir);
     let _ = std::fs::remove_dir_all(&empty);
 }

@@ -110,6 +110,18 @@ pub fn load(dir: &Path) -> Result<Loaded> {
                 .get("case")
                 .and_then(|c| c.as_str())
                 .map(str::to_string);
+            // The pictures must be drawn from this run's solution.vtu: a directory mixing
+            // the files of two runs is refused.
+            if let Some(record) = json.pointer("/files/solution.vtu") {
+                let actual = memcontact::output::file_record(&vtu_path)?;
+                if record.get("xxh3").and_then(|h| h.as_str()) != Some(actual.xxh3.as_str()) {
+                    return Err(file_err(format!(
+                        "is not the solution.vtu that summary.json lists (run {}): the \
+                         directory mixes the files of two runs; solve the case again",
+                        json.get("run_id").and_then(|r| r.as_str()).unwrap_or("?")
+                    )));
+                }
+            }
             match json.get("plot_options") {
                 Some(o) => {
                     options = serde_json::from_value(o.clone()).map_err(|e| Error::File {
