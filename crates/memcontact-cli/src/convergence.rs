@@ -146,6 +146,10 @@ pub fn parse_exact(case: &Case) -> Result<Option<Exact>> {
             let h = match &p.obstacle.stiffness {
                 FieldStiffness::Rigid => None,
                 FieldStiffness::Elastic(h) => Some(constant("obstacle.stiffness", h)?),
+                FieldStiffness::Mixed(_) => bail!(
+                    "[exact] kind = \"disk\" needs a constant obstacle.stiffness (the closed \
+                     form is for constant t, f, h, φ), not a table with rigid regions"
+                ),
             };
             let solution = DiskSolution::new(center, radius, t, f, h, phi)
                 .context("[exact] kind = \"disk\"")?;

@@ -332,6 +332,20 @@ pub fn mesh_state<'py>(py: Python<'py>, h: &Hierarchy) -> PyResult<Bound<'py, Py
     }
     d.set_item("parents", parents)?;
     d.set_item("names", h.finest().region_names.clone())?;
+    // Boundary regions of every level: (edges (k, 2), tags (k,)), and their names.
+    let boundary = PyList::empty(py);
+    for m in &h.levels {
+        let b = &m.boundary;
+        let flat: Vec<i64> = b.edges.iter().flat_map(|e| e.map(i64::from)).collect();
+        let edges = Array2::from_shape_vec((b.edges.len(), 2), flat).expect("k x 2");
+        let tags: Vec<i64> = b.tags.iter().map(|&t| i64::from(t)).collect();
+        boundary.append((
+            PyArray2::from_owned_array(py, edges),
+            PyArray1::from_vec(py, tags),
+        ))?;
+    }
+    d.set_item("boundary", boundary)?;
+    d.set_item("boundary_names", h.finest().boundary.names.clone())?;
     d.set_item(
         "circle",
         h.finest()
@@ -350,6 +364,29 @@ pub fn hierarchy_from_state(state: &Bound<'_, PyAny>) -> PyResult<Hierarchy> {
     };
     let names: BTreeMap<u32, String> = get("names")?.extract()?;
     let circle: Option<(f64, f64, f64)> = get("circle")?.extract()?;
+    // Boundary regions (absent from states written before they existed).
+    let boundary_names: BTreeMap<u32, String> = match d.get_item("boundary_names")? {
+        Some(v) => v.extract()?,
+        None => BTreeMap::new(),
+    };
+    let mut boundary = Vec::new();
+    if let Some(list) = d.get_item("boundary")? {
+        for item in list.try_iter()? {
+            let (e, t): (PyReadonlyArray2<'_, i64>, PyReadonlyArray1<'_, i64>) = item?.extract()?;
+            let edges: Vec<[u32; 2]> = e
+                .as_array()
+                .rows()
+                .into_iter()
+                .map(|r| [r[0] as u32, r[1] as u32])
+                .collect();
+            let tags: Vec<u32> = t.as_array().iter().map(|&x| x as u32).collect();
+            boundary.push(memcontact::mesh::BoundaryRegions {
+                edges,
+                tags,
+                names: boundary_names.clone(),
+            });
+        }
+    }
     let mut levels = Vec::new();
     for item in get("levels")?.try_iter()? {
         let (v, t, r): (
@@ -371,6 +408,7 @@ pub fn hierarchy_from_state(state: &Bound<'_, PyAny>) -> PyResult<Hierarchy> {
                 center: [x, y],
                 radius: r,
             }),
+            boundary: boundary.get(levels.len()).cloned().unwrap_or_default(),
         });
     }
     let mut refinements = Vec::new();

@@ -35,7 +35,7 @@ use crate::exact::ExactSolution;
 use crate::fem::{Coefficient, Element};
 use crate::mesh::refine::Hierarchy;
 use crate::mesh::{Mesh, Point};
-use crate::model::{Model, ProblemData, Stiffness};
+use crate::model::{Extensions, Model, ProblemData, Stiffness};
 use crate::solve::{self, Method, Settings, Silent, Solution};
 use crate::{Error, Result};
 use std::time::Instant;
@@ -179,8 +179,28 @@ pub struct Study {
 /// does not contain the mesh ([`error_norms`]); a [`Target::Discrete`] reference whose
 /// length is not the finest mesh's vertex count.
 pub fn run(
+    hierarchy: Hierarchy,
+    data: &ProblemData,
+    target: Target,
+    settings: &StudySettings,
+    progress: &mut dyn FnMut(&LevelResult),
+) -> Result<Study> {
+    run_with(
+        hierarchy,
+        data,
+        &Extensions::default(),
+        target,
+        settings,
+        progress,
+    )
+}
+
+/// [`run`] with the data beyond the paper's frame (boundary heights and free edges, rigid
+/// regions, a body below; SPEC §5): the same on every level, like `data`.
+pub fn run_with(
     mut hierarchy: Hierarchy,
     data: &ProblemData,
+    ext: &Extensions,
     target: Target,
     settings: &StudySettings,
     progress: &mut dyn FnMut(&LevelResult),
@@ -204,13 +224,13 @@ pub fn run(
         let refine_seconds = t0.elapsed().as_secs_f64();
         let mesh = hierarchy.finest();
         let t1 = Instant::now();
-        let model = Model::assemble(mesh, data).map_err(|e| at_level(level, e))?;
+        let model = Model::assemble_with(mesh, data, ext).map_err(|e| at_level(level, e))?;
         let assembly_seconds = t1.elapsed().as_secs_f64();
         let t2 = Instant::now();
         let (solution, note) =
             solve_level(&model, &hierarchy, &settings.solver).map_err(|e| at_level(level, e))?;
         let solve_seconds = t2.elapsed().as_secs_f64();
-        let u = model.dofs.to_vertices(&solution.u, 0.0);
+        let u = model.to_vertices(&solution.u);
         let t3 = Instant::now();
         let errors = match target {
             Target::Exact(exact) => {
@@ -411,7 +431,7 @@ pub fn contact_estimate(mesh: &Mesh, model: &Model, u: &[f64]) -> ContactEstimat
             })
             .sum()
     } else {
-        let uv = model.dofs.to_vertices(u, 0.0);
+        let uv = model.to_vertices(u);
         let g: Vec<f64> = uv
             .iter()
             .zip(&model.phi_vertices)
@@ -511,7 +531,7 @@ pub fn rigid_limit_sweep(
     };
     let rigid_model = Model::assemble(mesh, &rigid_data)?;
     let (rigid, _) = solve_level(&rigid_model, hierarchy, solver)?;
-    let rigid_u = rigid_model.dofs.to_vertices(&rigid.u, 0.0);
+    let rigid_u = rigid_model.to_vertices(&rigid.u);
     let rigid_contact = contact_estimate(mesh, &rigid_model, &rigid.u);
     let mut rows = Vec::with_capacity(stiffnesses.len());
     for &h in stiffnesses {
@@ -523,7 +543,7 @@ pub fn rigid_limit_sweep(
         let t = Instant::now();
         let (s, _) = solve_level(&model, hierarchy, solver)?;
         let solve_seconds = t.elapsed().as_secs_f64();
-        let u = model.dofs.to_vertices(&s.u, 0.0);
+        let u = model.to_vertices(&s.u);
         let diff: Vec<f64> = u.iter().zip(&rigid_u).map(|(a, b)| a - b).collect();
         let [l2, h1_semi, max_nodal] = p1_norms(mesh, &diff);
         rows.push(SweepRow {

@@ -25,7 +25,8 @@ pub const MAX_REFINE: usize = 12;
 
 /// A whole case: the problem, how to solve it, what to write, and (optionally) its exact
 /// solution. The TOML case file has the sections `[mesh]`, `[membrane]`, `[obstacle]`,
-/// `[solver]`, `[output]` and `[exact]`.
+/// `[solver]`, `[output]` and `[exact]`, and, beyond the paper's frame, `[boundary]` (heights
+/// and free edges) and `[lower]` (a body below).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(from = "CaseFile", into = "CaseFile")]
 pub struct Case {
@@ -65,6 +66,10 @@ struct CaseFile {
     mesh: MeshSpec,
     membrane: Membrane,
     obstacle: Obstacle,
+    #[serde(default, skip_serializing_if = "Boundary::is_default")]
+    boundary: Boundary,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    lower: Option<Obstacle>,
     #[serde(default)]
     solver: Settings,
     #[serde(default)]
@@ -86,6 +91,8 @@ impl From<CaseFile> for Case {
                 mesh: c.mesh,
                 membrane: c.membrane,
                 obstacle: c.obstacle,
+                boundary: c.boundary,
+                lower: c.lower,
             },
             settings: c.solver,
             output: c.output,
@@ -103,6 +110,8 @@ impl From<Case> for CaseFile {
             mesh: c.problem.mesh,
             membrane: c.problem.membrane,
             obstacle: c.problem.obstacle,
+            boundary: c.problem.boundary,
+            lower: c.problem.lower,
             solver: c.settings,
             output: c.output,
             exact: c.exact,
@@ -124,6 +133,53 @@ pub struct Problem {
     pub membrane: Membrane,
     /// `[obstacle]`: the elastic (or rigid) body.
     pub obstacle: Obstacle,
+    /// `[boundary]`: the heights on the fixed boundary and the free boundary regions
+    /// (default: the whole boundary fixed at 0, as in the paper).
+    #[serde(default, skip_serializing_if = "Boundary::is_default")]
+    pub boundary: Boundary,
+    /// `[lower]`: a second body below the membrane (its surface, stiffness, foundation and
+    /// sampling, with the keys of `[obstacle]`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub lower: Option<Obstacle>,
+}
+
+/// `[boundary]`: `u = g` on the fixed part of the boundary, the natural condition
+/// (no force across the edge) on the free part.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Boundary {
+    /// The height g (length): a number, an expression of x and y, a table per boundary
+    /// region (Gmsh physical curves; the generators' sides `left`, `right`, `bottom`,
+    /// `top`, `outer`, `hole1`, ...), or one value per vertex.
+    #[serde(default = "zero_height", skip_serializing_if = "is_zero")]
+    pub height: Field,
+    /// The boundary regions that are not fixed (names, or tags as text).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub free: Vec<String>,
+}
+
+fn zero_height() -> Field {
+    Field::Constant(0.0)
+}
+
+fn is_zero(f: &Field) -> bool {
+    matches!(f, Field::Constant(v) if *v == 0.0)
+}
+
+impl Default for Boundary {
+    fn default() -> Boundary {
+        Boundary {
+            height: zero_height(),
+            free: Vec::new(),
+        }
+    }
+}
+
+impl Boundary {
+    /// The paper's frame: everything fixed at height 0.
+    pub fn is_default(&self) -> bool {
+        is_zero(&self.height) && self.free.is_empty()
+    }
 }
 
 /// `[membrane]`.
@@ -480,6 +536,26 @@ impl MeshSpec {
             MeshSource::Rectangle { .. } => "rectangle",
             MeshSource::Disk { .. } => "disk",
             MeshSource::Polygon { .. } => "polygon",
+        }
+    }
+
+    /// The names of the boundary regions a generator gives its mesh, in the order of their
+    /// tags (`None` for a mesh file: its physical curves are known once it is read).
+    pub fn boundary_region_names(&self) -> Option<Vec<String>> {
+        match &self.source {
+            MeshSource::File(_) => None,
+            MeshSource::Rectangle { .. } => Some(
+                generate::RECTANGLE_SIDES
+                    .iter()
+                    .map(|s| s.to_string())
+                    .collect(),
+            ),
+            MeshSource::Disk { .. } => Some(vec!["outer".into()]),
+            MeshSource::Polygon { holes, .. } => Some(
+                std::iter::once("outer".to_string())
+                    .chain((1..=holes.len()).map(|h| format!("hole{h}")))
+                    .collect(),
+            ),
         }
     }
 
@@ -864,7 +940,8 @@ fn check_field(key: &str, f: &Field, non_negative: bool) -> std::result::Result<
 
 impl Problem {
     /// Checks every value that can be checked without the mesh: t > 0, constants finite,
-    /// h ≥ 0, ε > 0 and only with mollified sampling, the mesh generator's parameters.
+    /// h ≥ 0, ε > 0 and only with mollified sampling, the mesh generator's parameters, the
+    /// boundary heights and, for the generators, the names of the boundary regions.
     pub fn validate(&self) -> std::result::Result<(), Invalid> {
         self.mesh.validate()?;
         let t = self.membrane.tension;
@@ -875,30 +952,95 @@ impl Problem {
             ));
         }
         check_field("membrane.load", &self.membrane.load, false)?;
-        check_field("obstacle.shape", &self.obstacle.shape, false)?;
-        if let Stiffness::Elastic(h) = &self.obstacle.stiffness {
-            check_field("obstacle.stiffness", h, true)?;
+        self.obstacle.validate("obstacle")?;
+        if let Some(low) = &self.lower {
+            low.validate("lower")?;
         }
-        if let (SamplingKind::Mollified, Field::Nodal(_)) =
-            (self.obstacle.sampling, &self.obstacle.shape)
-        {
+        self.boundary.validate(&self.mesh)
+    }
+}
+
+impl Obstacle {
+    /// Checks a body's constants (the section is `obstacle` or `lower`).
+    fn validate(&self, section: &str) -> std::result::Result<(), Invalid> {
+        check_field(&format!("{section}.shape"), &self.shape, false)?;
+        for (key, h) in self.stiffness.elastic_fields() {
+            check_field(&format!("{section}.stiffness{key}"), h, true)?;
+        }
+        if let (SamplingKind::Mollified, Field::Nodal(_)) = (self.sampling, &self.shape) {
             return Err(Invalid::new(
-                "obstacle.sampling",
+                format!("{section}.sampling"),
                 "mollified sampling needs φ as a function of x and y; nodal values of φ \
                  are its samples (use sampling = \"nodal\")",
             ));
         }
-        match (self.obstacle.sampling, self.obstacle.epsilon) {
+        match (self.sampling, self.epsilon) {
             (SamplingKind::Nodal, Some(_)) => Err(Invalid::new(
-                "obstacle.epsilon",
+                format!("{section}.epsilon"),
                 "is only used with sampling = \"mollified\"",
             )),
             (SamplingKind::Mollified, Some(e)) if !(e.is_finite() && e > 0.0) => Err(Invalid::new(
-                "obstacle.epsilon",
+                format!("{section}.epsilon"),
                 format!("must be a finite number > 0, got {e}"),
             )),
             _ => Ok(()),
         }
+    }
+}
+
+impl Boundary {
+    /// Checks the heights' constants and, when the mesh generator names its boundary
+    /// regions, that `free` and the keys of a height table name existing regions.
+    fn validate(&self, mesh: &MeshSpec) -> std::result::Result<(), Invalid> {
+        check_field("boundary.height", &self.height, false)?;
+        for (i, name) in self.free.iter().enumerate() {
+            if name.trim().is_empty() {
+                return Err(Invalid::new("boundary.free", format!("entry {i} is empty")));
+            }
+            if self.free[..i].contains(name) {
+                return Err(Invalid::new(
+                    "boundary.free",
+                    format!("\"{name}\" is listed twice"),
+                ));
+            }
+        }
+        let Some(sides) = mesh.boundary_region_names() else {
+            return Ok(());
+        };
+        let known = |k: &str| {
+            sides.iter().any(|s| s == k)
+                || k.trim()
+                    .parse::<usize>()
+                    .is_ok_and(|t| t >= 1 && t <= sides.len())
+        };
+        let listing = sides.join(", ");
+        for name in &self.free {
+            if !known(name) {
+                return Err(Invalid::new(
+                    "boundary.free",
+                    format!(
+                        "no boundary region named '{name}' (the {} generator's boundary \
+                         regions: {listing})",
+                        mesh.kind()
+                    ),
+                ));
+            }
+        }
+        if let Field::Regions(table) = &self.height {
+            for key in table.keys() {
+                if key != crate::field::DEFAULT_KEY && !known(key) {
+                    return Err(Invalid::new(
+                        format!("boundary.height.{key}"),
+                        format!(
+                            "no boundary region named '{key}' (the {} generator's boundary \
+                             regions: {listing})",
+                            mesh.kind()
+                        ),
+                    ));
+                }
+            }
+        }
+        Ok(())
     }
 }
 

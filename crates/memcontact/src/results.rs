@@ -65,7 +65,7 @@ pub fn derive(mesh: &Mesh, model: &Model, solution: &Solution) -> (NodalFields, 
 pub fn derive_from(mesh: &Mesh, model: &Model, u_dofs: &[f64]) -> (NodalFields, Totals) {
     let nv = mesh.n_vertices();
     let dofs = &model.dofs;
-    let u = dofs.to_vertices(u_dofs, 0.0);
+    let u = model.to_vertices(u_dofs);
     let r = model.residual(u_dofs);
     let x1: Vec<f64> = r
         .iter()

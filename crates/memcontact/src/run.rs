@@ -11,10 +11,13 @@
 //! and its certificate. The library prints nothing: progress reaches the caller through
 //! the [`Observer`].
 
-use crate::field::{BoundField, Stiffness as FieldStiffness};
+use crate::field::BoundField;
 use crate::mesh::refine::Hierarchy;
 use crate::mesh::Mesh;
-use crate::model::{Certificate, FoundationMatrix, Model, ProblemData, Stiffness};
+use crate::model::{
+    BodyData, BoundaryData, Certificate, Extensions, FoundationMatrix, Model, ProblemData,
+    Stiffness,
+};
 use crate::problem::{Invalid, Problem};
 use crate::results::{derive_from, NodalFields, Totals};
 use crate::solve::{
@@ -23,7 +26,8 @@ use crate::solve::{
 use crate::{Error, Result};
 use std::time::Instant;
 
-/// The problem's data f, φ, h bound to a mesh's regions.
+/// The problem's data f, φ, h (and the data beyond the paper's frame: boundary heights,
+/// rigid regions, the body below) bound to a mesh's regions.
 #[derive(Debug, Clone)]
 pub struct BoundData {
     /// The load f.
@@ -32,21 +36,72 @@ pub struct BoundData {
     pub shape: BoundField,
     /// The stiffness h (`None`: rigid).
     pub stiffness: Option<BoundField>,
+    /// The obstacle's rigid regions when it is elastic elsewhere (mixed bodies).
+    pub rigid_regions: Vec<u32>,
+    /// The heights g on the fixed boundary, bound to the boundary regions, and the free
+    /// regions (`None`: the whole boundary fixed at 0).
+    pub boundary: Option<(BoundField, Vec<String>)>,
+    /// The body below.
+    pub lower: Option<BoundBody>,
+}
+
+/// A body's data bound to a mesh: surface, stiffness, rigid regions.
+#[derive(Debug, Clone)]
+pub struct BoundBody {
+    /// The surface.
+    pub shape: BoundField,
+    /// The stiffness (`None`: rigid everywhere).
+    pub stiffness: Option<BoundField>,
+    /// The rigid regions when it is elastic elsewhere.
+    pub rigid_regions: Vec<u32>,
+}
+
+impl BoundBody {
+    fn new(section: &str, body: &crate::problem::Obstacle, mesh: &Mesh) -> Result<BoundBody> {
+        let stiffness = body
+            .stiffness
+            .bind_to_mesh(&format!("{section}.stiffness"), mesh)?;
+        let rigid_regions = if stiffness.is_rigid() {
+            Vec::new()
+        } else {
+            stiffness.rigid_tags
+        };
+        Ok(BoundBody {
+            shape: body.shape.bind_to_mesh(&format!("{section}.shape"), mesh)?,
+            stiffness: stiffness.elastic,
+            rigid_regions,
+        })
+    }
+
+    fn stiffness(&self) -> Stiffness<'_> {
+        match &self.stiffness {
+            Some(h) => Stiffness::Elastic(h),
+            None => Stiffness::Rigid,
+        }
+    }
 }
 
 impl BoundData {
     /// Binds the problem's f, φ and h to the regions of `mesh` (a region table must name
-    /// regions the mesh has, or give a default) or, for nodal values, to its vertices.
+    /// regions the mesh has, or give a default) or, for nodal values, to its vertices; the
+    /// boundary heights to the mesh's boundary regions.
     pub fn new(problem: &Problem, mesh: &Mesh) -> Result<BoundData> {
+        let upper = BoundBody::new("obstacle", &problem.obstacle, mesh)?;
+        let boundary = if problem.boundary.is_default() {
+            None
+        } else {
+            let height = bind_height(&problem.boundary, mesh)?;
+            Some((height, problem.boundary.free.clone()))
+        };
         Ok(BoundData {
             load: problem.membrane.load.bind_to_mesh("membrane.load", mesh)?,
-            shape: problem
-                .obstacle
-                .shape
-                .bind_to_mesh("obstacle.shape", mesh)?,
-            stiffness: match &problem.obstacle.stiffness {
-                FieldStiffness::Rigid => None,
-                FieldStiffness::Elastic(h) => Some(h.bind_to_mesh("obstacle.stiffness", mesh)?),
+            shape: upper.shape,
+            stiffness: upper.stiffness,
+            rigid_regions: upper.rigid_regions,
+            boundary,
+            lower: match &problem.lower {
+                Some(low) => Some(BoundBody::new("lower", low, mesh)?),
+                None => None,
             },
         })
     }
@@ -65,6 +120,75 @@ impl BoundData {
             sampling: problem.obstacle.sampling(),
         }
     }
+
+    /// The model's view of the data beyond the paper's frame (SPEC §5).
+    pub fn extensions<'a>(&'a self, problem: &Problem) -> Extensions<'a> {
+        Extensions {
+            boundary: self
+                .boundary
+                .as_ref()
+                .map(|(height, free)| BoundaryData { free, height }),
+            rigid_regions: &self.rigid_regions,
+            lower: match (&self.lower, &problem.lower) {
+                (Some(b), Some(p)) => Some(BodyData {
+                    shape: &b.shape,
+                    stiffness: b.stiffness(),
+                    rigid_regions: &b.rigid_regions,
+                    foundation: p.foundation,
+                    sampling: p.sampling(),
+                }),
+                _ => None,
+            },
+        }
+    }
+}
+
+/// Binds the boundary heights to the boundary regions of `mesh` that are fixed (a table
+/// needs a value for each of them, or a default), or, for nodal values, to its vertices.
+fn bind_height(boundary: &crate::problem::Boundary, mesh: &Mesh) -> Result<BoundField> {
+    let name = "boundary.height";
+    if let crate::field::Field::Nodal(_) = &boundary.height {
+        return boundary.height.bind_to_mesh(name, mesh);
+    }
+    let adj = crate::fem::VertexTriangles::new(mesh);
+    let fixed = crate::mesh::boundary::FixedBoundary::new(mesh, &adj, &boundary.free)?;
+    let tagged = mesh.tagged_boundary(&adj);
+    let present = tagged.present();
+    // Keys may name the free regions too (the value is then not used).
+    let names = &mesh.boundary.names;
+    if let crate::field::Field::Regions(table) = &boundary.height {
+        for key in table.keys() {
+            if key != crate::field::DEFAULT_KEY && mesh.boundary.resolve(key, &present).is_empty() {
+                return Err(Error::Data(format!(
+                    "{name}: no boundary region named '{key}' in the mesh (boundary regions: \
+                     {})",
+                    mesh.boundary_listing(&tagged)
+                )));
+            }
+        }
+        let fixed_only: std::collections::BTreeMap<String, crate::field::Field> = table
+            .iter()
+            .filter(|(k, _)| {
+                k.as_str() == crate::field::DEFAULT_KEY
+                    || mesh
+                        .boundary
+                        .resolve(k, &present)
+                        .iter()
+                        .any(|t| fixed.fixed_tags.contains(t))
+            })
+            .map(|(k, v)| (k.clone(), v.clone()))
+            .collect();
+        if fixed_only.is_empty() {
+            return crate::field::Field::Constant(0.0).bind(name, names, &fixed.fixed_tags);
+        }
+        return crate::field::Field::Regions(fixed_only)
+            .bind(name, names, &fixed.fixed_tags)
+            .map_err(|e| match e {
+                Error::Data(m) => Error::Data(m.replace("(regions:", "(fixed boundary regions:")),
+                other => other,
+            });
+    }
+    boundary.height.bind(name, names, &fixed.fixed_tags)
 }
 
 /// A named phase of a run and its wall-clock seconds.
@@ -122,8 +246,8 @@ impl Discretization {
         let t0 = Instant::now();
         let mesh = hierarchy.finest();
         let bound = BoundData::new(problem, mesh)?;
-        check_boundary_data(mesh, &bound)?;
-        let model = Model::assemble(mesh, &bound.data(problem))?;
+        let model = Model::assemble_with(mesh, &bound.data(problem), &bound.extensions(problem))?;
+        check_boundary_data(mesh, &bound, &model)?;
         check_overflow(mesh, &model)?;
         let seconds = t0.elapsed().as_secs_f64();
         observer.phase_finished("assembly", seconds);
@@ -203,16 +327,21 @@ impl Discretization {
 }
 
 /// Checks the data where assembly does not sample it: f on the boundary vertices (a load
-/// singular on the boundary, like `1/x` on x = 0, is refused), and, for the rigid obstacle,
-/// that φ is not below the fixed boundary (`u = 0 > φ` there: no continuous solution).
-fn check_boundary_data(mesh: &Mesh, data: &BoundData) -> Result<()> {
+/// singular on the boundary, like `1/x` on x = 0, is refused), and, where a body is rigid
+/// next to the fixed boundary, that it leaves room for the prescribed height there
+/// (`φ ≥ g` above, `φ_low ≤ g` below: otherwise no continuous solution exists).
+fn check_boundary_data(mesh: &Mesh, data: &BoundData, model: &Model) -> Result<()> {
     let boundary = mesh.boundary_vertices();
     let adj = crate::fem::VertexTriangles::new(mesh);
+    let rigid_upper =
+        |region: u32| data.stiffness.is_none() || data.rigid_regions.contains(&region);
     for (v, &on) in boundary.iter().enumerate() {
         if !on {
             continue;
         }
         let p = mesh.points[v];
+        let fixed = model.dofs.dof[v].is_none();
+        let g = model.boundary_values.get(v).copied().unwrap_or(0.0);
         for &k in adj.of(v) {
             let region = mesh.regions[k as usize];
             let f = data.load.eval(p, region);
@@ -223,16 +352,34 @@ fn check_boundary_data(mesh: &Mesh, data: &BoundData) -> Result<()> {
                     p[0], p[1]
                 )));
             }
-            if data.stiffness.is_none() {
+            if !fixed {
+                continue;
+            }
+            if rigid_upper(region) {
                 let phi = data.shape.eval(p, region);
-                if phi < 0.0 {
+                if phi < g {
                     return Err(Error::Data(format!(
                         "obstacle.shape φ = {phi} at the boundary point ({}, {}) lies below \
-                         the fixed boundary (u = 0 there): with a rigid obstacle (u ≤ φ) the \
-                         problem has no continuous solution; raise φ to at least 0 on the \
+                         the fixed boundary (u = {g} there): with a rigid obstacle (u ≤ φ) the \
+                         problem has no continuous solution; raise φ to at least {g} on the \
                          boundary or give the obstacle a finite stiffness",
                         p[0], p[1]
                     )));
+                }
+            }
+            if let Some(low) = &data.lower {
+                if low.stiffness.is_none() || low.rigid_regions.contains(&region) {
+                    let phi = low.shape.eval(p, region);
+                    if phi > g {
+                        return Err(Error::Data(format!(
+                            "lower.shape φ_low = {phi} at the boundary point ({}, {}) lies \
+                             above the fixed boundary (u = {g} there): with a rigid body \
+                             below (u ≥ φ_low) the problem has no continuous solution; lower \
+                             φ_low to at most {g} on the boundary or give the body a finite \
+                             stiffness",
+                            p[0], p[1]
+                        )));
+                    }
                 }
             }
         }
