@@ -793,6 +793,26 @@ fn assemble_mass(
         .expect("a mass matrix was asked for")
 }
 
+/// Which vertices are fixed and their heights g (0 elsewhere), as the assembly with `ext`
+/// takes them (SPEC §5).
+pub fn fixed_heights(
+    mesh: &Mesh,
+    adj: &VertexTriangles,
+    ext: &Extensions,
+) -> Result<(Vec<bool>, Vec<f64>)> {
+    match &ext.boundary {
+        Some(b) => {
+            let fixed = FixedBoundary::new(mesh, adj, b.free)?;
+            let g = boundary_heights(mesh, &fixed, b.height)?;
+            Ok((fixed.fixed, g))
+        }
+        None => Ok((
+            mesh.boundary_vertices_with(adj),
+            vec![0.0; mesh.n_vertices()],
+        )),
+    }
+}
+
 /// The heights g at the fixed vertices (SPEC §5), 0 elsewhere: at a vertex, g with the tag
 /// of each fixed boundary edge through it, averaged over those edges (they differ only
 /// where a table gives two sides different heights). A height that is not finite is an

@@ -244,11 +244,7 @@ impl Discretization {
     ) -> Result<Discretization> {
         observer.phase_started("assembly");
         let t0 = Instant::now();
-        let mesh = hierarchy.finest();
-        let bound = BoundData::new(problem, mesh)?;
-        let model = Model::assemble_with(mesh, &bound.data(problem), &bound.extensions(problem))?;
-        check_boundary_data(mesh, &bound, &model)?;
-        check_overflow(mesh, &model)?;
+        let model = assemble_model(problem, hierarchy.finest())?;
         let seconds = t0.elapsed().as_secs_f64();
         observer.phase_finished("assembly", seconds);
         Ok(Discretization {
@@ -326,13 +322,31 @@ impl Discretization {
     }
 }
 
+/// Binds the problem's data to `mesh`, checks it (on the boundary, and for overflow) and
+/// assembles the model S, L, D, φₙ, M of the paper's §2. `problem.mesh` is not used.
+pub fn assemble_model(problem: &Problem, mesh: &Mesh) -> Result<Model> {
+    let bound = bind_and_check(problem, mesh)?;
+    let model = Model::assemble_with(mesh, &bound.data(problem), &bound.extensions(problem))?;
+    check_overflow(mesh, &model)?;
+    Ok(model)
+}
+
+/// Binds the problem's data to `mesh` and checks it where assembly does not sample it (on
+/// the boundary): the checks of [`assemble_model`] that need no assembly.
+pub fn bind_and_check(problem: &Problem, mesh: &Mesh) -> Result<BoundData> {
+    let bound = BoundData::new(problem, mesh)?;
+    check_boundary_data(mesh, &bound, problem)?;
+    Ok(bound)
+}
+
 /// Checks the data where assembly does not sample it: f on the boundary vertices (a load
 /// singular on the boundary, like `1/x` on x = 0, is refused), and, where a body is rigid
 /// next to the fixed boundary, that it leaves room for the prescribed height there
 /// (`φ ≥ g` above, `φ_low ≤ g` below: otherwise no continuous solution exists).
-fn check_boundary_data(mesh: &Mesh, data: &BoundData, model: &Model) -> Result<()> {
+fn check_boundary_data(mesh: &Mesh, data: &BoundData, problem: &Problem) -> Result<()> {
     let boundary = mesh.boundary_vertices();
     let adj = crate::fem::VertexTriangles::new(mesh);
+    let (fixed, heights) = crate::model::fixed_heights(mesh, &adj, &data.extensions(problem))?;
     let rigid_upper =
         |region: u32| data.stiffness.is_none() || data.rigid_regions.contains(&region);
     for (v, &on) in boundary.iter().enumerate() {
@@ -340,8 +354,7 @@ fn check_boundary_data(mesh: &Mesh, data: &BoundData, model: &Model) -> Result<(
             continue;
         }
         let p = mesh.points[v];
-        let fixed = model.dofs.dof[v].is_none();
-        let g = model.boundary_values.get(v).copied().unwrap_or(0.0);
+        let (fixed, g) = (fixed[v], heights[v]);
         for &k in adj.of(v) {
             let region = mesh.regions[k as usize];
             let f = data.load.eval(p, region);
