@@ -251,7 +251,7 @@ pub struct Model {
     /// The body below the membrane (SPEC §5).
     pub lower: Option<Body>,
     /// u where it is prescribed (the heights g on Γ_D), 0 at the other vertices; over all
-    /// vertices (empty for models that only a solver uses).
+    /// vertices (empty when g = 0 everywhere, and for models that only a solver uses).
     pub boundary_values: Vec<f64>,
     /// The lifting `S_fix G` over the unknowns (empty when G = 0): `d` is the assembled
     /// load minus it (SPEC §5).
@@ -311,15 +311,7 @@ impl Model {
         };
         let (s, l_consistent) =
             assemble_stiffness_and_mass(mesh, &dofs, &adj, &pattern, t, consistent_h);
-        let body = assemble_body(
-            mesh,
-            &adj,
-            &dofs,
-            &pattern,
-            &upper,
-            l_consistent,
-            NAMES_UPPER,
-        )?;
+        let body = assemble_body(mesh, &adj, &dofs, &upper, l_consistent, NAMES_UPPER)?;
         let load = data.load;
         let mut d = assemble_vector(mesh, &dofs, &adj, &|e, r, a| e.weighted_load(load, r, a));
         if let Some(i) = d.iter().position(|v| !v.is_finite()) {
@@ -342,14 +334,14 @@ impl Model {
         let (boundary_values, lift) = match (&ext.boundary, &fixed) {
             (Some(b), Some(f)) => {
                 let g = boundary_heights(mesh, f, b.height)?;
-                let lift = if g.iter().any(|&x| x != 0.0) {
-                    assemble_lift(mesh, &dofs, &adj, t, &g)
+                if g.iter().any(|&x| x != 0.0) {
+                    let lift = assemble_lift(mesh, &dofs, &adj, t, &g);
+                    (g, lift)
                 } else {
-                    Vec::new()
-                };
-                (g, lift)
+                    (Vec::new(), Vec::new())
+                }
             }
-            _ => (vec![0.0; mesh.n_vertices()], Vec::new()),
+            _ => (Vec::new(), Vec::new()),
         };
         for (di, li) in d.iter_mut().zip(&lift) {
             *di -= li;
@@ -367,7 +359,6 @@ impl Model {
                     mesh,
                     &adj,
                     &dofs,
-                    &pattern,
                     low,
                     l_consistent,
                     NAMES_LOWER,
@@ -503,6 +494,42 @@ impl Model {
                 j + foundation_energy(&low.l, &low.penetration(v))
             }
             None => j,
+        }
+    }
+
+    /// `true` when some body holds some unknown rigidly (the obstacle rigid, or rigid in
+    /// some regions, or a body below that is).
+    pub fn has_rigid_part(&self) -> bool {
+        self.is_rigid()
+            || self.rigid.is_some()
+            || self
+                .lower
+                .as_ref()
+                .is_some_and(|b| b.l.is_rigid() || b.rigid.is_some())
+    }
+
+    /// Projects `v` onto the rigid bodies' constraints: `V ≤ φ` where the obstacle is
+    /// rigid, `V ≥ φ_low` where the body below is.
+    pub fn project(&self, v: &mut [f64]) {
+        if !self.is_extended() {
+            if self.is_rigid() {
+                for ((vi, fi), &c) in v.iter_mut().zip(&self.phi).zip(&self.can_touch) {
+                    if c {
+                        *vi = vi.min(*fi);
+                    }
+                }
+            }
+            return;
+        }
+        for (i, vi) in v.iter_mut().enumerate() {
+            if self.can_touch[i] && self.rigid_at(i) {
+                *vi = vi.min(self.phi[i]);
+            }
+            if let Some(low) = &self.lower {
+                if low.can_touch[i] && low.rigid_at(i) {
+                    *vi = vi.max(low.phi[i]);
+                }
+            }
         }
     }
 
@@ -690,12 +717,10 @@ fn assemble_body(
     mesh: &Mesh,
     adj: &VertexTriangles,
     dofs: &DofMap,
-    pattern: &Arc<crate::sparse::Pattern>,
     data: &BodyData,
     l_consistent: Option<Csr>,
     names: BodyNames,
 ) -> Result<Body> {
-    let _ = pattern;
     let masked = Masked::new(*data);
     // Vertices whose patch meets a rigid region (every vertex for a wholly rigid body).
     let rigid_vertex: Option<Vec<bool>> = match (data.stiffness, data.rigid_regions) {

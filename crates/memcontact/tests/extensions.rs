@@ -299,3 +299,331 @@ refine = 2",
         });
     }
 }
+
+/// The formulations of SPEC §4 and §5 on one case: active set (2f), the QP with the extra
+/// variables (2c), coordinate descent (2b) and multigrid agree to 1e-8 with certificates
+/// ≤ 1e-9. Returns the active-set report and the largest difference.
+fn agree(name: &str, text: &str) -> (Discretization, memcontact::Report, f64) {
+    let d = disc(text);
+    let (ua, ra) = solve(&d, Method::ActiveSet, 1e-11);
+    let scale = ua.iter().fold(0.0f64, |m, x| m.max(x.abs())).max(1e-300);
+    let mut worst = 0.0f64;
+    for method in [Method::Qp, Method::Coordinate, Method::Multigrid] {
+        let (u, r) = solve(&d, method, 1e-11);
+        let c = d.model.certificate(&r.u);
+        assert!(
+            c.residual_2e <= 1e-9 && c.residual_2f <= 1e-9,
+            "{name} {}: {c:?}",
+            method.name()
+        );
+        let diff = u
+            .iter()
+            .zip(&ua)
+            .fold(0.0f64, |m, (x, y)| m.max((x - y).abs()))
+            / scale;
+        assert!(diff <= 1e-8, "{name} {}: {diff:e}", method.name());
+        assert!(
+            (r.energy - ra.energy).abs() <= 1e-9 * ra.energy.abs().max(1e-300),
+            "{name} {}",
+            method.name()
+        );
+        worst = worst.max(diff);
+    }
+    let c = d.model.certificate(&ra.u);
+    assert!(c.kkt() <= 1e-9, "{name} active-set: {c:?}");
+    eprintln!(
+        "{name}: max |U − U_active-set| / max|U| = {worst:.1e}, certificate {:.1e}",
+        c.kkt()
+    );
+    (d, ra, worst)
+}
+
+/// The square with a 16 × 16 grid and its multigrid levels.
+const SQUARE16: &str = r#"
+[mesh]
+generator = "rectangle"
+nx = 16
+ny = 16
+"#;
+
+/// A square site with a region `core` in the middle (polygon generator, refined once so
+/// that multigrid has levels).
+const SITE: &str = r#"
+[mesh]
+generator = "polygon"
+outer = [[0, 0], [1, 0], [1, 1], [0, 1]]
+regions = [{ name = "core", polygon = [[0.35, 0.3], [0.65, 0.3], [0.65, 0.7], [0.35, 0.7]] }]
+size = 0.12
+refine = 1
+"#;
+
+/// The cases of the issue's list, each with consistent and lumped foundations.
+fn cases(foundation: &str) -> Vec<(String, String)> {
+    let f = format!("foundation = \"{foundation}\"");
+    vec![
+        (
+            format!("boundary heights ({foundation})"),
+            format!(
+                r#"{SQUARE16}
+[membrane]
+tension = 1.0
+load = 16
+
+[obstacle]
+shape = "0.45 + 0.1*x"
+stiffness = 600
+{f}
+
+[boundary]
+height = {{ left = 0.2, right = "0.1 + 0.2*y", bottom = "0.05*sin(pi*x)", top = 0.25 }}
+"#
+            ),
+        ),
+        (
+            format!("free edge ({foundation})"),
+            format!(
+                r#"{SQUARE16}
+[membrane]
+tension = 1.0
+load = "14*(1 + x)"
+
+[obstacle]
+shape = "0.3 + 0.1*y"
+stiffness = 800
+{f}
+
+[boundary]
+height = "0.1*x"
+free = ["top"]
+"#
+            ),
+        ),
+        (
+            format!("elastic body below ({foundation})"),
+            format!(
+                r#"{SQUARE16}
+[membrane]
+tension = 1.0
+load = "40*sin(2*pi*x)*(0.5 + y)"
+
+[obstacle]
+shape = 0.25
+stiffness = 500
+{f}
+
+[lower]
+shape = "-0.2 + 0.05*y"
+stiffness = 300
+{f}
+
+[boundary]
+height = "0.05*y"
+"#
+            ),
+        ),
+        (
+            format!("both rigid, squeezed ({foundation})"),
+            format!(
+                r#"{SITE}
+[membrane]
+tension = 1.0
+load = "30*(x - 0.45)"
+
+[obstacle]
+shape = "0.06 + 0.3*(x - 0.5)^2"
+stiffness = "rigid"
+
+[lower]
+shape = "min(0.06 + 0.3*(x - 0.5)^2, 0.2 - 2*((x - 0.5)^2 + (y - 0.5)^2))"
+stiffness = {{ core = "rigid", default = 400 }}
+{f}
+"#
+            ),
+        ),
+        (
+            format!("rigid region next to elastic ({foundation})"),
+            format!(
+                r#"{SITE}
+[membrane]
+tension = 1.0
+load = 14
+
+[obstacle]
+shape = "0.2 + 0.06*x"
+stiffness = {{ core = "rigid", default = 350 }}
+{f}
+"#
+            ),
+        ),
+    ]
+}
+
+#[test]
+fn formulations_agree_beyond_the_paper_frame() {
+    for foundation in ["consistent", "lumped"] {
+        for (name, text) in cases(foundation) {
+            let (d, r, _) = agree(&name, &text);
+            let m = &d.model;
+            let up = m.states(&r.u);
+            let low = m.lower_states(&r.u);
+            // Each case exercises what it names.
+            if name.starts_with("both rigid") {
+                let squeezed = up
+                    .iter()
+                    .zip(&low)
+                    .filter(|(&a, &b)| a == 0 && b == 0)
+                    .count();
+                assert!(squeezed >= 3, "{name}: {squeezed} squeezed vertices");
+            }
+            if name.starts_with("elastic body below") {
+                assert!(
+                    low.contains(&1) && up.contains(&1),
+                    "{name}: both bodies act"
+                );
+            }
+            if name.starts_with("rigid region") {
+                let rigid = m.rigid.as_ref().expect("rigid vertices");
+                let on_rigid = (0..m.n()).filter(|&i| rigid[i] && up[i] == 0).count();
+                let pen = (0..m.n()).filter(|&i| !rigid[i] && up[i] == 1).count();
+                assert!(
+                    on_rigid > 0 && pen > 0,
+                    "{name}: {on_rigid} held, {pen} in foam"
+                );
+                // The rigid vertices never penetrate.
+                assert!((0..m.n()).all(|i| !rigid[i] || r.u[i] <= m.phi[i]));
+            }
+            if name.starts_with("free edge") {
+                assert!(m.n() > 15 * 15, "{name}: the free side carries unknowns");
+            }
+        }
+    }
+}
+
+/// The body below is the mirror of the obstacle: the lower body (φ_low, h) under the load
+/// f and heights g has the solution −U of the obstacle (−φ_low, h) under −f and −g.
+#[test]
+fn the_body_below_is_the_mirrored_obstacle() {
+    for stiffness in ["300", "\"rigid\""] {
+        for foundation in ["consistent", "lumped"] {
+            let lower = format!(
+                r#"{SQUARE16}
+[membrane]
+tension = 1.2
+load = "-20*(1 + 0.3*x)"
+
+[obstacle]
+shape = 0
+stiffness = 0
+
+[lower]
+shape = "-0.2 - 0.1*x*y"
+stiffness = {stiffness}
+foundation = "{foundation}"
+
+[boundary]
+height = "-0.02*x"
+"#
+            );
+            let upper = format!(
+                r#"{SQUARE16}
+[membrane]
+tension = 1.2
+load = "20*(1 + 0.3*x)"
+
+[obstacle]
+shape = "0.2 + 0.1*x*y"
+stiffness = {stiffness}
+foundation = "{foundation}"
+
+[boundary]
+height = "0.02*x"
+"#
+            );
+            let (dl, du) = (disc(&lower), disc(&upper));
+            for method in [Method::ActiveSet, Method::Multigrid, Method::Qp] {
+                let (ul, rl) = solve(&dl, method, 1e-12);
+                let (uu, ru) = solve(&du, method, 1e-12);
+                let scale = uu.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+                for (a, b) in ul.iter().zip(&uu) {
+                    assert!((a + b).abs() <= 1e-10 * scale, "{stiffness} {foundation}");
+                }
+                assert!((rl.energy - ru.energy).abs() <= 1e-10 * ru.energy.abs());
+                let states = dl.model.lower_states(&rl.u);
+                assert!(states.contains(&0) || states.contains(&1), "the body acts");
+            }
+        }
+    }
+}
+
+/// Extension data that change nothing give the paper's answer to rounding through the
+/// general code paths: a body below that never touches, a stiffness table whose rigid
+/// region holds nothing the answer needs (here: rigid far below the membrane is refused,
+/// so a body below with h = 0).
+#[test]
+fn inactive_extensions_reduce_to_the_paper_model() {
+    let paper = format!(
+        r#"{SQUARE16}
+[membrane]
+tension = 1.0
+load = 20
+
+[obstacle]
+shape = "0.5 + 0.1*sin(2*pi*x)*cos(2*pi*y)"
+stiffness = 1000
+"#
+    );
+    let d0 = disc(&paper);
+    for extra in [
+        "[lower]\nshape = -10\nstiffness = 500\n",
+        "[lower]\nshape = 0.3\nstiffness = 0\n",
+        "[lower]\nshape = -10\nstiffness = \"rigid\"\n",
+    ] {
+        let d1 = disc(&format!("{paper}\n{extra}"));
+        assert!(d1.model.is_extended());
+        for method in [
+            Method::ActiveSet,
+            Method::Coordinate,
+            Method::Multigrid,
+            Method::Qp,
+        ] {
+            let (u0, r0) = solve(&d0, method, 1e-11);
+            let (u1, r1) = solve(&d1, method, 1e-11);
+            let diff = u0
+                .iter()
+                .zip(&u1)
+                .fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
+            assert!(diff <= 1e-12, "{extra} {}: {diff:e}", method.name());
+            assert!((r0.energy - r1.energy).abs() <= 1e-12 * r0.energy.abs());
+        }
+    }
+}
+
+#[test]
+fn overlapping_rigid_bodies_are_refused_with_their_vertices() {
+    let e = refused(&format!(
+        r#"{SQUARE16}
+[membrane]
+tension = 1.0
+load = 1
+
+[obstacle]
+shape = "0.1"
+stiffness = "rigid"
+
+[lower]
+shape = "0.2*exp(-50*((x-0.5)^2 + (y-0.5)^2)) - 0.05"
+stiffness = "rigid"
+"#
+    ));
+    assert!(e.contains("both bodies are rigid and overlap"), "{e}");
+    assert!(e.contains("vertex") && e.contains("φ_low = "), "{e}");
+    // Rigid bodies that leave no room at the fixed boundary are refused too.
+    let e = refused(&format!(
+        "{SQUARE16}\n[membrane]\ntension = 1\nload = 1\n\n[obstacle]\nshape = 1\n\
+         stiffness = 10\n\n[lower]\nshape = 0.1\nstiffness = \"rigid\"\n"
+    ));
+    assert!(
+        e.contains("lower.shape") && e.contains("above the fixed boundary"),
+        "{e}"
+    );
+}

@@ -171,13 +171,7 @@ pub fn solve_with(
         if k > first {
             let mut next = vec![0.0; m.n()];
             levels.transfers[k - 1].prolongate(&v, &mut next);
-            if m.is_rigid() {
-                for ((x, f), &c) in next.iter_mut().zip(&m.phi).zip(&m.can_touch) {
-                    if c && *x > *f {
-                        *x = *f;
-                    }
-                }
-            }
+            m.project(&mut next);
             v = next;
         }
         let t0 = Instant::now();
@@ -403,12 +397,27 @@ fn level_solve(ls: LevelSolve) -> Result<(usize, f64, Option<Certificate>)> {
             for _ in 0..options.cycles {
                 mg.v_cycle(&a, &mut delta, &g);
             }
+            let extended = model.is_extended();
             for (i, d) in delta.iter_mut().enumerate() {
                 if st.truncated[i] || !d.is_finite() {
                     *d = 0.0;
-                } else if model.is_rigid() && model.can_touch[i] {
-                    // Project onto the defect obstacle: V + δ ≤ φ.
+                    continue;
+                }
+                // Project onto the defect obstacles of the rigid bodies: V + δ ≤ φ (and
+                // V + δ ≥ φ_low).
+                if !extended {
+                    if model.is_rigid() && model.can_touch[i] {
+                        *d = d.min(model.phi[i] - v[i]);
+                    }
+                    continue;
+                }
+                if model.can_touch[i] && model.rigid_at(i) {
                     *d = d.min(model.phi[i] - v[i]);
+                }
+                if let Some(low) = &model.lower {
+                    if low.can_touch[i] && low.rigid_at(i) {
+                        *d = d.max(low.phi[i] - v[i]);
+                    }
                 }
             }
         });
