@@ -7,7 +7,9 @@ use anyhow::{anyhow, bail, Context, Result};
 use memcontact::convergence::{
     self as study, LevelResult, ManufacturedLoad, Study, StudySettings, Sweep, Target,
 };
-use memcontact::exact::{DiskSolution, ExactSolution, Manufactured};
+use memcontact::exact::{
+    BenchmarkKind, DiskSolution, ExactSolution, Manufactured, ManufacturedCosine, ObstacleBenchmark,
+};
 use memcontact::field::Stiffness as FieldStiffness;
 use memcontact::io::csv::write_columns_csv;
 use memcontact::io::result_set::ResultSet;
@@ -15,7 +17,9 @@ use memcontact::io::vtu::DataArray;
 use memcontact::mesh::refine::Hierarchy;
 use memcontact::model::{Foundation, ProblemData, Sampling};
 use memcontact::output::{input_hash, new_run_id, write_manifest, MANIFEST};
-use memcontact::problem::{ExactSpec, ManufacturedDomain, MeshSource};
+use memcontact::problem::{
+    BenchmarkBody, ExactSpec, ManufacturedDomain, ManufacturedForm, MeshSource,
+};
 use memcontact::run::BoundData;
 use memcontact::Case;
 use memcontact_plot as plot;
@@ -81,8 +85,14 @@ pub struct Args {
 pub enum Exact {
     /// `kind = "disk"`: the axisymmetric disc (Bessel functions).
     Disk(DiskCase),
-    /// `kind = "manufactured"`: the load is replaced by `f = −tΔu + h(u − φ)⁺`.
+    /// `kind = "manufactured"`: the load is replaced by `f = −tΔu + h(u − φ)⁺` (less the
+    /// body below's reaction) and the heights of the fixed boundary by u.
     Manufactured(Manufactured),
+    /// `kind = "manufactured"`, `form = "cosine"`: the same with a u whose normal
+    /// derivative vanishes on every side of the rectangle.
+    Cosine(ManufacturedCosine),
+    /// `kind = "petsc-ex9"` or `"mfem-ex36"`: the rigid spherical obstacle benchmarks.
+    Benchmark(ObstacleBenchmark),
 }
 
 impl Exact {
@@ -91,7 +101,31 @@ impl Exact {
         match self {
             Exact::Disk(d) => &d.solution,
             Exact::Manufactured(m) => m,
+            Exact::Cosine(m) => m,
+            Exact::Benchmark(b) => b,
         }
+    }
+
+    /// Whether the load and the boundary heights are replaced by the manufactured ones.
+    fn manufactured(&self) -> bool {
+        matches!(self, Exact::Manufactured(_) | Exact::Cosine(_))
+    }
+}
+
+/// The exact solution as a coefficient: the heights of the fixed boundary of a
+/// manufactured case.
+struct ExactHeight<'a>(&'a dyn ExactSolution);
+
+impl memcontact::fem::Coefficient for ExactHeight<'_> {
+    fn at(&self, p: [f64; 2], _: u32) -> f64 {
+        if self.0.contains(p) {
+            self.0.value(p)
+        } else {
+            f64::NAN
+        }
+    }
+    fn on_region(&self, _: u32) -> Option<f64> {
+        None
     }
 }
 
@@ -148,6 +182,10 @@ pub fn parse_exact(case: &Case) -> Result<Option<Exact>> {
             let h = match &p.obstacle.stiffness {
                 FieldStiffness::Rigid => None,
                 FieldStiffness::Elastic(h) => Some(constant("obstacle.stiffness", h)?),
+                FieldStiffness::Mixed(_) => bail!(
+                    "[exact] kind = \"disk\" needs a constant obstacle.stiffness (the closed \
+                     form is for constant t, f, h, φ), not a table with rigid regions"
+                ),
             };
             let solution = DiskSolution::new(center, radius, t, f, h, phi)
                 .context("[exact] kind = \"disk\"")?;
@@ -160,11 +198,43 @@ pub fn parse_exact(case: &Case) -> Result<Option<Exact>> {
                 phi,
             })))
         }
-        &ExactSpec::Manufactured { domain, amplitude } => {
-            if p.obstacle.stiffness.is_rigid() {
+        &ExactSpec::Manufactured {
+            domain,
+            amplitude,
+            form,
+        } => {
+            if p.obstacle.stiffness.field().is_none()
+                || p.lower
+                    .as_ref()
+                    .is_some_and(|b| b.stiffness.field().is_none())
+            {
                 bail!(
-                    "[exact] kind = \"manufactured\" needs a finite obstacle.stiffness h: its \
-                     load f = −tΔu + h(u − φ)⁺ has no meaning for the rigid obstacle"
+                    "[exact] kind = \"manufactured\" needs a finite obstacle.stiffness h (and a \
+                     finite lower.stiffness with a body below): its load f = −tΔu + h(u − φ)⁺ \
+                     has no meaning for a rigid body or rigid regions"
+                );
+            }
+            if form == ManufacturedForm::Cosine {
+                let MeshSource::Rectangle { x0, y0, x1, y1, .. } = p.mesh.source else {
+                    bail!(
+                        "[exact] form = \"cosine\" needs [mesh] generator = \"rectangle\" (its \
+                         x0, y0, x1, y1 define the domain); this case uses {}",
+                        describe_mesh(case)
+                    );
+                };
+                if domain != ManufacturedDomain::Rectangle {
+                    bail!("[exact] form = \"cosine\" needs domain = \"rectangle\"");
+                }
+                let m = ManufacturedCosine::rectangle(x0, y0, x1, y1, amplitude)
+                    .context("[exact] kind = \"manufactured\"")?;
+                return Ok(Some(Exact::Cosine(m)));
+            }
+            if !p.boundary.free.is_empty() {
+                bail!(
+                    "[exact] kind = \"manufactured\" with u vanishing on the boundary needs the \
+                     whole boundary fixed (boundary.free = {:?}): its normal derivative does not \
+                     vanish on a free side; use form = \"cosine\"",
+                    p.boundary.free
                 );
             }
             let m = match domain {
@@ -187,7 +257,103 @@ pub fn parse_exact(case: &Case) -> Result<Option<Exact>> {
             .context("[exact] kind = \"manufactured\"")?;
             Ok(Some(Exact::Manufactured(m)))
         }
+        ExactSpec::PetscEx9 { body } | ExactSpec::MfemEx36 { body } => {
+            let kind = if matches!(spec, ExactSpec::PetscEx9 { .. }) {
+                BenchmarkKind::PetscEx9
+            } else {
+                BenchmarkKind::MfemEx36
+            };
+            let name = spec.kind();
+            match (kind, &p.mesh.source) {
+                (BenchmarkKind::PetscEx9, MeshSource::Rectangle { x0, y0, x1, y1, .. })
+                    if [*x0, *y0, *x1, *y1] == [-2.0, -2.0, 2.0, 2.0] => {}
+                (BenchmarkKind::PetscEx9, _) => bail!(
+                    "[exact] kind = \"{name}\" needs [mesh] generator = \"rectangle\" with \
+                     x0 = y0 = -2, x1 = y1 = 2; this case uses {}",
+                    describe_mesh(case)
+                ),
+                (BenchmarkKind::MfemEx36, MeshSource::Disk { center, radius, .. })
+                    if *center == [0.0, 0.0] && *radius == 1.0 => {}
+                (BenchmarkKind::MfemEx36, _) => bail!(
+                    "[exact] kind = \"{name}\" needs [mesh] generator = \"disk\" with center = \
+                     [0, 0] and radius = 1; this case uses {}",
+                    describe_mesh(case)
+                ),
+            }
+            if p.membrane.load.constant() != Some(0.0) || t != 1.0 {
+                bail!("[exact] kind = \"{name}\" needs membrane.load = 0 and membrane.tension = 1");
+            }
+            let below = *body == BenchmarkBody::Lower;
+            let (rigid, key) = if below {
+                (
+                    p.lower.as_ref().is_some_and(|b| b.stiffness.is_rigid()),
+                    "lower",
+                )
+            } else {
+                (p.obstacle.stiffness.is_rigid(), "obstacle")
+            };
+            if !rigid {
+                bail!("[exact] kind = \"{name}\" needs {key}.stiffness = \"rigid\"");
+            }
+            if below && p.obstacle.stiffness.field().and_then(|h| h.constant()) != Some(0.0) {
+                bail!(
+                    "[exact] kind = \"{name}\" with body = \"lower\" needs no obstacle above: \
+                     obstacle.stiffness = 0"
+                );
+            }
+            if !below && p.lower.is_some() {
+                bail!("[exact] kind = \"{name}\" has no body below: remove [lower]");
+            }
+            Ok(Some(Exact::Benchmark(ObstacleBenchmark::new(kind, below))))
+        }
     }
+}
+
+/// Checks that the case describes the benchmark `b` on `mesh`: the rigid body's surface at
+/// every vertex and the heights on the fixed boundary agree with the closed form.
+fn check_benchmark(
+    b: &ObstacleBenchmark,
+    case: &Case,
+    mesh: &memcontact::mesh::Mesh,
+    fields: &BoundData,
+) -> Result<()> {
+    let (surface, key) = if b.below() {
+        (
+            &fields.lower.as_ref().expect("checked by parse_exact").shape,
+            "lower.shape",
+        )
+    } else {
+        (&fields.shape, "obstacle.shape")
+    };
+    let adj = memcontact::mesh::VertexTriangles::new(mesh);
+    let (fixed, heights) =
+        memcontact::model::fixed_heights(mesh, &adj, &fields.extensions(&case.problem))?;
+    let tol = 1e-9;
+    for (v, &p) in mesh.points.iter().enumerate() {
+        let region = mesh.regions[adj.of(v)[0] as usize];
+        let (given, expected) = (surface.eval(p, region), b.surface(p));
+        if (given - expected).abs() > tol {
+            bail!(
+                "[exact] kind = \"{}\": {key} is {given} at ({}, {}), the benchmark's \
+                 surface is {expected} there",
+                case.exact.as_ref().map_or("", |e| e.kind()),
+                p[0],
+                p[1]
+            );
+        }
+        if fixed[v] && (heights[v] - b.value(p)).abs() > tol {
+            bail!(
+                "[exact] kind = \"{}\": boundary.height is {} at ({}, {}), the benchmark's u \
+                 is {} there (g = u on the boundary)",
+                case.exact.as_ref().map_or("", |e| e.kind()),
+                heights[v],
+                p[0],
+                p[1],
+                b.value(p)
+            );
+        }
+    }
+    Ok(())
 }
 
 fn describe_mesh(case: &Case) -> String {
@@ -268,22 +434,46 @@ pub fn run(args: &Args) -> Result<()> {
         eprintln!("warning: {w}");
     }
     let fields = BoundData::new(&case.problem, hierarchy.finest())?;
+    if let Some(Exact::Benchmark(b)) = &exact {
+        check_benchmark(b, &case, hierarchy.finest(), &fields)?;
+    }
     let manufactured_load;
     let load: &dyn memcontact::fem::Coefficient = match &exact {
-        Some(Exact::Manufactured(m)) => {
+        Some(e) if e.manufactured() => {
             manufactured_load = ManufacturedLoad {
-                exact: m,
+                exact: e.solution(),
                 tension: t,
                 stiffness: fields
                     .stiffness
                     .as_ref()
                     .expect("elastic, checked by parse_exact"),
                 shape: &fields.shape,
+                lower: fields.lower.as_ref().map(|b| {
+                    (
+                        b.stiffness
+                            .as_ref()
+                            .expect("elastic, checked by parse_exact")
+                            as &dyn memcontact::fem::Coefficient,
+                        &b.shape as &dyn memcontact::fem::Coefficient,
+                    )
+                }),
             };
             &manufactured_load
         }
         _ => &fields.load,
     };
+    // The data beyond the paper's frame; a manufactured u also gives the fixed boundary
+    // its heights.
+    let exact_height = exact.as_ref().map(|e| ExactHeight(e.solution()));
+    let mut extensions = fields.extensions(&case.problem);
+    if let (Some(e), Some(h)) = (&exact, &exact_height) {
+        if e.manufactured() {
+            extensions.boundary = Some(memcontact::model::BoundaryData {
+                free: &case.problem.boundary.free,
+                height: h,
+            });
+        }
+    }
     // The problem data of one variant (foundation, sampling) of the case.
     let data_for = |v: &Variant| ProblemData {
         load,
@@ -307,10 +497,24 @@ pub fn run(args: &Args) -> Result<()> {
             );
         }
     }
-    if let Some(Exact::Manufactured(_)) = &exact {
+    if exact.as_ref().is_some_and(Exact::manufactured) {
         let _ = writeln!(
             out,
-            "  load         membrane.load replaced by the manufactured f = −tΔu + h(u − φ)⁺"
+            "  load         membrane.load replaced by the manufactured f = −tΔu + h(u − φ)⁺{}",
+            if case.problem.lower.is_some() {
+                " − h_low(φ_low − u)⁺"
+            } else {
+                ""
+            }
+        );
+        let _ = writeln!(
+            out,
+            "  boundary     the fixed boundary's heights replaced by the manufactured u{}",
+            if case.problem.boundary.free.is_empty() {
+                String::new()
+            } else {
+                format!(" (free: {})", case.problem.boundary.free.join(", "))
+            }
         );
     }
     if args.h_sweep {
@@ -399,9 +603,10 @@ pub fn run(args: &Args) -> Result<()> {
             bar.steps(r.level + 1, total);
             bar.message(&format!("level {} …", r.level + 1));
         };
-        let s = study::run(
+        let s = study::run_with(
             hierarchy.clone(),
             &data,
+            &extensions,
             target,
             &study_settings,
             &mut progress,
@@ -522,6 +727,17 @@ fn table(case: &Case, v: &Variant, s: &Study, exact: bool, reference: Option<&st
         case.settings.tolerance,
         reference.map(|r| format!("; {r}")).unwrap_or_default()
     );
+    if let Some(low) = &case.problem.lower {
+        let _ = writeln!(
+            o,
+            "  body below: {}",
+            if low.stiffness.is_rigid() {
+                "rigid"
+            } else {
+                low.foundation.name()
+            }
+        );
+    }
     let radius = exact && s.levels.iter().any(|r| r.contact_radius_error.is_some());
     let _ = write!(
         o,

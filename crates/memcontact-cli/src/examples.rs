@@ -56,6 +56,48 @@ const EXAMPLES: &[Example] = &[
         )],
     },
     Example {
+        name: "roof-frame",
+        about: "a roof membrane on a frame of varying height, under snow, sagging onto insulation below it",
+        files: &[("roof-frame.toml", include_str!("../../../examples/roof-frame.toml"))],
+    },
+    Example {
+        name: "geomembrane",
+        about: "a geomembrane liner between the subsoil below and a cover layer above (two bodies)",
+        files: &[(
+            "geomembrane.toml",
+            include_str!("../../../examples/geomembrane.toml"),
+        )],
+    },
+    Example {
+        name: "plinth",
+        about: "a cover resting on a foam bed interrupted by a rigid plinth (a body rigid in one region)",
+        files: &[("plinth.toml", include_str!("../../../examples/plinth.toml"))],
+    },
+    Example {
+        name: "petsc-ex9",
+        about: "PETSc SNES ex9, the rigid obstacle benchmark with boundary data (exact solution known)",
+        files: &[
+            ("petsc-ex9.toml", include_str!("../../../examples/petsc-ex9.toml")),
+            (
+                "petsc-ex9-lower.toml",
+                include_str!("../../../examples/petsc-ex9-lower.toml"),
+            ),
+        ],
+    },
+    Example {
+        name: "mfem-ex36",
+        about: "MFEM ex36, the obstacle benchmark on the unit disc (exact solution known)",
+        files: &[("mfem-ex36.toml", include_str!("../../../examples/mfem-ex36.toml"))],
+    },
+    Example {
+        name: "manufactured-free-edge",
+        about: "a manufactured solution with boundary heights, a free edge and two elastic bodies",
+        files: &[(
+            "manufactured-free-edge.toml",
+            include_str!("../../../examples/manufactured-free-edge.toml"),
+        )],
+    },
+    Example {
         name: "gmsh-disk",
         about: "a Gmsh mesh with two physical surfaces (foam, soil) of different stiffness",
         files: &[

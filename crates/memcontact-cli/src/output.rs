@@ -94,6 +94,59 @@ pub fn human(label: &str, outcome: &Outcome, written: Option<(&Summary, &Path)>)
             .map(|e| format!(" (ε = {e:.4e})"))
             .unwrap_or_default()
     );
+    if let Some(rigid) = &m.rigid {
+        let _ = writeln!(
+            o,
+            "  rigid part   {} unknowns held rigidly (u ≤ φ) by rigid regions",
+            rigid.iter().filter(|&&x| x).count()
+        );
+    }
+    if let Some(low) = &m.lower {
+        let _ = writeln!(
+            o,
+            "  body below   foundation {}{}, {} unknowns it can touch",
+            if low.l.is_rigid() {
+                "rigid"
+            } else {
+                low.foundation.name()
+            },
+            match &low.rigid {
+                Some(r) => format!(
+                    " ({} unknowns held rigidly)",
+                    r.iter().filter(|&&x| x).count()
+                ),
+                None => String::new(),
+            },
+            low.can_touch.iter().filter(|&&c| c).count()
+        );
+    }
+    let fixed = m.dofs.dof.iter().filter(|d| d.is_none()).count();
+    let free = mesh
+        .boundary_vertices()
+        .iter()
+        .enumerate()
+        .filter(|(v, &b)| b && m.dofs.dof[*v].is_some())
+        .count();
+    if free > 0 || !m.boundary_values.is_empty() {
+        let heights = m
+            .boundary_values
+            .iter()
+            .enumerate()
+            .filter(|(v, _)| m.dofs.dof[*v].is_none())
+            .map(|(_, &g)| g);
+        let (lo, hi) = heights.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), g| {
+            (a.min(g), b.max(g))
+        });
+        let range = if lo.is_finite() {
+            format!(", heights g in [{lo:.6e}, {hi:.6e}]")
+        } else {
+            ", heights g = 0".to_string()
+        };
+        let _ = writeln!(
+            o,
+            "  boundary     {fixed} fixed vertices{range}, {free} vertices on free edges"
+        );
+    }
     let why = match (&r.fallback, r.requested) {
         (Some(f), _) => format!(
             " (auto: {} {} at KKT {:.1e}, fell back)",
@@ -125,10 +178,29 @@ pub fn human(label: &str, outcome: &Outcome, written: Option<(&Summary, &Path)>)
         "  contact      {} vertices ({} touching, {} penetrating), area {:.6e}",
         t.contact_vertices, t.touching_vertices, t.penetrating_vertices, t.contact_area
     );
+    if let Some(l) = &t.lower {
+        let _ = writeln!(
+            o,
+            "  below        {} vertices on the body below ({} touching, {} sunk in), area \
+             {:.6e}; {} squeezed between both",
+            l.contact_low_vertices,
+            l.touching_low_vertices,
+            l.penetrating_low_vertices,
+            l.contact_area_low,
+            l.squeezed_vertices
+        );
+    }
     let _ = writeln!(
         o,
-        "  forces       total load {:.6e}, total contact force {:.6e}",
-        t.total_load, t.total_contact_force
+        "  forces       total load {:.6e}, total contact force {:.6e}{}",
+        t.total_load,
+        t.total_contact_force,
+        t.lower
+            .map(|l| format!(
+                ", body below's force {:.6e} (upward)",
+                l.total_contact_force_low
+            ))
+            .unwrap_or_default()
     );
     let _ = writeln!(
         o,

@@ -321,15 +321,28 @@ fn every_example_case_solves_with_a_certificate() {
         assert!(o.status.success(), "{name}: {}", text(&o));
         let s = summary(&out);
         assert!(s["kkt_residual"].as_f64().unwrap() <= 1e-9, "{name}");
-        // Equilibrium: the obstacle never carries more than the load.
+        // Equilibrium: the obstacle never carries more than the load (in the paper's
+        // frame: with boundary heights or a body below, the frame and the body below
+        // carry their share, and an obstacle that displaces the unloaded membrane, as in
+        // the obstacle benchmarks, carries its own force; then only the signs of the
+        // bodies' forces are known).
         let (load, force) = (
             s["total_load"].as_f64().unwrap(),
             s["total_contact_force"].as_f64().unwrap(),
         );
-        assert!(
-            force >= -1e-12 && force <= load * (1.0 + 1e-12),
-            "{name}: {force} vs {load}"
-        );
+        let beyond =
+            s.get("fixed_vertices").is_some() || s.get("lower_foundation").is_some() || load == 0.0;
+        if beyond {
+            let low = s
+                .get("total_contact_force_low")
+                .map_or(0.0, |f| f.as_f64().unwrap());
+            assert!(force >= -1e-12 && low >= -1e-12, "{name}: {force}, {low}");
+        } else {
+            assert!(
+                force >= -1e-12 && force <= load * (1.0 + 1e-12),
+                "{name}: {force} vs {load}"
+            );
+        }
     }
     assert!(n >= 5);
 }

@@ -23,6 +23,7 @@
 //! The crate prints nothing: errors are returned, notes are handed back to the caller.
 
 pub mod axes;
+pub mod bodies;
 pub mod canvas;
 pub mod colormap;
 pub mod lines;

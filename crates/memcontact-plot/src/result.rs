@@ -86,7 +86,7 @@ pub fn load(dir: &Path) -> Result<Loaded> {
             ))),
         })
         .collect::<Result<_>>()?;
-    let covered = match mesh.point_array("covered") {
+    let covered: Vec<bool> = match mesh.point_array("covered") {
         Some(a) => a.values.iter().map(|&c| c != 0.0).collect(),
         None => {
             notes.push(
@@ -96,6 +96,34 @@ pub fn load(dir: &Path) -> Result<Loaded> {
             );
             phi.iter().map(|p| p.is_finite()).collect()
         }
+    };
+    // A body below: its fields are drawn with the obstacle's, as when solving.
+    let (phi, state, pressure, covered) = match (
+        mesh.point_array("phi_low"),
+        mesh.point_array("state_low"),
+        mesh.point_array("pressure_low"),
+        mesh.point_array("covered_low"),
+    ) {
+        (Some(p), Some(s), Some(q), Some(c)) => {
+            let state_low: Vec<i8> = s.values.iter().map(|&x| x as i8).collect();
+            let covered_low: Vec<bool> = c.values.iter().map(|&x| x != 0.0).collect();
+            let m = crate::bodies::merge(
+                crate::bodies::BodyFields {
+                    phi: &phi,
+                    state: &state,
+                    pressure: &pressure,
+                    covered: &covered,
+                },
+                crate::bodies::BodyFields {
+                    phi: &p.values,
+                    state: &state_low,
+                    pressure: &q.values,
+                    covered: &covered_low,
+                },
+            );
+            (m.phi, m.state, m.pressure, m.covered)
+        }
+        _ => (phi, state, pressure, covered),
     };
     let summary_path = dir.join("summary.json");
     let mut options = PlotOptions::default();

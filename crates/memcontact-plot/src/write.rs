@@ -6,6 +6,7 @@
 //! The picture options stored in each `summary.json` are the ones the pictures were drawn
 //! with (title included), so that `memcontact plot DIR` redraws identical files.
 
+use crate::bodies::{merge, BodyFields};
 use crate::{draw_all, line_plot, LinePlot, PlotData, PlotKind, PlotOptions, Series, Units};
 use memcontact::mesh::Mesh;
 use memcontact::output::{step_label, write_result_set, SweepSet, WriteOptions};
@@ -102,14 +103,41 @@ pub fn pictures<'a>(
         if options.plots.is_empty() {
             return Ok(Vec::new());
         }
-        let data = PlotData {
-            points: &mesh.points,
-            triangles: &mesh.triangles,
-            u: &fields.u,
+        let upper = BodyFields {
             phi: &fields.phi,
             state: &fields.state,
             pressure: &fields.pressure,
             covered: &fields.covered,
+        };
+        // With a body below, both bodies' contact is drawn ([`crate::bodies`]).
+        let merged = fields.lower.as_ref().map(|l| {
+            merge(
+                upper,
+                BodyFields {
+                    phi: &l.phi,
+                    state: &l.state,
+                    pressure: &l.pressure,
+                    covered: &l.covered,
+                },
+            )
+        });
+        let shown = match &merged {
+            Some(m) => BodyFields {
+                phi: &m.phi,
+                state: &m.state,
+                pressure: &m.pressure,
+                covered: &m.covered,
+            },
+            None => upper,
+        };
+        let data = PlotData {
+            points: &mesh.points,
+            triangles: &mesh.triangles,
+            u: &fields.u,
+            phi: shown.phi,
+            state: shown.state,
+            pressure: shown.pressure,
+            covered: shown.covered,
         };
         let files =
             draw_all(dir, &data, options).map_err(|e| Error::Data(format!("pictures: {e}")))?;

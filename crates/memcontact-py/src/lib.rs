@@ -80,13 +80,17 @@ fn solve_on(
     let mesh = mesh.clone();
     for (name, values) in nodal.unwrap_or_default() {
         let field = Field::Nodal(values.as_array().iter().copied().collect());
-        match name.as_str() {
-            "load" => c.problem.membrane.load = field,
-            "shape" => c.problem.obstacle.shape = field,
-            "stiffness" => c.problem.obstacle.stiffness = Stiffness::Elastic(field),
-            other => {
+        match (name.as_str(), c.problem.lower.as_mut()) {
+            ("load", _) => c.problem.membrane.load = field,
+            ("shape", _) => c.problem.obstacle.shape = field,
+            ("stiffness", _) => c.problem.obstacle.stiffness = Stiffness::Elastic(field),
+            ("height", _) => c.problem.boundary.height = field,
+            ("lower_shape", Some(low)) => low.shape = field,
+            ("lower_stiffness", Some(low)) => low.stiffness = Stiffness::Elastic(field),
+            (other, _) => {
                 return Err(PyValueError::new_err(format!(
-                    "nodal: \"{other}\" is not a field (load, shape or stiffness)"
+                    "nodal: \"{other}\" is not a field (load, shape, stiffness, height, \
+                     lower_shape or lower_stiffness with a body below)"
                 )))
             }
         }

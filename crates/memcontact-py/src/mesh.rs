@@ -159,21 +159,30 @@ pub fn mesh_from_arrays(
 
 #[pymethods]
 impl PyMesh {
-    /// Mesh(vertices, triangles, regions=None, region_names=None)
+    /// Mesh(vertices, triangles, regions=None, region_names=None, boundary_edges=None,
+    ///      boundary_tags=None, boundary_names=None)
     ///
     /// A mesh from NumPy arrays: `vertices` (n, 2) float64, `triangles` (m, 3) int64
     /// vertex indices, `regions` (m,) int64 region tags (default all 0) and `region_names`
-    /// mapping tags to names (the keys of region tables). The mesh is checked: finite
-    /// coordinates, no degenerate, inverted or duplicate element, no unused vertex, a
-    /// manifold boundary; clockwise meshes are reoriented.
+    /// mapping tags to names (the keys of region tables). `boundary_edges` (k, 2) vertex
+    /// pairs of boundary edges with `boundary_tags` (k,) and `boundary_names` name
+    /// boundary regions (the keys of `[boundary]` tables and `free`; untagged boundary
+    /// edges are region 0). The mesh is checked: finite coordinates, no degenerate,
+    /// inverted or duplicate element, no unused vertex, a manifold boundary, tagged edges
+    /// on the boundary; clockwise meshes are reoriented.
     #[new]
-    #[pyo3(signature = (vertices, triangles, regions=None, region_names=None))]
+    #[pyo3(signature = (vertices, triangles, regions=None, region_names=None,
+                        boundary_edges=None, boundary_tags=None, boundary_names=None))]
+    #[allow(clippy::too_many_arguments)]
     fn py_new(
         py: Python<'_>,
         vertices: &Bound<'_, PyAny>,
         triangles: &Bound<'_, PyAny>,
         regions: Option<&Bound<'_, PyAny>>,
         region_names: Option<BTreeMap<u32, String>>,
+        boundary_edges: Option<&Bound<'_, PyAny>>,
+        boundary_tags: Option<&Bound<'_, PyAny>>,
+        boundary_names: Option<BTreeMap<u32, String>>,
     ) -> PyResult<PyMesh> {
         let np = py.import("numpy")?;
         let float64 = np.getattr("float64")?;
@@ -203,8 +212,78 @@ impl PyMesh {
                 })?)
             }
         };
-        let mesh = mesh_from_arrays(&v, &t, r, region_names)?;
+        let mut mesh = mesh_from_arrays(&v, &t, r, region_names)?;
+        if boundary_edges.is_some() || boundary_tags.is_some() || boundary_names.is_some() {
+            let (Some(e), Some(tags)) = (boundary_edges, boundary_tags) else {
+                return Err(PyValueError::new_err(
+                    "boundary regions need both boundary_edges (k, 2) and boundary_tags (k,)",
+                ));
+            };
+            let e = integer_array(&np, e, "boundary_edges")?;
+            let e: PyReadonlyArray2<'_, i64> = e.extract().map_err(|_| {
+                PyValueError::new_err(format!(
+                    "boundary_edges must have shape (k, 2), got shape {}",
+                    shape_of(&e)
+                ))
+            })?;
+            let a = e.as_array();
+            if a.ncols() != 2 {
+                return Err(PyValueError::new_err(format!(
+                    "boundary_edges must have shape (k, 2), got {:?}",
+                    a.shape()
+                )));
+            }
+            let n = mesh.n_vertices();
+            let mut edges = Vec::with_capacity(a.nrows());
+            for (k, r) in a.rows().into_iter().enumerate() {
+                if r.iter().any(|&v| v < 0 || v as u64 >= n as u64) {
+                    return Err(PyValueError::new_err(format!(
+                        "boundary edge {k} refers to vertex ({}, {}), but there are {n} \
+                         vertices",
+                        r[0], r[1]
+                    )));
+                }
+                edges.push([r[0] as u32, r[1] as u32]);
+            }
+            let tags = integer_array(&np, tags, "boundary_tags")?;
+            let tags: PyReadonlyArray1<'_, i64> = tags.extract().map_err(|_| {
+                PyValueError::new_err(format!(
+                    "boundary_tags must have shape (k,), got shape {}",
+                    shape_of(&tags)
+                ))
+            })?;
+            let tags = regions_of(Some(tags), edges.len()).map_err(|e| {
+                PyValueError::new_err(e.to_string().replace("regions", "boundary_tags"))
+            })?;
+            mesh = mesh
+                .with_boundary_regions(edges, tags, boundary_names.unwrap_or_default())
+                .map_err(py_err)?;
+        }
         Ok(PyMesh::new_from(Hierarchy::single(mesh)))
+    }
+
+    /// The tagged boundary edges (vertex pairs), shape (k, 2), int64: Gmsh physical curves
+    /// or the generators' sides (a new array).
+    #[getter]
+    fn boundary_edges<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<i64>> {
+        let b = &self.finest().boundary;
+        let flat: Vec<i64> = b.edges.iter().flat_map(|e| e.map(i64::from)).collect();
+        let a = Array2::from_shape_vec((b.edges.len(), 2), flat).expect("k x 2");
+        PyArray2::from_owned_array(py, a)
+    }
+
+    /// The boundary region tag of every edge of `boundary_edges`, shape (k,), int64.
+    #[getter]
+    fn boundary_tags<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<i64>> {
+        let b = &self.finest().boundary;
+        PyArray1::from_owned_array(py, Array1::from_iter(b.tags.iter().map(|&t| i64::from(t))))
+    }
+
+    /// The names of the boundary region tags (the keys of `[boundary]` tables and
+    /// `free`), e.g. `{1: "bottom", 2: "right", 3: "top", 4: "left"}` for a rectangle.
+    #[getter]
+    fn boundary_names(&self) -> BTreeMap<u32, String> {
+        self.finest().boundary.names.clone()
     }
 
     /// Vertex coordinates, shape (n, 2), float64 (a new array).
@@ -342,6 +421,20 @@ pub fn mesh_state<'py>(py: Python<'py>, h: &Hierarchy) -> PyResult<Bound<'py, Py
     }
     d.set_item("parents", parents)?;
     d.set_item("names", h.finest().region_names.clone())?;
+    // Boundary regions of every level: (edges (k, 2), tags (k,)), and their names.
+    let boundary = PyList::empty(py);
+    for m in &h.levels {
+        let b = &m.boundary;
+        let flat: Vec<i64> = b.edges.iter().flat_map(|e| e.map(i64::from)).collect();
+        let edges = Array2::from_shape_vec((b.edges.len(), 2), flat).expect("k x 2");
+        let tags: Vec<i64> = b.tags.iter().map(|&t| i64::from(t)).collect();
+        boundary.append((
+            PyArray2::from_owned_array(py, edges),
+            PyArray1::from_vec(py, tags),
+        ))?;
+    }
+    d.set_item("boundary", boundary)?;
+    d.set_item("boundary_names", h.finest().boundary.names.clone())?;
     d.set_item(
         "circle",
         h.finest()
@@ -360,6 +453,29 @@ pub fn hierarchy_from_state(state: &Bound<'_, PyAny>) -> PyResult<Hierarchy> {
     };
     let names: BTreeMap<u32, String> = get("names")?.extract()?;
     let circle: Option<(f64, f64, f64)> = get("circle")?.extract()?;
+    // Boundary regions (absent from states written before they existed).
+    let boundary_names: BTreeMap<u32, String> = match d.get_item("boundary_names")? {
+        Some(v) => v.extract()?,
+        None => BTreeMap::new(),
+    };
+    let mut boundary = Vec::new();
+    if let Some(list) = d.get_item("boundary")? {
+        for item in list.try_iter()? {
+            let (e, t): (PyReadonlyArray2<'_, i64>, PyReadonlyArray1<'_, i64>) = item?.extract()?;
+            let edges: Vec<[u32; 2]> = e
+                .as_array()
+                .rows()
+                .into_iter()
+                .map(|r| [r[0] as u32, r[1] as u32])
+                .collect();
+            let tags: Vec<u32> = t.as_array().iter().map(|&x| x as u32).collect();
+            boundary.push(memcontact::mesh::BoundaryRegions {
+                edges,
+                tags,
+                names: boundary_names.clone(),
+            });
+        }
+    }
     let mut levels = Vec::new();
     for item in get("levels")?.try_iter()? {
         let (v, t, r): (
@@ -381,6 +497,7 @@ pub fn hierarchy_from_state(state: &Bound<'_, PyAny>) -> PyResult<Hierarchy> {
                 center: [x, y],
                 radius: r,
             }),
+            boundary: boundary.get(levels.len()).cloned().unwrap_or_default(),
         });
     }
     let mut refinements = Vec::new();

@@ -7,7 +7,7 @@ use crate::mesh::{hierarchy_from_state, mesh_state, PyMesh};
 use memcontact::model::Certificate;
 use memcontact::output::{input_hash, new_run_id, WriteOptions};
 use memcontact::problem::VtuFormat;
-use memcontact::results::NodalFields;
+use memcontact::results::{LowerFields, NodalFields};
 use memcontact::run::Phase;
 use memcontact::solve::{Choice, Fallback, IterationRecord, Multipliers, Silent};
 use memcontact::sweep::step_discretization;
@@ -194,6 +194,14 @@ fn phases_in(p: Vec<(String, f64)>) -> Vec<Phase> {
 
 const FIELD_NAMES: [&str; 5] = ["u", "phi", "penetration", "pressure", "contact_force"];
 
+/// The body below's float fields in a pickled result.
+const LOWER_NAMES: [&str; 4] = [
+    "phi_low",
+    "penetration_low",
+    "pressure_low",
+    "contact_force_low",
+];
+
 #[pymethods]
 impl PyResult_ {
     /// The deflection u at every vertex (u = 0 on the boundary), in the mesh's vertex order.
@@ -230,6 +238,42 @@ impl PyResult_ {
     #[getter]
     fn state<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<i8>> {
         PyArray1::from_slice(py, &self.data.fields.state)
+    }
+
+    /// The body below's sampled surface φ_low at every vertex (`None` without one).
+    #[getter]
+    fn phi_low<'py>(&self, py: Python<'py>) -> Option<Bound<'py, PyArray1<f64>>> {
+        let l = self.data.fields.lower.as_ref()?;
+        Some(Self::f64_array(py, &l.phi))
+    }
+
+    /// The penetration into the body below (φ_low − u)⁺ (`None` without one).
+    #[getter]
+    fn penetration_low<'py>(&self, py: Python<'py>) -> Option<Bound<'py, PyArray1<f64>>> {
+        let l = self.data.fields.lower.as_ref()?;
+        Some(Self::f64_array(py, &l.penetration))
+    }
+
+    /// The body below's contact pressure (pushing up; `None` without one).
+    #[getter]
+    fn pressure_low<'py>(&self, py: Python<'py>) -> Option<Bound<'py, PyArray1<f64>>> {
+        let l = self.data.fields.lower.as_ref()?;
+        Some(Self::f64_array(py, &l.pressure))
+    }
+
+    /// The body below's nodal contact force (pushing up; `None` without one).
+    #[getter]
+    fn contact_force_low<'py>(&self, py: Python<'py>) -> Option<Bound<'py, PyArray1<f64>>> {
+        let l = self.data.fields.lower.as_ref()?;
+        Some(Self::f64_array(py, &l.contact_force))
+    }
+
+    /// The state toward the body below: −1 clear, 0 touching (U = φ_low), 1 sunk into it
+    /// (int8; `None` without a body below).
+    #[getter]
+    fn state_low<'py>(&self, py: Python<'py>) -> Option<Bound<'py, PyArray1<i8>>> {
+        let l = self.data.fields.lower.as_ref()?;
+        Some(PyArray1::from_slice(py, &l.state))
     }
 
     /// How the solve ended: "converged", "rounding_floor", "iteration_limit", "stalled"
@@ -419,10 +463,25 @@ impl PyResult_ {
         }
         state.set_item("state", PyArray1::from_slice(py, &f.state))?;
         state.set_item("covered", PyArray1::from_slice(py, &f.covered))?;
+        if let Some(l) = &f.lower {
+            for (name, v) in
+                LOWER_NAMES
+                    .iter()
+                    .zip([&l.phi, &l.penetration, &l.pressure, &l.contact_force])
+            {
+                state.set_item(*name, Self::f64_array(py, v))?;
+            }
+            state.set_item("state_low", PyArray1::from_slice(py, &l.state))?;
+            state.set_item("covered_low", PyArray1::from_slice(py, &l.covered))?;
+        }
         state.set_item("u_dofs", Self::f64_array(py, &r.u))?;
         if let Some(m) = &r.multipliers {
             state.set_item("x1", Self::f64_array(py, &m.x1))?;
             state.set_item("x2", Self::f64_array(py, &m.x2))?;
+            if !m.x1_low.is_empty() {
+                state.set_item("x1_low", Self::f64_array(py, &m.x1_low))?;
+                state.set_item("x2_low", Self::f64_array(py, &m.x2_low))?;
+            }
         }
         state.set_item("mesh", mesh_state(py, &d.mesh.hierarchy)?)?;
         let rebuild = py
@@ -473,11 +532,33 @@ pub fn _result_from_state(state: &Bound<'_, PyDict>) -> PyResult<PyResult_> {
         pressure: vec("pressure")?,
         contact_force: vec("contact_force")?,
         state: state_arr.as_array().to_vec(),
+        lower: match state.get_item("phi_low")? {
+            Some(_) => {
+                let state_low: PyReadonlyArray1<'_, i8> = get("state_low")?.extract()?;
+                Some(LowerFields {
+                    phi: vec("phi_low")?,
+                    penetration: vec("penetration_low")?,
+                    pressure: vec("pressure_low")?,
+                    contact_force: vec("contact_force_low")?,
+                    state: state_low.as_array().to_vec(),
+                    covered: vec_bool(&get("covered_low")?)?,
+                })
+            }
+            None => None,
+        },
     };
     let multipliers = match state.get_item("x1")? {
         Some(_) => Some(Multipliers {
             x1: vec("x1")?,
             x2: vec("x2")?,
+            x1_low: match state.get_item("x1_low")? {
+                Some(_) => vec("x1_low")?,
+                None => Vec::new(),
+            },
+            x2_low: match state.get_item("x2_low")? {
+                Some(_) => vec("x2_low")?,
+                None => Vec::new(),
+            },
         }),
         None => None,
     };

@@ -42,7 +42,8 @@ BAD = [
     ("membrane.load", "1 + z", "membrane.load", "z"),
     ("membrane.load", {}, "membrane.load", "empty"),
     ("obstacle.stiffness", -3.0, "obstacle.stiffness", "≥ 0"),
-    ("obstacle.stiffness", {"soil": "rigid"}, "obstacle.stiffness", "rigid"),
+    # A region may be rigid (mixed bodies), but not "rigidly".
+    ("obstacle.stiffness", {"soil": "rigidly"}, "obstacle.stiffness", "rigidly"),
     ("obstacle.shape", True, "obstacle.shape", "a number"),
     ("obstacle.shape", [1, "x"], "obstacle.shape", "a number"),
     ("membrane.load", [], "membrane.load", "empty array"),

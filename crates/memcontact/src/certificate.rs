@@ -16,6 +16,13 @@
 //!
 //! These are the componentwise conditions of 2f; with `X₁ = D − SU`, `U₂ = p`,
 //! `X₂ = L̃U₂ − X₁` they are those of 2e (`X ≥ 0`, `X̂₁ = 0` off M, both complementarities).
+//!
+//! Beyond the paper (SPEC §5) the same pass takes a body below and rigid regions: with
+//! `q = (φ_low − U)⁺`, zero must lie between `left = r + (Lp)·[U > φ] − (L_low q)·[U ≤
+//! φ_low]` and `right = r + (Lp)·[U ≥ φ] − (L_low q)·[U < φ_low]`, and 2e splits the net
+//! force between the two bodies ([`ContactForces`]). Without a body below and rigid
+//! regions these are exactly the conditions above; the pass then runs its original
+//! instantiation, at its original cost. Boundary heights enter through `D` (the lifting).
 //! The largest violation, a force, is divided by the **force scale of the iterate**
 //! `max(‖D‖∞, ‖SU‖∞, ‖Lp‖∞)`: the load and the elastic and foundation forces actually
 //! present, never forces the iterate does not exert, so that no iterate passes unless it
@@ -26,7 +33,7 @@
 //! rounding leaves an error of a few ulps of that. A residual at the floor is as good as
 //! the data allow in this arithmetic.
 
-use crate::model::{FoundationMatrix, Model};
+use crate::model::{Body, FoundationMatrix, Model};
 use rayon::prelude::*;
 
 /// Rows per block of the deterministic reductions.
@@ -187,8 +194,18 @@ impl Acc {
 
 /// The certificate and energy of `v` (see the module doc).
 pub fn evaluate(model: &Model, v: &[f64]) -> Evaluation {
+    if model.is_extended() {
+        evaluate_bodies::<true>(model, v)
+    } else {
+        evaluate_bodies::<false>(model, v)
+    }
+}
+
+/// [`evaluate`] with the upper body's `(Lp)_i` computed by a closure per kind of L (the
+/// inner loop is compiled once per kind). `EXT`: a body below or rigid regions (SPEC §5).
+fn evaluate_bodies<const EXT: bool>(model: &Model, v: &[f64]) -> Evaluation {
     match &model.l {
-        FoundationMatrix::Consistent(l) => evaluate_with(model, v, |_, s, e| {
+        FoundationMatrix::Consistent(l) => evaluate_with::<EXT>(model, v, |_, s, e| {
             let (mut lp, mut size) = (0.0, 0.0);
             for (&j, &lv) in l.pattern.col[s..e].iter().zip(&l.val[s..e]) {
                 let j = j as usize;
@@ -202,7 +219,7 @@ pub fn evaluate(model: &Model, v: &[f64]) -> Evaluation {
             }
             (lp, size)
         }),
-        FoundationMatrix::Lumped(d) => evaluate_with(model, v, |i, _, _| {
+        FoundationMatrix::Lumped(d) => evaluate_with::<EXT>(model, v, |i, _, _| {
             let pi = v[i] - model.phi[i];
             if model.can_touch[i] && pi > 0.0 {
                 (d[i] * pi, d[i] * (v[i].abs() + model.phi[i].abs()))
@@ -210,13 +227,225 @@ pub fn evaluate(model: &Model, v: &[f64]) -> Evaluation {
                 (0.0, 0.0)
             }
         }),
-        FoundationMatrix::Rigid => evaluate_with(model, v, |_, _, _| (0.0, 0.0)),
+        FoundationMatrix::Rigid => evaluate_with::<EXT>(model, v, |_, _, _| (0.0, 0.0)),
+    }
+}
+
+/// The body below's `((L_low q)_i, Σⱼ L_low,ij (|U_j| + |φ_low,j|))` over the penetrating
+/// j (`q = (φ_low − U)⁺`); its L shares the pattern of S.
+#[inline]
+fn lower_dot(body: &Body, v: &[f64], i: usize, s: usize, e: usize) -> (f64, f64) {
+    match &body.l {
+        FoundationMatrix::Consistent(l) => {
+            let (mut lq, mut size) = (0.0, 0.0);
+            for (&j, &lv) in l.pattern.col[s..e].iter().zip(&l.val[s..e]) {
+                let j = j as usize;
+                if lv != 0.0 && body.can_touch[j] {
+                    let qj = body.phi[j] - v[j];
+                    if qj > 0.0 {
+                        lq += lv * qj;
+                        size += lv * (v[j].abs() + body.phi[j].abs());
+                    }
+                }
+            }
+            (lq, size)
+        }
+        FoundationMatrix::Lumped(d) => {
+            let qi = body.phi[i] - v[i];
+            if body.can_touch[i] && qi > 0.0 {
+                (d[i] * qi, d[i] * (v[i].abs() + body.phi[i].abs()))
+            } else {
+                (0.0, 0.0)
+            }
+        }
+        FoundationMatrix::Rigid => (0.0, 0.0),
+    }
+}
+
+/// One body at one vertex, for [`conditions`]: its surface, `(Lp)_i` (its elastic force),
+/// whether it can touch the vertex and whether it holds it rigidly.
+#[derive(Clone, Copy)]
+struct Side {
+    phi: f64,
+    force: f64,
+    active: bool,
+    rigid: bool,
+}
+
+impl Side {
+    const NONE: Side = Side {
+        phi: 0.0,
+        force: 0.0,
+        active: false,
+        rigid: false,
+    };
+}
+
+/// The optimality conditions at a vertex that a body can touch (SPEC §5): the violations
+/// `(2f, 2e)` as forces. 2f: zero lies between the left and right derivatives of J along
+/// the coordinate, `left = r + (Lp)·[U > φ] − (L_low q)·[U ≤ φ_low]`,
+/// `right = r + (Lp)·[U ≥ φ] − (L_low q)·[U < φ_low]` (±∞ on the far side of a rigid
+/// body at its surface; a rigid body violated counts the force `S_ii` times the
+/// violation). 2e: the contact forces `X = X_up` (pushing down) and `X_low` (pushing up)
+/// with `r + X − X_low = 0`, each ≥ 0, zero where its body is clear, and, for an elastic
+/// body, at most its force `(Lp)_i` and equal to it where it penetrates. Without a body
+/// below these are the paper's 2f and 2e with `X₁ = −r`, `X₂ = Lp + r`.
+#[inline(always)]
+fn conditions(r: f64, sii: f64, vi: f64, up: Side, low: Side) -> (f64, f64) {
+    let up_el = up.active && !up.rigid;
+    let low_el = low.active && !low.rigid;
+    // Left and right derivatives of J along the coordinate.
+    let mut left = r;
+    let mut right = r;
+    if up_el {
+        if vi > up.phi {
+            left += up.force;
+        }
+        if vi >= up.phi {
+            right += up.force;
+        }
+    }
+    if low_el {
+        if vi <= low.phi {
+            left -= low.force;
+        }
+        if vi < low.phi {
+            right -= low.force;
+        }
+    }
+    if up.active && up.rigid && vi == up.phi {
+        right = f64::INFINITY;
+    }
+    if low.active && low.rigid && vi == low.phi {
+        left = f64::NEG_INFINITY;
+    }
+    let mut f2 = left.max(-right).max(0.0);
+    // A rigid body violated: the force that would push the vertex back.
+    let mut infeasible = 0.0f64;
+    if up.active && up.rigid && vi > up.phi {
+        infeasible = sii * (vi - up.phi);
+    }
+    if low.active && low.rigid && vi < low.phi {
+        infeasible = infeasible.max(sii * (low.phi - vi));
+    }
+    if infeasible > 0.0 {
+        f2 = f2.max(infeasible);
+    }
+    // 2e: the contact forces of the two bodies.
+    let pen_up = up_el && vi > up.phi;
+    let pen_low = low_el && vi < low.phi;
+    let (x, x_low) = split(r, vi, up, low);
+    let mut e2 = (-x).max(0.0);
+    if low.active {
+        e2 = e2.max(-x_low);
+    }
+    if up_el {
+        let x2 = up.force - x;
+        e2 = e2.max(-x2);
+        if pen_up {
+            e2 = e2.max(x2.abs());
+        }
+    }
+    if low_el {
+        let y2 = low.force - x_low;
+        e2 = e2.max(-y2);
+        if pen_low {
+            e2 = e2.max(y2.abs());
+        }
+    }
+    e2 = e2.max((r + x - x_low).abs());
+    if infeasible > 0.0 {
+        e2 = e2.max(infeasible);
+    }
+    (f2, e2)
+}
+
+/// The contact forces of the two bodies at an iterate, over the unknowns: `up` pushing
+/// down (the obstacle's, X₁ of 2e) and `low` pushing up (the body below's), with
+/// `up − low = D − SU` where a body touches. Without a body below, `up = D − SU` on M
+/// (the paper's X₁) and `low` is empty. With one, the net force `D − SU` is split by the
+/// bodies' states: to the body in contact; where both are, the elastic force of a
+/// penetrated body fixes its share, and between two bodies just touching each takes the
+/// part pushing away from it.
+#[derive(Debug, Clone)]
+pub struct ContactForces {
+    /// The obstacle's force on the membrane (positive downward).
+    pub up: Vec<f64>,
+    /// The body below's force (positive upward; empty without a body below).
+    pub low: Vec<f64>,
+}
+
+/// The contact forces of `model` at `u` (see [`ContactForces`]).
+pub fn contact_forces(model: &Model, u: &[f64]) -> ContactForces {
+    let r = model.residual(u);
+    let Some(low) = &model.lower else {
+        let up = r
+            .iter()
+            .zip(&model.can_touch)
+            .map(|(ri, &c)| if c { -ri } else { 0.0 })
+            .collect();
+        return ContactForces {
+            up,
+            low: Vec::new(),
+        };
+    };
+    let p = model.penetration(u);
+    let q = low.penetration(u);
+    let mut lp = vec![0.0; model.n()];
+    let mut lq = vec![0.0; model.n()];
+    model.l.mul_into(&p, &mut lp);
+    low.l.mul_into(&q, &mut lq);
+    let mut up_f = vec![0.0; model.n()];
+    let mut low_f = vec![0.0; model.n()];
+    for i in 0..model.n() {
+        let up = Side {
+            phi: model.phi[i],
+            force: lp[i],
+            active: model.can_touch[i],
+            rigid: model.rigid_at(i),
+        };
+        let down = Side {
+            phi: low.phi[i],
+            force: lq[i],
+            active: low.can_touch[i],
+            rigid: low.rigid_at(i),
+        };
+        let (x, x_low) = split(r[i], u[i], up, down);
+        up_f[i] = x;
+        low_f[i] = x_low;
+    }
+    ContactForces {
+        up: up_f,
+        low: low_f,
+    }
+}
+
+/// The split of the net force `−r` between the two bodies at a vertex (see
+/// [`ContactForces`]): `(X, X_low)` with `X − X_low = −r` where a body touches, zero for
+/// a body clear of the vertex.
+#[inline(always)]
+fn split(r: f64, vi: f64, up: Side, low: Side) -> (f64, f64) {
+    let clear_up = !up.active || vi < up.phi;
+    let clear_low = !low.active || vi > low.phi;
+    match (clear_up, clear_low) {
+        (true, true) => (0.0, 0.0),
+        (true, false) => (0.0, r),
+        (false, true) => (-r, 0.0),
+        (false, false) => {
+            if up.active && !up.rigid && vi > up.phi {
+                (up.force, up.force + r)
+            } else if low.active && !low.rigid && vi < low.phi {
+                (low.force - r, low.force)
+            } else {
+                ((-r).max(0.0), r.max(0.0))
+            }
+        }
     }
 }
 
 /// [`evaluate`] with `lp(i, row start, row end) = ((Lp)_i, Σⱼ L_ij(|U_j| + |φ_j|))` over
 /// the penetrating j (S and a consistent L share their pattern).
-fn evaluate_with(
+fn evaluate_with<const EXT: bool>(
     model: &Model,
     v: &[f64],
     lp_of: impl Fn(usize, usize, usize) -> (f64, f64) + Sync,
@@ -225,6 +454,7 @@ fn evaluate_with(
     let rigid = model.is_rigid();
     let pat = &model.s.pattern;
     let sval = &model.s.val;
+    let lower = if EXT { model.lower.as_ref() } else { None };
     let block = |b: usize| -> Acc {
         let mut acc = Acc::default();
         let (lo, hi) = (b * BLOCK, ((b + 1) * BLOCK).min(n));
@@ -243,55 +473,53 @@ fn evaluate_with(
             let (vi, fi) = (v[i], model.phi[i]);
             acc.scale = acc.scale.max(model.d[i].abs()).max(su.abs());
             acc.quad += vi * (r - model.d[i]);
-            let (violation_2f, violation_2e) = if model.can_touch[i] {
-                let (lp, lsize) = lp_of(i, s, e);
-                size += lsize;
-                acc.scale = acc.scale.max(lp.abs());
-                let p = (vi - fi).max(0.0);
-                acc.foundation += p * lp;
-                if vi == fi {
+            let mut up = Side {
+                phi: fi,
+                force: 0.0,
+                active: model.can_touch[i],
+                rigid: if EXT { model.rigid_at(i) } else { rigid },
+            };
+            let mut down = Side::NONE;
+            if let Some(low) = lower {
+                down = Side {
+                    phi: low.phi[i],
+                    force: 0.0,
+                    active: low.can_touch[i],
+                    rigid: low.rigid_at(i),
+                };
+            }
+            let (violation_2f, violation_2e) = if up.active || down.active {
+                if up.active {
+                    let (lp, lsize) = lp_of(i, s, e);
+                    size += lsize;
+                    acc.scale = acc.scale.max(lp.abs());
+                    acc.foundation += (vi - fi).max(0.0) * lp;
+                    up.force = lp;
+                }
+                if down.active {
+                    let low = lower.expect("a body below");
+                    let (lq, qsize) = lower_dot(low, v, i, s, e);
+                    size += qsize;
+                    acc.scale = acc.scale.max(lq.abs());
+                    acc.foundation += (down.phi - vi).max(0.0) * lq;
+                    down.force = lq;
+                }
+                let touching = (up.active && vi == fi) || (down.active && vi == down.phi);
+                let penetrating = (up.active && vi > fi) || (down.active && vi < down.phi);
+                if touching {
                     acc.touching += 1;
-                } else if vi > fi {
+                } else if penetrating {
                     acc.penetrating += 1;
                 }
-                // Left and right derivatives of J along coordinate i.
-                let (left, right) = if vi < fi {
-                    (r, r)
-                } else if vi > fi {
-                    if rigid {
-                        acc.infeasible = true;
-                        (r, r)
-                    } else {
-                        (r + lp, r + lp)
-                    }
-                } else if rigid {
-                    (r, f64::INFINITY)
-                } else {
-                    (r, r + lp)
-                };
-                let mut f2 = left.max(-right).max(0.0);
-                if rigid && vi > fi {
-                    f2 = f2.max(sii * (vi - fi));
+                if (up.active && up.rigid && vi > fi)
+                    || (down.active && down.rigid && vi < down.phi)
+                {
+                    acc.infeasible = true;
                 }
-                // 2e: X₁ = −r ≥ 0, X₂ = Lp − X₁ ≥ 0 (elastic), X₁ = 0 where U < φ,
-                // X₂ = 0 where p > 0.
-                let (x1, x2) = (-r, lp + r);
-                let mut e2 = (-x1).max(0.0);
-                if !rigid {
-                    e2 = e2.max(-x2);
-                    if p > 0.0 {
-                        e2 = e2.max(x2.abs());
-                    }
-                }
-                if vi < fi {
-                    e2 = e2.max(x1.abs());
-                }
-                if rigid && vi > fi {
-                    e2 = e2.max(sii * (vi - fi));
-                }
-                (f2, e2)
+                conditions(r, sii, vi, up, down)
             } else {
-                // Off M, L vanishes: r = 0 (2f), and X̂₁ = 0 there (2e).
+                // Off M (and off the body below), no foundation acts: r = 0 (2f), and
+                // X̂₁ = 0 there (2e).
                 (r.abs(), r.abs())
             };
             // NaN anywhere makes the certificate fail.

@@ -10,30 +10,37 @@
 
 use crate::fem::{Coefficient, VertexTriangles};
 use crate::mesh::Mesh;
-use crate::model::{FoundationMatrix, Model, ProblemData, Stiffness};
+use crate::model::{Extensions, FoundationMatrix, Model, ProblemData, Stiffness};
 use crate::results::{NodalFields, Totals};
 use crate::{Error, Result};
 
-/// Assembles the model of `data` on `mesh` ([`Model::assemble`]) between the checks of the
-/// boundary data ([`check_boundary_data`]) and of overflow ([`check_model`]).
-pub fn assemble(mesh: &Mesh, data: &ProblemData) -> Result<Model> {
-    check_boundary_data(mesh, data)?;
-    let model = Model::assemble(mesh, data)?;
+/// Assembles the model of `data` with the extensions `ext` on `mesh`
+/// ([`Model::assemble_with`]) between the checks of the boundary data
+/// ([`check_boundary_data`]) and of overflow ([`check_model`]).
+pub fn assemble(mesh: &Mesh, data: &ProblemData, ext: &Extensions) -> Result<Model> {
+    check_boundary_data(mesh, data, ext)?;
+    let model = Model::assemble_with(mesh, data, ext)?;
     check_model(mesh, &model)?;
     Ok(model)
 }
 
 /// Checks the data where assembly does not sample it: f on the boundary vertices (a load
-/// singular on the boundary, like `1/x` on x = 0, is refused), and, for the rigid obstacle,
-/// that φ is not below the fixed boundary (`u = 0 > φ` there: no continuous solution).
-pub fn check_boundary_data(mesh: &Mesh, data: &ProblemData) -> Result<()> {
+/// singular on the boundary, like `1/x` on x = 0, is refused), and, where a body is rigid
+/// next to the fixed boundary, that it leaves room for the prescribed height g there
+/// (`φ ≥ g` above, `φ_low ≤ g` below: otherwise no continuous solution exists).
+pub fn check_boundary_data(mesh: &Mesh, data: &ProblemData, ext: &Extensions) -> Result<()> {
     let boundary = mesh.boundary_vertices();
     let adj = VertexTriangles::new(mesh);
+    let (fixed, heights) = crate::model::fixed_heights(mesh, &adj, ext)?;
+    let rigid_upper = |region: u32| {
+        matches!(data.stiffness, Stiffness::Rigid) || ext.rigid_regions.contains(&region)
+    };
     for (v, &on) in boundary.iter().enumerate() {
         if !on {
             continue;
         }
         let p = mesh.points[v];
+        let (fixed, g) = (fixed[v], heights[v]);
         for &k in adj.of(v) {
             let region = mesh.regions[k as usize];
             let f = value(data.load, p, region);
@@ -44,16 +51,35 @@ pub fn check_boundary_data(mesh: &Mesh, data: &ProblemData) -> Result<()> {
                     p[0], p[1]
                 )));
             }
-            if let Stiffness::Rigid = data.stiffness {
+            if !fixed {
+                continue;
+            }
+            if rigid_upper(region) {
                 let phi = value(data.shape, p, region);
-                if phi < 0.0 {
+                if phi < g {
                     return Err(Error::Data(format!(
                         "obstacle.shape φ = {phi} at the boundary point ({}, {}) lies below \
-                         the fixed boundary (u = 0 there): with a rigid obstacle (u ≤ φ) the \
-                         problem has no continuous solution; raise φ to at least 0 on the \
+                         the fixed boundary (u = {g} there): with a rigid obstacle (u ≤ φ) the \
+                         problem has no continuous solution; raise φ to at least {g} on the \
                          boundary or give the obstacle a finite stiffness",
                         p[0], p[1]
                     )));
+                }
+            }
+            if let Some(low) = &ext.lower {
+                if matches!(low.stiffness, Stiffness::Rigid) || low.rigid_regions.contains(&region)
+                {
+                    let phi = value(low.shape, p, region);
+                    if phi > g {
+                        return Err(Error::Data(format!(
+                            "lower.shape φ_low = {phi} at the boundary point ({}, {}) lies \
+                             above the fixed boundary (u = {g} there): with a rigid body \
+                             below (u ≥ φ_low) the problem has no continuous solution; lower \
+                             φ_low to at most {g} on the boundary or give the body a finite \
+                             stiffness",
+                            p[0], p[1]
+                        )));
+                    }
                 }
             }
         }
@@ -79,12 +105,7 @@ pub fn check_model(mesh: &Mesh, model: &Model) -> Result<()> {
             model.tension
         )));
     }
-    let l_finite = match &model.l {
-        FoundationMatrix::Consistent(l) => l.is_finite(),
-        FoundationMatrix::Lumped(d) => d.iter().all(|v| v.is_finite()),
-        FoundationMatrix::Rigid => true,
-    };
-    if !l_finite {
+    if !matrix_finite(&model.l) {
         return Err(Error::Data(
             "the foundation matrix L = ∫h gᵢgⱼ overflows double precision: \
              obstacle.stiffness h is too large (use stiffness = \"rigid\" for a rigid body)"
@@ -97,6 +118,22 @@ pub fn check_model(mesh: &Mesh, model: &Model) -> Result<()> {
             "obstacle.shape φ is not finite at ({}, {})",
             p[0], p[1]
         )));
+    }
+    if let Some(low) = &model.lower {
+        if !matrix_finite(&low.l) {
+            return Err(Error::Data(
+                "the foundation matrix of the body below overflows double precision: \
+                 lower.stiffness is too large (use stiffness = \"rigid\" for a rigid body)"
+                    .into(),
+            ));
+        }
+        if let Some(i) = low.phi.iter().position(|v| !v.is_finite()) {
+            let p = mesh.points[model.dofs.vertex[i] as usize];
+            return Err(Error::Data(format!(
+                "lower.shape φ_low is not finite at ({}, {})",
+                p[0], p[1]
+            )));
+        }
     }
     if let Some(i) = model.d.iter().position(|v| !v.is_finite()) {
         let p = mesh.points[model.dofs.vertex[i] as usize];
@@ -123,6 +160,15 @@ pub fn check_model(mesh: &Mesh, model: &Model) -> Result<()> {
         )));
     }
     Ok(())
+}
+
+/// Whether a foundation matrix holds finite numbers only.
+fn matrix_finite(l: &FoundationMatrix) -> bool {
+    match l {
+        FoundationMatrix::Consistent(l) => l.is_finite(),
+        FoundationMatrix::Lumped(d) => d.iter().all(|v| v.is_finite()),
+        FoundationMatrix::Rigid => true,
+    }
 }
 
 /// What overflowed, in terms of the data, for the messages of [`check_solution`] and
@@ -206,16 +252,20 @@ mod tests {
             foundation: Foundation::Consistent,
             sampling: Sampling::Nodal,
         };
-        let e = assemble(&mesh, &data).unwrap_err().to_string();
+        let e = assemble(&mesh, &data, &Extensions::default())
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("boundary") && e.contains("membrane.load"), "{e}");
         let (one, below) = (bind("1"), bind("x - 0.5"));
         data.load = &one;
         data.shape = &below;
         data.stiffness = Stiffness::Rigid;
-        let e = assemble(&mesh, &data).unwrap_err().to_string();
+        let e = assemble(&mesh, &data, &Extensions::default())
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("below the fixed boundary"), "{e}");
         data.stiffness = Stiffness::Elastic(&h);
-        assert!(assemble(&mesh, &data).is_ok());
+        assert!(assemble(&mesh, &data, &Extensions::default()).is_ok());
     }
 
     #[test]

@@ -35,16 +35,17 @@ use crate::exact::ExactSolution;
 use crate::fem::{Coefficient, Element};
 use crate::mesh::refine::Hierarchy;
 use crate::mesh::{Mesh, Point};
-use crate::model::{Model, ProblemData, Stiffness};
+use crate::model::{Extensions, Model, ProblemData, Stiffness};
 use crate::solve::{self, Method, Settings, Silent, Solution};
 use crate::{Error, Result};
 use std::time::Instant;
 
 /// The load of a manufactured solution (SPEC §4): `f = −t Δu + h (u − φ)⁺`, from the exact
 /// Laplacian of `exact` and the problem's own `h` and `φ` evaluated at the same point and
-/// region (so `h` and `φ` may be expressions or region tables). It is
-/// [`crate::exact::manufactured_load`] as an assembly coefficient: NaN outside Ω (which the
-/// model's data checks then report), never an evaluation of the exact solution there.
+/// region (so `h` and `φ` may be expressions or region tables); with a body below (SPEC §5)
+/// its reaction `− h_low (φ_low − u)⁺` too. It is [`crate::exact::manufactured_load`] as an
+/// assembly coefficient: NaN outside Ω (which the model's data checks then report), never
+/// an evaluation of the exact solution there.
 pub struct ManufacturedLoad<'a> {
     /// The manufactured solution u.
     pub exact: &'a dyn ExactSolution,
@@ -54,6 +55,8 @@ pub struct ManufacturedLoad<'a> {
     pub stiffness: &'a dyn Coefficient,
     /// The obstacle φ.
     pub shape: &'a dyn Coefficient,
+    /// The body below's stiffness h_low and surface φ_low, when there is one.
+    pub lower: Option<(&'a dyn Coefficient, &'a dyn Coefficient)>,
 }
 
 impl Coefficient for ManufacturedLoad<'_> {
@@ -63,7 +66,14 @@ impl Coefficient for ManufacturedLoad<'_> {
         }
         let h = self.stiffness.at(p, region);
         let phi = self.shape.at(p, region);
-        -self.tension * self.exact.laplacian(p) + h * (self.exact.value(p) - phi).max(0.0)
+        let u = self.exact.value(p);
+        let f = -self.tension * self.exact.laplacian(p) + h * (u - phi).max(0.0);
+        match self.lower {
+            Some((h_low, phi_low)) => {
+                f - h_low.at(p, region) * (phi_low.at(p, region) - u).max(0.0)
+            }
+            None => f,
+        }
     }
 
     fn on_region(&self, _region: u32) -> Option<f64> {
@@ -179,8 +189,28 @@ pub struct Study {
 /// does not contain the mesh ([`error_norms`]); a [`Target::Discrete`] reference whose
 /// length is not the finest mesh's vertex count.
 pub fn run(
+    hierarchy: Hierarchy,
+    data: &ProblemData,
+    target: Target,
+    settings: &StudySettings,
+    progress: &mut dyn FnMut(&LevelResult),
+) -> Result<Study> {
+    run_with(
+        hierarchy,
+        data,
+        &Extensions::default(),
+        target,
+        settings,
+        progress,
+    )
+}
+
+/// [`run`] with the data beyond the paper's frame (boundary heights and free edges, rigid
+/// regions, a body below; SPEC §5): the same on every level, like `data`.
+pub fn run_with(
     mut hierarchy: Hierarchy,
     data: &ProblemData,
+    ext: &Extensions,
     target: Target,
     settings: &StudySettings,
     progress: &mut dyn FnMut(&LevelResult),
@@ -213,13 +243,13 @@ pub fn run(
         let refine_seconds = t0.elapsed().as_secs_f64();
         let mesh = hierarchy.finest();
         let t1 = Instant::now();
-        let model = crate::checks::assemble(mesh, data).map_err(|e| at_level(level, e))?;
+        let model = crate::checks::assemble(mesh, data, ext).map_err(|e| at_level(level, e))?;
         let assembly_seconds = t1.elapsed().as_secs_f64();
         let t2 = Instant::now();
         let (solution, note) =
             solve_level(&model, &hierarchy, &settings.solver).map_err(|e| at_level(level, e))?;
         let solve_seconds = t2.elapsed().as_secs_f64();
-        let u = model.dofs.to_vertices(&solution.u, 0.0);
+        let u = model.to_vertices(&solution.u);
         let t3 = Instant::now();
         let errors = match target {
             Target::Exact(exact) => {
@@ -412,35 +442,50 @@ pub fn p1_norms(mesh: &Mesh, e: &[f64]) -> [f64; 3] {
 ///
 /// The radius is `√(A_h/π)`, meaningful when the contact zone is a disc.
 pub fn contact_estimate(mesh: &Mesh, model: &Model, u: &[f64]) -> ContactEstimate {
-    let area = if model.is_rigid() {
-        let mut touching = vec![false; mesh.n_vertices()];
+    let uv = model.to_vertices(u);
+    // A rigid body's zone: the nodal areas of the vertices on its surface.
+    let touching_area = |touching: &dyn Fn(usize, u32) -> bool| -> f64 {
+        let mut on = vec![false; mesh.n_vertices()];
         for (i, &v) in model.dofs.vertex.iter().enumerate() {
-            touching[v as usize] = model.can_touch[i] && u[i] == model.phi[i];
+            on[v as usize] = touching(i, v);
         }
         mesh.triangles
             .iter()
             .enumerate()
             .map(|(k, t)| {
-                let n = t.iter().filter(|&&v| touching[v as usize]).count();
+                let n = t.iter().filter(|&&v| on[v as usize]).count();
                 mesh.area(k).abs() * n as f64 / 3.0
             })
             .sum()
-    } else {
-        let uv = model.dofs.to_vertices(u, 0.0);
-        let g: Vec<f64> = uv
-            .iter()
-            .zip(&model.phi_vertices)
-            .map(|(a, b)| a - b)
-            .collect();
+    };
+    // An elastic body's zone: where the interpolated gap (positive inside) is positive.
+    let penetrated_area = |gap: &dyn Fn(usize) -> f64| -> f64 {
         mesh.triangles
             .iter()
             .enumerate()
             .map(|(k, t)| {
-                let gv = [g[t[0] as usize], g[t[1] as usize], g[t[2] as usize]];
+                let gv = [gap(t[0] as usize), gap(t[1] as usize), gap(t[2] as usize)];
                 mesh.area(k).abs() * positive_fraction(gv)
             })
             .sum()
     };
+    let upper = if model.is_rigid() {
+        touching_area(&|i, _| model.can_touch[i] && u[i] == model.phi[i])
+    } else if model.lower.is_some() && !model.can_touch.iter().any(|&c| c) {
+        0.0
+    } else {
+        penetrated_area(&|v| uv[v] - model.phi_vertices[v])
+    };
+    let lower = match &model.lower {
+        Some(low) if low.l.is_rigid() => {
+            touching_area(&|i, _| low.can_touch[i] && u[i] == low.phi[i])
+        }
+        Some(low) if low.can_touch.iter().any(|&c| c) => {
+            penetrated_area(&|v| low.phi_vertices[v] - uv[v])
+        }
+        _ => 0.0,
+    };
+    let area = upper + lower;
     ContactEstimate {
         area,
         radius: (area / std::f64::consts::PI).sqrt(),
@@ -524,9 +569,9 @@ pub fn rigid_limit_sweep(
         stiffness: Stiffness::Rigid,
         ..*data
     };
-    let rigid_model = crate::checks::assemble(mesh, &rigid_data)?;
+    let rigid_model = crate::checks::assemble(mesh, &rigid_data, &Extensions::default())?;
     let (rigid, _) = solve_level(&rigid_model, hierarchy, solver)?;
-    let rigid_u = rigid_model.dofs.to_vertices(&rigid.u, 0.0);
+    let rigid_u = rigid_model.to_vertices(&rigid.u);
     let rigid_contact = contact_estimate(mesh, &rigid_model, &rigid.u);
     let mut rows = Vec::with_capacity(stiffnesses.len());
     for &h in stiffnesses {
@@ -534,11 +579,11 @@ pub fn rigid_limit_sweep(
             stiffness: Stiffness::Elastic(&h),
             ..*data
         };
-        let model = crate::checks::assemble(mesh, &d)?;
+        let model = crate::checks::assemble(mesh, &d, &Extensions::default())?;
         let t = Instant::now();
         let (s, _) = solve_level(&model, hierarchy, solver)?;
         let solve_seconds = t.elapsed().as_secs_f64();
-        let u = model.dofs.to_vertices(&s.u, 0.0);
+        let u = model.to_vertices(&s.u);
         let diff: Vec<f64> = u.iter().zip(&rigid_u).map(|(a, b)| a - b).collect();
         let [l2, h1_semi, max_nodal] = p1_norms(mesh, &diff);
         rows.push(SweepRow {
@@ -649,6 +694,7 @@ mod tests {
             tension: 1.5,
             stiffness: &h,
             shape: &phi,
+            lower: None,
         };
         let base = generate::rectangle(&RectangleSpec {
             x0: 0.0,

@@ -726,6 +726,243 @@ impl ExactSolution for Manufactured {
     }
 }
 
+// ---------------------------------------------------------------------------------------
+
+/// PETSc SNES ex9's contact radius `a` (SPEC §5): where `√(1 − a²)` meets `−A ln a + B`
+/// with matching slopes.
+pub const EX9_RADIUS: f64 = 0.697965148223374;
+
+/// The radius where PETSc SNES ex9's obstacle turns from the sphere to its tangent line.
+pub const EX9_KNEE: f64 = 0.9;
+
+/// The classical radial obstacle benchmarks (SPEC §5): a rigid spherical cap with a
+/// conical skirt, `f = 0`, t = 1, the membrane lying on the cap for `r ≤ a` and harmonic
+/// beyond.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum BenchmarkKind {
+    /// PETSc SNES ex9: Ω = (−2, 2)², `ψ = √(1 − r²)` for `r ≤ 0.9` and its tangent line
+    /// beyond, `u = ψ` for `r ≤ a`, `u = −A ln r + B` beyond, `A = a²/√(1 − a²)`,
+    /// `B = A ln 2`, `g = u` on ∂Ω.
+    PetscEx9,
+    /// MFEM ex36: the same problem scaled by ½ onto the unit disc (`g = 0` on the circle).
+    MfemEx36,
+}
+
+/// A radial obstacle benchmark ([`BenchmarkKind`]) in either sign convention: the body
+/// below as in the benchmark (`u ≥ ψ`, `sign = 1`), or this project's obstacle above
+/// (`u ≤ φ = −ψ`, the solution `−u`, `sign = −1`).
+#[derive(Debug, Clone, Copy)]
+pub struct ObstacleBenchmark {
+    kind: BenchmarkKind,
+    /// 1 for ex9, ½ for ex36: `u(r) = s u₉(r / s)`.
+    scale: f64,
+    sign: f64,
+}
+
+impl ObstacleBenchmark {
+    /// The benchmark `kind`; `below = true` for the body below (the benchmark's own
+    /// convention), `false` for the obstacle above (the solution and obstacle negated).
+    pub fn new(kind: BenchmarkKind, below: bool) -> ObstacleBenchmark {
+        ObstacleBenchmark {
+            kind,
+            scale: match kind {
+                BenchmarkKind::PetscEx9 => 1.0,
+                BenchmarkKind::MfemEx36 => 0.5,
+            },
+            sign: if below { 1.0 } else { -1.0 },
+        }
+    }
+
+    /// `A = a²/√(1 − a²)` of ex9.
+    fn big_a() -> f64 {
+        EX9_RADIUS * EX9_RADIUS / (1.0 - EX9_RADIUS * EX9_RADIUS).sqrt()
+    }
+
+    /// ex9's radial profile at ρ: `[u, u', Δu]`.
+    fn profile(rho: f64) -> [f64; 3] {
+        let a = EX9_RADIUS;
+        if rho <= a {
+            let w = 1.0 - rho * rho;
+            [
+                w.sqrt(),
+                -rho / w.sqrt(),
+                -(2.0 - rho * rho) / (w * w.sqrt()),
+            ]
+        } else {
+            let big_a = Self::big_a();
+            [big_a * (2.0 / rho).ln(), -big_a / rho, 0.0]
+        }
+    }
+
+    /// ex9's obstacle ψ at ρ: the sphere, then its tangent line beyond 0.9.
+    pub fn ex9_obstacle(rho: f64) -> f64 {
+        let k = EX9_KNEE;
+        if rho <= k {
+            (1.0 - rho * rho).sqrt()
+        } else {
+            let c = (1.0 - k * k).sqrt();
+            c - k / c * (rho - k)
+        }
+    }
+
+    /// The body's surface at `p` in this convention: `ψ` below, `φ = −ψ` above.
+    pub fn surface(&self, p: [f64; 2]) -> f64 {
+        let s = self.scale;
+        self.sign * s * Self::ex9_obstacle(p[0].hypot(p[1]) / s)
+    }
+
+    /// `true` for the convention of the body below.
+    pub fn below(&self) -> bool {
+        self.sign > 0.0
+    }
+
+    /// Which benchmark.
+    pub fn kind(&self) -> BenchmarkKind {
+        self.kind
+    }
+}
+
+impl ExactSolution for ObstacleBenchmark {
+    fn value(&self, p: [f64; 2]) -> f64 {
+        let s = self.scale;
+        self.sign * s * Self::profile(p[0].hypot(p[1]) / s)[0]
+    }
+
+    fn gradient(&self, p: [f64; 2]) -> [f64; 2] {
+        let r = p[0].hypot(p[1]);
+        if r == 0.0 {
+            return [0.0, 0.0];
+        }
+        let du = self.sign * Self::profile(r / self.scale)[1];
+        [du * p[0] / r, du * p[1] / r]
+    }
+
+    fn laplacian(&self, p: [f64; 2]) -> f64 {
+        self.sign * Self::profile(p[0].hypot(p[1]) / self.scale)[2] / self.scale
+    }
+
+    fn contact_radius(&self) -> Option<f64> {
+        Some(self.scale * EX9_RADIUS)
+    }
+
+    fn contact_area(&self) -> Option<f64> {
+        let a = self.scale * EX9_RADIUS;
+        Some(PI * a * a)
+    }
+
+    fn contains(&self, p: [f64; 2]) -> bool {
+        match self.kind {
+            BenchmarkKind::PetscEx9 => {
+                let tol = 2.0 + 4e-10;
+                p[0].abs() <= tol && p[1].abs() <= tol
+            }
+            BenchmarkKind::MfemEx36 => p[0].hypot(p[1]) <= 1.0 + 1e-10,
+        }
+    }
+
+    fn disk(&self) -> Option<([f64; 2], f64)> {
+        match self.kind {
+            BenchmarkKind::PetscEx9 => None,
+            BenchmarkKind::MfemEx36 => Some(([0.0, 0.0], 1.0)),
+        }
+    }
+
+    fn describe(&self) -> String {
+        let (name, domain) = match self.kind {
+            BenchmarkKind::PetscEx9 => ("PETSc SNES ex9", "(−2, 2)², g = u on the boundary"),
+            BenchmarkKind::MfemEx36 => ("MFEM ex36", "the unit disc, g = 0"),
+        };
+        let convention = if self.below() {
+            "rigid body below, u ≥ ψ"
+        } else {
+            "rigid obstacle above, u ≤ φ = −ψ (the solution negated)"
+        };
+        format!(
+            "{name}: f = 0, t = 1 on {domain}; {convention}; contact radius a = {}",
+            self.scale * EX9_RADIUS
+        )
+    }
+}
+
+/// A manufactured solution with zero normal derivative on every side of a rectangle, so
+/// that any side may be free (the natural condition holds there) and the others fixed at
+/// `g = u`: `u = A (cos(πX) cos(πY) + ½ cos(2πY))` with `X = (x − x0)/(x1 − x0)`,
+/// `Y = (y − y0)/(y1 − y0)`; `u` ranges over `[−¾A, 3/2 A]`.
+#[derive(Debug, Clone, Copy)]
+pub struct ManufacturedCosine {
+    x0: f64,
+    y0: f64,
+    lx: f64,
+    ly: f64,
+    amplitude: f64,
+}
+
+impl ManufacturedCosine {
+    /// On the rectangle `[x0, x1] × [y0, y1]`. Errors: non-finite data, an empty rectangle.
+    pub fn rectangle(x0: f64, y0: f64, x1: f64, y1: f64, amplitude: f64) -> Result<Self> {
+        Manufactured::rectangle(x0, y0, x1, y1, amplitude)?;
+        Ok(ManufacturedCosine {
+            x0,
+            y0,
+            lx: x1 - x0,
+            ly: y1 - y0,
+            amplitude,
+        })
+    }
+}
+
+impl ExactSolution for ManufacturedCosine {
+    fn value(&self, p: [f64; 2]) -> f64 {
+        let (ax, ay) = (
+            PI * (p[0] - self.x0) / self.lx,
+            PI * (p[1] - self.y0) / self.ly,
+        );
+        self.amplitude * (ax.cos() * ay.cos() + 0.5 * (2.0 * ay).cos())
+    }
+
+    fn gradient(&self, p: [f64; 2]) -> [f64; 2] {
+        let (ax, ay) = (
+            PI * (p[0] - self.x0) / self.lx,
+            PI * (p[1] - self.y0) / self.ly,
+        );
+        let a = self.amplitude;
+        [
+            -a * PI / self.lx * ax.sin() * ay.cos(),
+            -a * PI / self.ly * (ax.cos() * ay.sin() + (2.0 * ay).sin()),
+        ]
+    }
+
+    fn laplacian(&self, p: [f64; 2]) -> f64 {
+        let (ax, ay) = (
+            PI * (p[0] - self.x0) / self.lx,
+            PI * (p[1] - self.y0) / self.ly,
+        );
+        let (kx, ky) = (PI / self.lx, PI / self.ly);
+        -self.amplitude
+            * ((kx * kx + ky * ky) * ax.cos() * ay.cos() + 2.0 * ky * ky * (2.0 * ay).cos())
+    }
+
+    fn contains(&self, p: [f64; 2]) -> bool {
+        let tol = 1e-10 * self.lx.max(self.ly);
+        p[0] >= self.x0 - tol
+            && p[0] <= self.x0 + self.lx + tol
+            && p[1] >= self.y0 - tol
+            && p[1] <= self.y0 + self.ly + tol
+    }
+
+    fn describe(&self) -> String {
+        format!(
+            "manufactured A (cos(πX) cos(πY) + ½ cos(2πY)) on [{}, {}] × [{}, {}] (zero normal \
+             derivative on every side), A = {}",
+            self.x0,
+            self.x0 + self.lx,
+            self.y0,
+            self.y0 + self.ly,
+            self.amplitude
+        )
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -1216,5 +1453,83 @@ mod tests {
         let g = |x: f64| (x - 1e-9).powi(3);
         let r = brent(g, 0.0, 1.0, g(0.0), g(1.0));
         assert!((r - 1e-9).abs() <= 1e-12, "{r}");
+    }
+
+    #[test]
+    fn obstacle_benchmarks_are_continuous_c1_and_harmonic_outside() {
+        let a = EX9_RADIUS;
+        for kind in [BenchmarkKind::PetscEx9, BenchmarkKind::MfemEx36] {
+            for below in [true, false] {
+                let b = ObstacleBenchmark::new(kind, below);
+                let s = b.scale;
+                let r = s * a;
+                // Value and slope match at the contact radius.
+                let (lo, hi) = ([r * (1.0 - 1e-12), 0.0], [r * (1.0 + 1e-12), 0.0]);
+                assert!((b.value(lo) - b.value(hi)).abs() < 1e-10);
+                assert!((b.gradient(lo)[0] - b.gradient(hi)[0]).abs() < 1e-9);
+                // u = ψ on the contact disc, u above ψ (below φ) beyond.
+                for k in 0..=40 {
+                    let rho = 1.9 * s * k as f64 / 40.0;
+                    let p = [rho * 0.6, rho * 0.8];
+                    let gap = b.sign * (b.value(p) - b.surface(p));
+                    if rho <= r {
+                        assert!(gap.abs() < 1e-14, "{kind:?} r {rho}");
+                    } else {
+                        assert!(gap > 0.0, "{kind:?} r {rho}: {gap}");
+                    }
+                }
+                // The outer part is harmonic: a finite-difference Laplacian vanishes.
+                let p = [0.8 * s, 0.5 * s];
+                let d = 1e-4 * s;
+                let fd = (b.value([p[0] + d, p[1]])
+                    + b.value([p[0] - d, p[1]])
+                    + b.value([p[0], p[1] + d])
+                    + b.value([p[0], p[1] - d])
+                    - 4.0 * b.value(p))
+                    / (d * d);
+                assert!(fd.abs() < 1e-5, "{fd}");
+                assert_eq!(b.laplacian(p), 0.0);
+            }
+        }
+        // MFEM ex36 is ex9 scaled by ½: u = ln r × A₃₆ outside, A₃₆ = −0.340129705945858.
+        let m = ObstacleBenchmark::new(BenchmarkKind::MfemEx36, true);
+        let p: [f64; 2] = [0.5, 0.3];
+        let r = p[0].hypot(p[1]);
+        assert!((m.value(p) - (-0.340129705945858) * r.ln()).abs() < 1e-13);
+        assert!(m.value([1.0, 0.0]).abs() < 1e-15);
+        // ex9's boundary values: u = A ln(2/r), zero at the midpoints of the sides.
+        let e = ObstacleBenchmark::new(BenchmarkKind::PetscEx9, true);
+        assert!(e.value([2.0, 0.0]).abs() < 1e-15);
+        assert!(e.value([2.0, 2.0]) < 0.0);
+    }
+
+    #[test]
+    fn the_cosine_manufactured_solution_has_its_derivatives() {
+        let m = ManufacturedCosine::rectangle(0.0, 0.0, 2.0, 1.0, 0.3).unwrap();
+        let d = 1e-5;
+        for p in [[0.3, 0.2], [1.1, 0.7], [1.9, 0.45]] {
+            let g = m.gradient(p);
+            let fx = (m.value([p[0] + d, p[1]]) - m.value([p[0] - d, p[1]])) / (2.0 * d);
+            let fy = (m.value([p[0], p[1] + d]) - m.value([p[0], p[1] - d])) / (2.0 * d);
+            assert!((g[0] - fx).abs() < 1e-8 && (g[1] - fy).abs() < 1e-8);
+            let lap = (m.value([p[0] + d, p[1]])
+                + m.value([p[0] - d, p[1]])
+                + m.value([p[0], p[1] + d])
+                + m.value([p[0], p[1] - d])
+                - 4.0 * m.value(p))
+                / (d * d);
+            assert!(
+                (m.laplacian(p) - lap).abs() < 1e-4,
+                "{} {lap}",
+                m.laplacian(p)
+            );
+        }
+        // The normal derivative vanishes on every side.
+        for t in [0.1, 0.5, 0.9] {
+            assert!(m.gradient([0.0, t])[0].abs() < 1e-14);
+            assert!(m.gradient([2.0, t])[0].abs() < 1e-14);
+            assert!(m.gradient([2.0 * t, 0.0])[1].abs() < 1e-14);
+            assert!(m.gradient([2.0 * t, 1.0])[1].abs() < 1e-14);
+        }
     }
 }

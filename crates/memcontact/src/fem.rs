@@ -267,6 +267,43 @@ pub fn assemble_vector(
         .collect()
 }
 
+/// The lifting of boundary data (SPEC §5): `(S_fix G)_i = t Σ_j ∫ ∇g_i·∇g_j G_j` over the
+/// fixed vertices j (those without an unknown), for every unknown i. `g` holds G over all
+/// vertices (its values at unknowns are not used).
+pub fn assemble_lift(
+    mesh: &Mesh,
+    dofs: &DofMap,
+    adj: &VertexTriangles,
+    t: f64,
+    g: &[f64],
+) -> Vec<f64> {
+    dofs.vertex
+        .par_iter()
+        .with_min_len(1024)
+        .map(|&v| {
+            let v = v as usize;
+            let mut sum = 0.0;
+            for &k in adj.of(v) {
+                let tri = mesh.triangles[k as usize];
+                if tri.iter().all(|&w| dofs.dof[w as usize].is_some()) {
+                    continue;
+                }
+                let e = Element::of(mesh, k as usize);
+                let a = tri
+                    .iter()
+                    .position(|&w| w as usize == v)
+                    .expect("v in triangle");
+                for (b, &w) in tri.iter().enumerate() {
+                    if dofs.dof[w as usize].is_none() {
+                        sum += t * e.stiffness(a, b) * g[w as usize];
+                    }
+                }
+            }
+            sum
+        })
+        .collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

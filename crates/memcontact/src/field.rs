@@ -395,16 +395,38 @@ impl BoundField {
     }
 }
 
-/// The foundation stiffness h: an elastic (Winkler) obstacle with `h ≥ 0`, or the rigid
-/// obstacle `h = ∞` of the classical obstacle problem `u ≤ φ` (SPEC §1, limits).
+/// The foundation stiffness h: an elastic (Winkler) obstacle with `h ≥ 0`, the rigid
+/// obstacle `h = ∞` of the classical obstacle problem `u ≤ φ` (SPEC §1, limits), or a body
+/// rigid in some regions and elastic in others.
 ///
-/// Deserialises like a [`Field`], and from the string `"rigid"` (any case).
+/// Deserialises like a [`Field`], from the string `"rigid"` (any case), and from a region
+/// table whose values may be `"rigid"`: `{ plinth = "rigid", default = 200 }`.
 #[derive(Clone, Debug, PartialEq)]
 pub enum Stiffness {
     /// A finite stiffness field `h ≥ 0`.
     Elastic(Field),
     /// The rigid obstacle.
     Rigid,
+    /// A region table in which some regions (or the default) are rigid: every value is
+    /// [`Stiffness::Rigid`] or [`Stiffness::Elastic`] of a number or an expression.
+    Mixed(BTreeMap<String, Stiffness>),
+}
+
+/// A [`Stiffness`] resolved against a mesh: the elastic part (zero on the rigid regions)
+/// and the tags of the rigid regions.
+#[derive(Clone, Debug)]
+pub struct BoundStiffness {
+    /// h on the elastic regions, 0 on the rigid ones (`None`: every region is rigid).
+    pub elastic: Option<BoundField>,
+    /// The region tags that are rigid (all of them when `elastic` is `None`).
+    pub rigid_tags: Vec<u32>,
+}
+
+impl BoundStiffness {
+    /// `true` when every region is rigid.
+    pub fn is_rigid(&self) -> bool {
+        self.elastic.is_none()
+    }
 }
 
 impl Stiffness {
@@ -422,11 +444,86 @@ impl Stiffness {
         matches!(self, Stiffness::Rigid)
     }
 
-    /// The stiffness field of an elastic obstacle.
+    /// The stiffness field of an elastic obstacle (`None` for a rigid or mixed body).
     pub fn field(&self) -> Option<&Field> {
         match self {
             Stiffness::Elastic(f) => Some(f),
-            Stiffness::Rigid => None,
+            Stiffness::Rigid | Stiffness::Mixed(_) => None,
+        }
+    }
+
+    /// The elastic part of a mixed table: the rigid entries replaced by 0 (the elastic
+    /// term is integrated over the elastic triangles only).
+    fn elastic_table(table: &BTreeMap<String, Stiffness>) -> Field {
+        Field::Regions(
+            table
+                .iter()
+                .map(|(k, v)| {
+                    let f = match v {
+                        Stiffness::Elastic(f) => f.clone(),
+                        _ => Field::Constant(0.0),
+                    };
+                    (k.clone(), f)
+                })
+                .collect(),
+        )
+    }
+
+    /// The elastic fields of the stiffness (a mixed table's elastic entries), for checks.
+    pub fn elastic_fields(&self) -> Vec<(String, &Field)> {
+        match self {
+            Stiffness::Elastic(f) => vec![(String::new(), f)],
+            Stiffness::Rigid => Vec::new(),
+            Stiffness::Mixed(t) => t
+                .iter()
+                .filter_map(|(k, v)| match v {
+                    Stiffness::Elastic(f) => Some((format!(".{k}"), f)),
+                    _ => None,
+                })
+                .collect(),
+        }
+    }
+
+    /// Resolves the stiffness against `mesh` ([`Field::bind_to_mesh`] for the elastic
+    /// part; the rigid entries of a mixed table name regions like any other key).
+    pub fn bind_to_mesh(&self, name: &str, mesh: &Mesh) -> Result<BoundStiffness> {
+        let mut tags: Vec<u32> = mesh.regions.clone();
+        tags.sort_unstable();
+        tags.dedup();
+        match self {
+            Stiffness::Rigid => Ok(BoundStiffness {
+                elastic: None,
+                rigid_tags: tags,
+            }),
+            Stiffness::Elastic(h) => Ok(BoundStiffness {
+                elastic: Some(h.bind_to_mesh(name, mesh)?),
+                rigid_tags: Vec::new(),
+            }),
+            Stiffness::Mixed(table) => {
+                // Which regions are rigid: a marker table bound like the stiffness itself,
+                // so that names, tags and the default resolve with the same rules.
+                let marker = Field::Regions(
+                    table
+                        .iter()
+                        .map(|(k, v)| (k.clone(), Field::Constant(f64::from(v.is_rigid()))))
+                        .collect(),
+                );
+                let marker = marker.bind(name, &mesh.region_names, &tags)?;
+                let rigid_tags: Vec<u32> = tags
+                    .iter()
+                    .copied()
+                    .filter(|&t| marker.region_constant(t) == Some(1.0))
+                    .collect();
+                let elastic = if rigid_tags.len() == tags.len() {
+                    None
+                } else {
+                    Some(Stiffness::elastic_table(table).bind(name, &mesh.region_names, &tags)?)
+                };
+                Ok(BoundStiffness {
+                    elastic,
+                    rigid_tags,
+                })
+            }
         }
     }
 }
@@ -632,8 +729,8 @@ impl<'de> serde::Deserialize<'de> for RegionValue {
             fn visit_str<E: de::Error>(self, v: &str) -> std::result::Result<RegionValue, E> {
                 if v.trim().eq_ignore_ascii_case("rigid") {
                     return Err(E::custom(
-                        "\"rigid\" cannot be the value of one region: only the whole \
-                         obstacle can be rigid (h = \"rigid\")",
+                        "\"rigid\" is a stiffness: only the regions of a stiffness table \
+                         can be rigid",
                     ));
                 }
                 Field::parse(v).map(RegionValue).map_err(E::custom)
@@ -668,12 +765,72 @@ impl<'de> Visitor<'de> for StiffnessVisitor {
         Stiffness::parse(v).map_err(E::custom)
     }
 
-    fn visit_map<A: MapAccess<'de>>(self, map: A) -> std::result::Result<Stiffness, A::Error> {
-        FieldVisitor.visit_map(map).map(Stiffness::Elastic)
+    fn visit_map<A: MapAccess<'de>>(self, mut map: A) -> std::result::Result<Stiffness, A::Error> {
+        let mut table = BTreeMap::new();
+        while let Some((key, RegionStiffness(value))) =
+            map.next_entry::<String, RegionStiffness>()?
+        {
+            if table.contains_key(&key) {
+                return Err(de::Error::custom(format!("region '{key}' is given twice")));
+            }
+            table.insert(key, value);
+        }
+        if table.is_empty() {
+            return Err(de::Error::custom(
+                "an empty table: give at least one region or a \"default\"",
+            ));
+        }
+        if table.values().any(Stiffness::is_rigid) {
+            return Ok(Stiffness::Mixed(table));
+        }
+        Ok(Stiffness::Elastic(Field::Regions(
+            table
+                .into_iter()
+                .map(|(k, v)| match v {
+                    Stiffness::Elastic(f) => (k, f),
+                    _ => unreachable!("no rigid entry"),
+                })
+                .collect(),
+        )))
     }
 
     fn visit_seq<A: SeqAccess<'de>>(self, seq: A) -> std::result::Result<Stiffness, A::Error> {
         FieldVisitor.visit_seq(seq).map(Stiffness::Elastic)
+    }
+}
+
+/// The value of one region in a stiffness table: `"rigid"`, a number or a string.
+struct RegionStiffness(Stiffness);
+
+impl<'de> serde::Deserialize<'de> for RegionStiffness {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> std::result::Result<RegionStiffness, D::Error> {
+        struct V;
+        impl<'de> Visitor<'de> for V {
+            type Value = RegionStiffness;
+            fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
+                f.write_str(
+                    "a region's stiffness: \"rigid\", a number or a string with a number or \
+                     an expression",
+                )
+            }
+            fn visit_i64<E: de::Error>(self, v: i64) -> std::result::Result<RegionStiffness, E> {
+                Ok(RegionStiffness(Stiffness::Elastic(Field::Constant(
+                    v as f64,
+                ))))
+            }
+            fn visit_u64<E: de::Error>(self, v: u64) -> std::result::Result<RegionStiffness, E> {
+                Ok(RegionStiffness(Stiffness::Elastic(Field::Constant(
+                    v as f64,
+                ))))
+            }
+            fn visit_f64<E: de::Error>(self, v: f64) -> std::result::Result<RegionStiffness, E> {
+                Ok(RegionStiffness(Stiffness::Elastic(Field::Constant(v))))
+            }
+            fn visit_str<E: de::Error>(self, v: &str) -> std::result::Result<RegionStiffness, E> {
+                Stiffness::parse(v).map(RegionStiffness).map_err(E::custom)
+            }
+        }
+        d.deserialize_any(V)
     }
 }
 
@@ -708,6 +865,13 @@ impl serde::Serialize for Stiffness {
         match self {
             Stiffness::Elastic(f) => f.serialize(s),
             Stiffness::Rigid => s.serialize_str("rigid"),
+            Stiffness::Mixed(table) => {
+                let mut map = s.serialize_map(Some(table.len()))?;
+                for (k, v) in table {
+                    map.serialize_entry(k, v)?;
+                }
+                map.end()
+            }
         }
     }
 }
@@ -921,10 +1085,19 @@ mod tests {
         assert!(matches!(s, Stiffness::Elastic(Field::Expr(_))));
         let s: Stiffness = serde_json::from_str(r#"{"soil": 100, "foam": "50*x"}"#).unwrap();
         assert!(matches!(s, Stiffness::Elastic(Field::Regions(ref t)) if t.len() == 2));
-        let e = serde_json::from_str::<Stiffness>(r#"{"soil": "rigid"}"#)
+        // A table may make some regions rigid (mixed bodies); other fields may not.
+        let s: Stiffness = serde_json::from_str(r#"{"soil": "rigid", "foam": 50}"#).unwrap();
+        let Stiffness::Mixed(t) = &s else {
+            panic!("{s:?}")
+        };
+        assert_eq!(t["soil"], Stiffness::Rigid);
+        assert_eq!(t["foam"], Stiffness::Elastic(Field::Constant(50.0)));
+        let back = serde_json::to_string(&s).unwrap();
+        assert_eq!(serde_json::from_str::<Stiffness>(&back).unwrap(), s);
+        let e = serde_json::from_str::<Field>(r#"{"soil": "rigid"}"#)
             .unwrap_err()
             .to_string();
-        assert!(e.contains("only the whole obstacle can be rigid"), "{e}");
+        assert!(e.contains("only the regions of a stiffness table"), "{e}");
     }
 
     #[test]

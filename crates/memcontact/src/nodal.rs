@@ -267,6 +267,8 @@ mod tests {
                     sampling: SamplingKind::Nodal,
                     epsilon: None,
                 },
+                boundary: Default::default(),
+                lower: None,
             };
             let solve = |p: Problem| {
                 let d = Discretization::assemble(&p, Hierarchy::single(mesh.clone()), &mut Silent)

@@ -34,6 +34,16 @@ pub const NODAL_FIELDS: [&str; 6] = [
     "state",
 ];
 
+/// The columns of `nodes.csv` (and point fields of `solution.vtu`) a body below adds, after
+/// [`NODAL_FIELDS`].
+pub const LOWER_FIELDS: [&str; 5] = [
+    "phi_low",
+    "penetration_low",
+    "pressure_low",
+    "contact_force_low",
+    "state_low",
+];
+
 /// How a result set is written.
 #[derive(Debug, Clone)]
 pub struct WriteOptions {
@@ -118,8 +128,29 @@ pub fn write_fields(
         ("contact_force", DataArray::F64(&fields.contact_force)),
         ("state", DataArray::I32(&state)),
     ];
+    // The body below's fields follow the paper's (SPEC §5), when there is one.
+    let lower = fields.lower.as_ref();
+    let state_low: Vec<i32> =
+        lower.map_or(Vec::new(), |l| l.state.iter().map(|&s| s as i32).collect());
+    let covered_low: Vec<i32> = lower.map_or(Vec::new(), |l| {
+        l.covered.iter().map(|&c| c as i32).collect()
+    });
+    let lower_data: Vec<(&str, DataArray)> = match lower {
+        Some(l) => vec![
+            ("phi_low", DataArray::F64(&l.phi)),
+            ("penetration_low", DataArray::F64(&l.penetration)),
+            ("pressure_low", DataArray::F64(&l.pressure)),
+            ("contact_force_low", DataArray::F64(&l.contact_force)),
+            ("state_low", DataArray::I32(&state_low)),
+        ],
+        None => Vec::new(),
+    };
     let mut vtu_points = point_data.to_vec();
     vtu_points.push(("covered", DataArray::I32(&covered)));
+    vtu_points.extend(lower_data.iter().cloned());
+    if lower.is_some() {
+        vtu_points.push(("covered_low", DataArray::I32(&covered_low)));
+    }
     write_vtu_with_field_data(
         &dir.join("solution.vtu"),
         mesh,
@@ -135,6 +166,7 @@ pub fn write_fields(
     let y: Vec<f64> = mesh.points.iter().map(|p| p[1]).collect();
     let mut columns = vec![("x", DataArray::F64(&x)), ("y", DataArray::F64(&y))];
     columns.extend(point_data);
+    columns.extend(lower_data);
     write_columns_csv(&dir.join("nodes.csv"), &columns)
 }
 

@@ -26,7 +26,8 @@ pub const MAX_REFINE: usize = 12;
 
 /// A whole case: the problem, how to solve it, what to write, and (optionally) its exact
 /// solution. The TOML case file has the sections `[mesh]`, `[membrane]`, `[obstacle]`,
-/// `[solver]`, `[output]` and `[exact]`.
+/// `[solver]`, `[output]` and `[exact]`, and, beyond the paper's frame, `[boundary]` (heights
+/// and free edges) and `[lower]` (a body below).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(from = "CaseFile", into = "CaseFile")]
 pub struct Case {
@@ -66,6 +67,10 @@ struct CaseFile {
     mesh: MeshSpec,
     membrane: Membrane,
     obstacle: Obstacle,
+    #[serde(default, skip_serializing_if = "Boundary::is_default")]
+    boundary: Boundary,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    lower: Option<Obstacle>,
     #[serde(default)]
     solver: Settings,
     #[serde(default)]
@@ -87,6 +92,8 @@ impl From<CaseFile> for Case {
                 mesh: c.mesh,
                 membrane: c.membrane,
                 obstacle: c.obstacle,
+                boundary: c.boundary,
+                lower: c.lower,
             },
             settings: c.solver,
             output: c.output,
@@ -104,6 +111,8 @@ impl From<Case> for CaseFile {
             mesh: c.problem.mesh,
             membrane: c.problem.membrane,
             obstacle: c.problem.obstacle,
+            boundary: c.problem.boundary,
+            lower: c.problem.lower,
             solver: c.settings,
             output: c.output,
             exact: c.exact,
@@ -125,6 +134,53 @@ pub struct Problem {
     pub membrane: Membrane,
     /// `[obstacle]`: the elastic (or rigid) body.
     pub obstacle: Obstacle,
+    /// `[boundary]`: the heights on the fixed boundary and the free boundary regions
+    /// (default: the whole boundary fixed at 0, as in the paper).
+    #[serde(default, skip_serializing_if = "Boundary::is_default")]
+    pub boundary: Boundary,
+    /// `[lower]`: a second body below the membrane (its surface, stiffness, foundation and
+    /// sampling, with the keys of `[obstacle]`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub lower: Option<Obstacle>,
+}
+
+/// `[boundary]`: `u = g` on the fixed part of the boundary, the natural condition
+/// (no force across the edge) on the free part.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Boundary {
+    /// The height g (length): a number, an expression of x and y, a table per boundary
+    /// region (Gmsh physical curves; the generators' sides `left`, `right`, `bottom`,
+    /// `top`, `outer`, `hole1`, ...), or one value per vertex.
+    #[serde(default = "zero_height", skip_serializing_if = "is_zero")]
+    pub height: Field,
+    /// The boundary regions that are not fixed (names, or tags as text).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub free: Vec<String>,
+}
+
+fn zero_height() -> Field {
+    Field::Constant(0.0)
+}
+
+fn is_zero(f: &Field) -> bool {
+    matches!(f, Field::Constant(v) if *v == 0.0)
+}
+
+impl Default for Boundary {
+    fn default() -> Boundary {
+        Boundary {
+            height: zero_height(),
+            free: Vec::new(),
+        }
+    }
+}
+
+impl Boundary {
+    /// The paper's frame: everything fixed at height 0.
+    pub fn is_default(&self) -> bool {
+        is_zero(&self.height) && self.free.is_empty()
+    }
 }
 
 /// `[membrane]`.
@@ -528,6 +584,26 @@ impl MeshSpec {
         )
     }
 
+    /// The names of the boundary regions a generator gives its mesh, in the order of their
+    /// tags (`None` for a mesh file: its physical curves are known once it is read).
+    pub fn boundary_region_names(&self) -> Option<Vec<String>> {
+        match &self.source {
+            MeshSource::File(_) => None,
+            MeshSource::Rectangle { .. } => Some(
+                generate::RECTANGLE_SIDES
+                    .iter()
+                    .map(|s| s.to_string())
+                    .collect(),
+            ),
+            MeshSource::Disk { .. } => Some(vec!["outer".into()]),
+            MeshSource::Polygon { holes, .. } => Some(
+                std::iter::once("outer".to_string())
+                    .chain((1..=holes.len()).map(|h| format!("hole{h}")))
+                    .collect(),
+            ),
+        }
+    }
+
     /// Builds the mesh and its hierarchy of levels; warnings (from a Gmsh import) are
     /// returned for the caller to show. The memory the run on the refined mesh needs is
     /// checked before the base mesh is generated (when its size is known beforehand) and
@@ -849,12 +925,32 @@ pub enum VtuFormat {
 pub enum ExactSpec {
     /// The axisymmetric disc (constant t, f, h, φ on a disc mesh): Bessel functions.
     Disk {},
-    /// A manufactured solution: the load is replaced by `f = −tΔu + h(u − φ)⁺`.
+    /// A manufactured solution: the load is replaced by `f = −tΔu + h(u − φ)⁺` (minus
+    /// `h_low(φ_low − u)⁺` with a body below) and the heights of the fixed boundary by u.
     Manufactured {
         /// The domain of the manufactured u (it vanishes on its boundary).
         domain: ManufacturedDomain,
         /// The scale of u.
         amplitude: f64,
+        /// Which u: one vanishing on the boundary (default), or, on a rectangle, one with
+        /// zero normal derivative on every side (any side may then be free).
+        #[serde(default, skip_serializing_if = "ManufacturedForm::is_default")]
+        form: ManufacturedForm,
+    },
+    /// PETSc SNES ex9: the rigid spherical obstacle on (−2, 2)² with its boundary data.
+    #[serde(rename = "petsc-ex9")]
+    PetscEx9 {
+        /// Which body is the obstacle: `"obstacle"` above (u ≤ φ = −ψ, the solution
+        /// negated; default) or `"lower"` (u ≥ ψ, as in PETSc).
+        #[serde(default, skip_serializing_if = "BenchmarkBody::is_default")]
+        body: BenchmarkBody,
+    },
+    /// MFEM ex36: PETSc SNES ex9 scaled by ½ onto the unit disc (g = 0).
+    #[serde(rename = "mfem-ex36")]
+    MfemEx36 {
+        /// As for `petsc-ex9`.
+        #[serde(default, skip_serializing_if = "BenchmarkBody::is_default")]
+        body: BenchmarkBody,
     },
 }
 
@@ -864,6 +960,8 @@ impl ExactSpec {
         match self {
             ExactSpec::Disk {} => "disk",
             ExactSpec::Manufactured { .. } => "manufactured",
+            ExactSpec::PetscEx9 { .. } => "petsc-ex9",
+            ExactSpec::MfemEx36 { .. } => "mfem-ex36",
         }
     }
 }
@@ -876,6 +974,41 @@ pub enum ManufacturedDomain {
     Rectangle,
     /// The disc of `[mesh]`.
     Disk,
+}
+
+/// Which manufactured solution.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum ManufacturedForm {
+    /// u vanishes on the boundary (the paper's frame).
+    #[default]
+    Vanishing,
+    /// On a rectangle, `u = A (cos(πX) cos(πY) + ½ cos(2πY))`: zero normal derivative on
+    /// every side, so sides may be free, and non-zero heights on the fixed ones.
+    Cosine,
+}
+
+impl ManufacturedForm {
+    fn is_default(&self) -> bool {
+        *self == ManufacturedForm::Vanishing
+    }
+}
+
+/// The body of a rigid obstacle benchmark.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum BenchmarkBody {
+    /// The obstacle above (`[obstacle]`), with the problem negated.
+    #[default]
+    Obstacle,
+    /// The body below (`[lower]`), the benchmark's own convention.
+    Lower,
+}
+
+impl BenchmarkBody {
+    fn is_default(&self) -> bool {
+        *self == BenchmarkBody::Obstacle
+    }
 }
 
 /// A value refused by validation: the key (dotted path) and what is wrong.
@@ -941,7 +1074,8 @@ fn check_field(key: &str, f: &Field, non_negative: bool) -> std::result::Result<
 
 impl Problem {
     /// Checks every value that can be checked without the mesh: t > 0, constants finite,
-    /// h ≥ 0, ε > 0 and only with mollified sampling, the mesh generator's parameters.
+    /// h ≥ 0, ε > 0 and only with mollified sampling, the mesh generator's parameters, the
+    /// boundary heights and, for the generators, the names of the boundary regions.
     pub fn validate(&self) -> std::result::Result<(), Invalid> {
         self.mesh.validate()?;
         let t = self.membrane.tension;
@@ -952,30 +1086,95 @@ impl Problem {
             ));
         }
         check_field("membrane.load", &self.membrane.load, false)?;
-        check_field("obstacle.shape", &self.obstacle.shape, false)?;
-        if let Stiffness::Elastic(h) = &self.obstacle.stiffness {
-            check_field("obstacle.stiffness", h, true)?;
+        self.obstacle.validate("obstacle")?;
+        if let Some(low) = &self.lower {
+            low.validate("lower")?;
         }
-        if let (SamplingKind::Mollified, Field::Nodal(_)) =
-            (self.obstacle.sampling, &self.obstacle.shape)
-        {
+        self.boundary.validate(&self.mesh)
+    }
+}
+
+impl Obstacle {
+    /// Checks a body's constants (the section is `obstacle` or `lower`).
+    fn validate(&self, section: &str) -> std::result::Result<(), Invalid> {
+        check_field(&format!("{section}.shape"), &self.shape, false)?;
+        for (key, h) in self.stiffness.elastic_fields() {
+            check_field(&format!("{section}.stiffness{key}"), h, true)?;
+        }
+        if let (SamplingKind::Mollified, Field::Nodal(_)) = (self.sampling, &self.shape) {
             return Err(Invalid::new(
-                "obstacle.sampling",
+                format!("{section}.sampling"),
                 "mollified sampling needs φ as a function of x and y; nodal values of φ \
                  are its samples (use sampling = \"nodal\")",
             ));
         }
-        match (self.obstacle.sampling, self.obstacle.epsilon) {
+        match (self.sampling, self.epsilon) {
             (SamplingKind::Nodal, Some(_)) => Err(Invalid::new(
-                "obstacle.epsilon",
+                format!("{section}.epsilon"),
                 "is only used with sampling = \"mollified\"",
             )),
             (SamplingKind::Mollified, Some(e)) if !(e.is_finite() && e > 0.0) => Err(Invalid::new(
-                "obstacle.epsilon",
+                format!("{section}.epsilon"),
                 format!("must be a finite number > 0, got {e}"),
             )),
             _ => Ok(()),
         }
+    }
+}
+
+impl Boundary {
+    /// Checks the heights' constants and, when the mesh generator names its boundary
+    /// regions, that `free` and the keys of a height table name existing regions.
+    fn validate(&self, mesh: &MeshSpec) -> std::result::Result<(), Invalid> {
+        check_field("boundary.height", &self.height, false)?;
+        for (i, name) in self.free.iter().enumerate() {
+            if name.trim().is_empty() {
+                return Err(Invalid::new("boundary.free", format!("entry {i} is empty")));
+            }
+            if self.free[..i].contains(name) {
+                return Err(Invalid::new(
+                    "boundary.free",
+                    format!("\"{name}\" is listed twice"),
+                ));
+            }
+        }
+        let Some(sides) = mesh.boundary_region_names() else {
+            return Ok(());
+        };
+        let known = |k: &str| {
+            sides.iter().any(|s| s == k)
+                || k.trim()
+                    .parse::<usize>()
+                    .is_ok_and(|t| t >= 1 && t <= sides.len())
+        };
+        let listing = sides.join(", ");
+        for name in &self.free {
+            if !known(name) {
+                return Err(Invalid::new(
+                    "boundary.free",
+                    format!(
+                        "no boundary region named '{name}' (the {} generator's boundary \
+                         regions: {listing})",
+                        mesh.kind()
+                    ),
+                ));
+            }
+        }
+        if let Field::Regions(table) = &self.height {
+            for key in table.keys() {
+                if key != crate::field::DEFAULT_KEY && !known(key) {
+                    return Err(Invalid::new(
+                        format!("boundary.height.{key}"),
+                        format!(
+                            "no boundary region named '{key}' (the {} generator's boundary \
+                             regions: {listing})",
+                            mesh.kind()
+                        ),
+                    ));
+                }
+            }
+        }
+        Ok(())
     }
 }
 

@@ -6,7 +6,7 @@ use crate::mesh::Mesh;
 use crate::model::Model;
 use crate::solve::Solution;
 
-/// Fields over all mesh vertices (boundary vertices included, u = 0 there).
+/// Fields over all mesh vertices (u = g on the fixed boundary, 0 by default).
 #[derive(Debug, Clone)]
 pub struct NodalFields {
     /// Deflection u.
@@ -15,14 +15,35 @@ pub struct NodalFields {
     pub phi: Vec<f64>,
     /// Penetration (u − φ)⁺ (zero where the obstacle cannot touch).
     pub penetration: Vec<f64>,
-    /// Contact pressure h (u − φ)⁺; for the rigid obstacle, the nodal contact force per
-    /// unit of nodal area X₁ᵢ / (|Qᵢ|/3).
+    /// Contact pressure h (u − φ)⁺; where the obstacle is rigid, the nodal contact force
+    /// per unit of nodal area X₁ᵢ / (|Qᵢ|/3).
     pub pressure: Vec<f64>,
-    /// Nodal contact force X₁ = D − SU on M (zero elsewhere and on the boundary).
+    /// Nodal contact force of the obstacle X₁ (= D − SU on M without a body below; the
+    /// obstacle's share of it with one), zero elsewhere and on the fixed boundary.
     pub contact_force: Vec<f64>,
     /// −1 clear, 0 touching (U = φ), 1 penetrating.
     pub state: Vec<i8>,
     /// Where the body lies against the membrane: h > 0 around the vertex, or rigid.
+    pub covered: Vec<bool>,
+    /// The body below's fields, when there is one.
+    pub lower: Option<LowerFields>,
+}
+
+/// The body below's fields over all vertices (SPEC §5).
+#[derive(Debug, Clone)]
+pub struct LowerFields {
+    /// Its sampled surface φ_low.
+    pub phi: Vec<f64>,
+    /// Penetration (φ_low − u)⁺ (zero where it cannot touch).
+    pub penetration: Vec<f64>,
+    /// Contact pressure h_low (φ_low − u)⁺, or, where rigid, the nodal force per nodal
+    /// area (positive pushing up).
+    pub pressure: Vec<f64>,
+    /// Its nodal contact force (pushing up).
+    pub contact_force: Vec<f64>,
+    /// −1 clear, 0 touching (U = φ_low), 1 penetrating (U < φ_low).
+    pub state: Vec<i8>,
+    /// Where it lies under the membrane (h_low > 0 around the vertex, or rigid).
     pub covered: Vec<bool>,
 }
 
@@ -54,6 +75,31 @@ pub struct Totals {
     pub min_u: f64,
     /// The largest u.
     pub max_u: f64,
+    /// The body below's totals, when there is one.
+    pub lower: Option<LowerTotals>,
+}
+
+/// The body below's totals (SPEC §5).
+#[derive(Debug, Clone, Copy, serde::Serialize)]
+pub struct LowerTotals {
+    /// Unknowns it can touch.
+    pub can_touch_low_vertices: usize,
+    /// Vertices in contact with it (touching or penetrating).
+    pub contact_low_vertices: usize,
+    /// Vertices exactly on it (U = φ_low).
+    pub touching_low_vertices: usize,
+    /// Vertices sunk into it (U < φ_low).
+    pub penetrating_low_vertices: usize,
+    /// Vertices in contact with both bodies at once (squeezed between them).
+    pub squeezed_vertices: usize,
+    /// Σ |Qᵢ|/3 over the vertices in contact with it.
+    pub contact_area_low: f64,
+    /// Its total force on the membrane (positive pushing up).
+    pub total_contact_force_low: f64,
+    /// Its largest contact pressure.
+    pub max_pressure_low: f64,
+    /// Area where it lies under the membrane but the membrane is clear of it.
+    pub liftoff_area_low: f64,
 }
 
 /// Computes the vertex fields and totals of `solution`.
@@ -61,18 +107,43 @@ pub fn derive(mesh: &Mesh, model: &Model, solution: &Solution) -> (NodalFields, 
     derive_from(mesh, model, &solution.u)
 }
 
+/// Nodal areas |Q_i| / 3 of every vertex.
+fn nodal_areas(mesh: &Mesh) -> Vec<f64> {
+    let mut nodal_area = vec![0.0; mesh.n_vertices()];
+    for k in 0..mesh.n_triangles() {
+        let a = mesh.area(k) / 3.0;
+        for &v in &mesh.triangles[k] {
+            nodal_area[v as usize] += a;
+        }
+    }
+    nodal_area
+}
+
+/// A body's pressure at every vertex: `h × penetration`, or where it is rigid (h = ∞),
+/// its nodal force per nodal area.
+fn pressure(h: &[f64], penetration: &[f64], force: &[f64], nodal_area: &[f64]) -> Vec<f64> {
+    (0..h.len())
+        .map(|v| {
+            if h[v].is_infinite() {
+                if nodal_area[v] > 0.0 {
+                    force[v] / nodal_area[v]
+                } else {
+                    0.0
+                }
+            } else {
+                h[v] * penetration[v]
+            }
+        })
+        .collect()
+}
+
 /// Computes the vertex fields and totals of the iterate `u` (over the unknowns).
 pub fn derive_from(mesh: &Mesh, model: &Model, u_dofs: &[f64]) -> (NodalFields, Totals) {
     let nv = mesh.n_vertices();
     let dofs = &model.dofs;
-    let u = dofs.to_vertices(u_dofs, 0.0);
-    let r = model.residual(u_dofs);
-    let x1: Vec<f64> = r
-        .iter()
-        .zip(&model.can_touch)
-        .map(|(ri, &c)| if c { -ri } else { 0.0 })
-        .collect();
-    let contact_force = dofs.to_vertices(&x1, 0.0);
+    let u = model.to_vertices(u_dofs);
+    let forces = crate::certificate::contact_forces(model, u_dofs);
+    let contact_force = dofs.to_vertices(&forces.up, 0.0);
     let states = model.states(u_dofs);
     let mut state = vec![-1i8; nv];
     let mut penetration = vec![0.0; nv];
@@ -82,43 +153,66 @@ pub fn derive_from(mesh: &Mesh, model: &Model, u_dofs: &[f64]) -> (NodalFields, 
             penetration[v as usize] = (u_dofs[i] - model.phi[i]).max(0.0);
         }
     }
-    // Nodal areas |Q_i| / 3.
-    let mut nodal_area = vec![0.0; nv];
-    for k in 0..mesh.n_triangles() {
-        let a = mesh.area(k) / 3.0;
-        for &v in &mesh.triangles[k] {
-            nodal_area[v as usize] += a;
-        }
-    }
-    let pressure: Vec<f64> = (0..nv)
-        .map(|v| {
-            if model.is_rigid() {
-                if nodal_area[v] > 0.0 {
-                    contact_force[v] / nodal_area[v]
-                } else {
-                    0.0
-                }
-            } else {
-                model.h_vertices[v] * penetration[v]
-            }
-        })
-        .collect();
+    let nodal_area = nodal_areas(mesh);
+    let pressure_up = pressure(&model.h_vertices, &penetration, &contact_force, &nodal_area);
     let count = |s: i8| states.iter().filter(|&&x| x == s).count();
     // (An empty f64 sum is −0.)
-    let contact_area = 0.0
-        + (0..nv)
-            .filter(|&v| state[v] >= 0)
+    let area_where = |pick: &dyn Fn(usize) -> bool| {
+        0.0 + (0..nv)
+            .filter(|&v| pick(v))
             .map(|v| nodal_area[v])
-            .sum::<f64>();
+            .sum::<f64>()
+    };
+    let contact_area = area_where(&|v| state[v] >= 0);
     let covered: Vec<bool> = model.h_vertices.iter().map(|&h| h > 0.0).collect();
-    let liftoff_area = 0.0
-        + (0..nv)
-            .filter(|&v| covered[v] && state[v] < 0 && !mesh_boundary(dofs, v))
-            .map(|v| nodal_area[v])
-            .sum::<f64>();
-    let max_pressure = pressure.iter().cloned().fold(0.0f64, f64::max);
+    let liftoff_area = area_where(&|v| covered[v] && state[v] < 0 && !mesh_boundary(dofs, v));
+    let max_pressure = pressure_up.iter().cloned().fold(0.0f64, f64::max);
     let max_u = u.iter().cloned().fold(f64::NEG_INFINITY, f64::max);
     let min_u = u.iter().cloned().fold(f64::INFINITY, f64::min);
+    let (lower, lower_totals) = match &model.lower {
+        Some(low) => {
+            let states_low = model.lower_states(u_dofs);
+            let mut state_low = vec![-1i8; nv];
+            let mut penetration_low = vec![0.0; nv];
+            for (i, &v) in dofs.vertex.iter().enumerate() {
+                state_low[v as usize] = states_low[i];
+                if low.can_touch[i] {
+                    penetration_low[v as usize] = (low.phi[i] - u_dofs[i]).max(0.0);
+                }
+            }
+            let force_low = dofs.to_vertices(&forces.low, 0.0);
+            let pressure_low = pressure(&low.h_vertices, &penetration_low, &force_low, &nodal_area);
+            let covered_low: Vec<bool> = low.h_vertices.iter().map(|&h| h > 0.0).collect();
+            let count_low = |s: i8| states_low.iter().filter(|&&x| x == s).count();
+            let totals = LowerTotals {
+                can_touch_low_vertices: low.can_touch.iter().filter(|&&c| c).count(),
+                contact_low_vertices: count_low(0) + count_low(1),
+                touching_low_vertices: count_low(0),
+                penetrating_low_vertices: count_low(1),
+                squeezed_vertices: states
+                    .iter()
+                    .zip(&states_low)
+                    .filter(|(&a, &b)| a >= 0 && b >= 0)
+                    .count(),
+                contact_area_low: area_where(&|v| state_low[v] >= 0),
+                total_contact_force_low: forces.low.iter().sum(),
+                max_pressure_low: pressure_low.iter().cloned().fold(0.0f64, f64::max),
+                liftoff_area_low: area_where(&|v| {
+                    covered_low[v] && state_low[v] < 0 && !mesh_boundary(dofs, v)
+                }),
+            };
+            let fields = LowerFields {
+                phi: low.phi_vertices.clone(),
+                penetration: penetration_low,
+                pressure: pressure_low,
+                contact_force: force_low,
+                state: state_low,
+                covered: covered_low,
+            };
+            (Some(fields), Some(totals))
+        }
+        None => (None, None),
+    };
     let totals = Totals {
         liftoff_area,
         max_pressure,
@@ -128,20 +222,22 @@ pub fn derive_from(mesh: &Mesh, model: &Model, u_dofs: &[f64]) -> (NodalFields, 
         clear_vertices: count(-1),
         contact_area,
         total_load: model.total_load,
-        total_contact_force: x1.iter().sum(),
+        total_contact_force: forces.up.iter().sum(),
         max_deflection: max_u.abs().max(min_u.abs()),
         min_u,
         max_u,
+        lower: lower_totals,
     };
     (
         NodalFields {
             u,
             phi: model.phi_vertices.clone(),
             penetration,
-            pressure,
+            pressure: pressure_up,
             contact_force,
             state,
             covered,
+            lower,
         },
         totals,
     )

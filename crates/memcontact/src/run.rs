@@ -11,19 +11,22 @@
 //! and its certificate. The library prints nothing: progress reaches the caller through
 //! the [`Observer`].
 
-use crate::field::{BoundField, Stiffness as FieldStiffness};
+use crate::field::BoundField;
 use crate::mesh::refine::Hierarchy;
 use crate::mesh::Mesh;
-use crate::model::{Certificate, Model, ProblemData, Stiffness};
+use crate::model::{
+    BodyData, BoundaryData, Certificate, Extensions, Model, ProblemData, Stiffness,
+};
 use crate::problem::{Invalid, Problem};
 use crate::results::{derive_from, NodalFields, Totals};
 use crate::solve::{
     self, Choice, Fallback, IterationRecord, Method, Observer, Settings, Solution, Status,
 };
-use crate::Result;
+use crate::{Error, Result};
 use std::time::Instant;
 
-/// The problem's data f, φ, h bound to a mesh's regions.
+/// The problem's data f, φ, h (and the data beyond the paper's frame: boundary heights,
+/// rigid regions, the body below) bound to a mesh's regions.
 #[derive(Debug, Clone)]
 pub struct BoundData {
     /// The load f.
@@ -32,21 +35,72 @@ pub struct BoundData {
     pub shape: BoundField,
     /// The stiffness h (`None`: rigid).
     pub stiffness: Option<BoundField>,
+    /// The obstacle's rigid regions when it is elastic elsewhere (mixed bodies).
+    pub rigid_regions: Vec<u32>,
+    /// The heights g on the fixed boundary, bound to the boundary regions, and the free
+    /// regions (`None`: the whole boundary fixed at 0).
+    pub boundary: Option<(BoundField, Vec<String>)>,
+    /// The body below.
+    pub lower: Option<BoundBody>,
+}
+
+/// A body's data bound to a mesh: surface, stiffness, rigid regions.
+#[derive(Debug, Clone)]
+pub struct BoundBody {
+    /// The surface.
+    pub shape: BoundField,
+    /// The stiffness (`None`: rigid everywhere).
+    pub stiffness: Option<BoundField>,
+    /// The rigid regions when it is elastic elsewhere.
+    pub rigid_regions: Vec<u32>,
+}
+
+impl BoundBody {
+    fn new(section: &str, body: &crate::problem::Obstacle, mesh: &Mesh) -> Result<BoundBody> {
+        let stiffness = body
+            .stiffness
+            .bind_to_mesh(&format!("{section}.stiffness"), mesh)?;
+        let rigid_regions = if stiffness.is_rigid() {
+            Vec::new()
+        } else {
+            stiffness.rigid_tags
+        };
+        Ok(BoundBody {
+            shape: body.shape.bind_to_mesh(&format!("{section}.shape"), mesh)?,
+            stiffness: stiffness.elastic,
+            rigid_regions,
+        })
+    }
+
+    fn stiffness(&self) -> Stiffness<'_> {
+        match &self.stiffness {
+            Some(h) => Stiffness::Elastic(h),
+            None => Stiffness::Rigid,
+        }
+    }
 }
 
 impl BoundData {
     /// Binds the problem's f, φ and h to the regions of `mesh` (a region table must name
-    /// regions the mesh has, or give a default) or, for nodal values, to its vertices.
+    /// regions the mesh has, or give a default) or, for nodal values, to its vertices; the
+    /// boundary heights to the mesh's boundary regions.
     pub fn new(problem: &Problem, mesh: &Mesh) -> Result<BoundData> {
+        let upper = BoundBody::new("obstacle", &problem.obstacle, mesh)?;
+        let boundary = if problem.boundary.is_default() {
+            None
+        } else {
+            let height = bind_height(&problem.boundary, mesh)?;
+            Some((height, problem.boundary.free.clone()))
+        };
         Ok(BoundData {
             load: problem.membrane.load.bind_to_mesh("membrane.load", mesh)?,
-            shape: problem
-                .obstacle
-                .shape
-                .bind_to_mesh("obstacle.shape", mesh)?,
-            stiffness: match &problem.obstacle.stiffness {
-                FieldStiffness::Rigid => None,
-                FieldStiffness::Elastic(h) => Some(h.bind_to_mesh("obstacle.stiffness", mesh)?),
+            shape: upper.shape,
+            stiffness: upper.stiffness,
+            rigid_regions: upper.rigid_regions,
+            boundary,
+            lower: match &problem.lower {
+                Some(low) => Some(BoundBody::new("lower", low, mesh)?),
+                None => None,
             },
         })
     }
@@ -65,6 +119,75 @@ impl BoundData {
             sampling: problem.obstacle.sampling(),
         }
     }
+
+    /// The model's view of the data beyond the paper's frame (SPEC §5).
+    pub fn extensions<'a>(&'a self, problem: &Problem) -> Extensions<'a> {
+        Extensions {
+            boundary: self
+                .boundary
+                .as_ref()
+                .map(|(height, free)| BoundaryData { free, height }),
+            rigid_regions: &self.rigid_regions,
+            lower: match (&self.lower, &problem.lower) {
+                (Some(b), Some(p)) => Some(BodyData {
+                    shape: &b.shape,
+                    stiffness: b.stiffness(),
+                    rigid_regions: &b.rigid_regions,
+                    foundation: p.foundation,
+                    sampling: p.sampling(),
+                }),
+                _ => None,
+            },
+        }
+    }
+}
+
+/// Binds the boundary heights to the boundary regions of `mesh` that are fixed (a table
+/// needs a value for each of them, or a default), or, for nodal values, to its vertices.
+fn bind_height(boundary: &crate::problem::Boundary, mesh: &Mesh) -> Result<BoundField> {
+    let name = "boundary.height";
+    if let crate::field::Field::Nodal(_) = &boundary.height {
+        return boundary.height.bind_to_mesh(name, mesh);
+    }
+    let adj = crate::fem::VertexTriangles::new(mesh);
+    let fixed = crate::mesh::boundary::FixedBoundary::new(mesh, &adj, &boundary.free)?;
+    let tagged = mesh.tagged_boundary(&adj);
+    let present = tagged.present();
+    // Keys may name the free regions too (the value is then not used).
+    let names = &mesh.boundary.names;
+    if let crate::field::Field::Regions(table) = &boundary.height {
+        for key in table.keys() {
+            if key != crate::field::DEFAULT_KEY && mesh.boundary.resolve(key, &present).is_empty() {
+                return Err(Error::Data(format!(
+                    "{name}: no boundary region named '{key}' in the mesh (boundary regions: \
+                     {})",
+                    mesh.boundary_listing(&tagged)
+                )));
+            }
+        }
+        let fixed_only: std::collections::BTreeMap<String, crate::field::Field> = table
+            .iter()
+            .filter(|(k, _)| {
+                k.as_str() == crate::field::DEFAULT_KEY
+                    || mesh
+                        .boundary
+                        .resolve(k, &present)
+                        .iter()
+                        .any(|t| fixed.fixed_tags.contains(t))
+            })
+            .map(|(k, v)| (k.clone(), v.clone()))
+            .collect();
+        if fixed_only.is_empty() {
+            return crate::field::Field::Constant(0.0).bind(name, names, &fixed.fixed_tags);
+        }
+        return crate::field::Field::Regions(fixed_only)
+            .bind(name, names, &fixed.fixed_tags)
+            .map_err(|e| match e {
+                Error::Data(m) => Error::Data(m.replace("(regions:", "(fixed boundary regions:")),
+                other => other,
+            });
+    }
+    boundary.height.bind(name, names, &fixed.fixed_tags)
 }
 
 /// A named phase of a run and its wall-clock seconds.
@@ -236,14 +359,14 @@ impl Discretization {
 /// `problem.mesh` is not used.
 pub fn assemble_model(problem: &Problem, mesh: &Mesh) -> Result<Model> {
     let bound = BoundData::new(problem, mesh)?;
-    crate::checks::assemble(mesh, &bound.data(problem))
+    crate::checks::assemble(mesh, &bound.data(problem), &bound.extensions(problem))
 }
 
 /// Binds the problem's data to `mesh` and checks it where assembly does not sample it (on
 /// the boundary): the checks of [`assemble_model`] that need no assembly.
 pub fn bind_and_check(problem: &Problem, mesh: &Mesh) -> Result<BoundData> {
     let bound = BoundData::new(problem, mesh)?;
-    crate::checks::check_boundary_data(mesh, &bound.data(problem))?;
+    crate::checks::check_boundary_data(mesh, &bound.data(problem), &bound.extensions(problem))?;
     Ok(bound)
 }
 

@@ -132,6 +132,51 @@ pub struct Summary {
     /// How the pictures were drawn (so `memcontact plot` redraws them identically).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub plot_options: Option<serde_json::Value>,
+    /// Vertices on the fixed boundary Γ_D (present with boundary heights or free edges).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub fixed_vertices: Option<usize>,
+    /// Boundary vertices on free edges only (they carry unknowns).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub free_boundary_vertices: Option<usize>,
+    /// Unknowns the obstacle holds rigidly when it is rigid in some regions only.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rigid_vertices: Option<usize>,
+    /// The body below: `consistent`, `lumped` or `rigid` (present with a body below).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub lower_foundation: Option<String>,
+    /// Whether the body below is rigid everywhere.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub lower_rigid: Option<bool>,
+    /// Unknowns the body below holds rigidly when it is rigid in some regions only.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rigid_low_vertices: Option<usize>,
+    /// Unknowns the body below can touch.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub can_touch_low_vertices: Option<usize>,
+    /// Vertices in contact with the body below (touching or sunk into it).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub contact_low_vertices: Option<usize>,
+    /// Vertices exactly on the body below.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub touching_low_vertices: Option<usize>,
+    /// Vertices sunk into the body below.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub penetrating_low_vertices: Option<usize>,
+    /// Vertices in contact with both bodies at once.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub squeezed_vertices: Option<usize>,
+    /// Σ |Qᵢ|/3 over the vertices in contact with the body below.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub contact_area_low: Option<f64>,
+    /// The body below's total force on the membrane (positive pushing up).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub total_contact_force_low: Option<f64>,
+    /// The body below's largest contact pressure.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub max_pressure_low: Option<f64>,
+    /// Area where the body below lies under the membrane but the membrane is clear of it.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub liftoff_area_low: Option<f64>,
 }
 
 impl Summary {
@@ -144,7 +189,7 @@ impl Summary {
             case: case.to_string(),
             vertices: quality.vertices,
             triangles: quality.triangles,
-            unknowns: quality.unknowns,
+            unknowns: m.n(),
             levels: outcome.discretization.hierarchy.depth(),
             l_n: quality.l_n,
             s_n: quality.s_n,
@@ -207,6 +252,50 @@ impl Summary {
             input_hash: String::new(),
             files: BTreeMap::new(),
             plot_options: None,
+            fixed_vertices: None,
+            free_boundary_vertices: None,
+            rigid_vertices: m.rigid.as_ref().map(|r| r.iter().filter(|&&x| x).count()),
+            lower_foundation: m.lower.as_ref().map(|b| {
+                if b.l.is_rigid() {
+                    "rigid".to_string()
+                } else {
+                    b.foundation.name().to_string()
+                }
+            }),
+            lower_rigid: m.lower.as_ref().map(|b| b.l.is_rigid()),
+            rigid_low_vertices: m
+                .lower
+                .as_ref()
+                .and_then(|b| b.rigid.as_ref())
+                .map(|r| r.iter().filter(|&&x| x).count()),
+            can_touch_low_vertices: totals.lower.map(|t| t.can_touch_low_vertices),
+            contact_low_vertices: totals.lower.map(|t| t.contact_low_vertices),
+            touching_low_vertices: totals.lower.map(|t| t.touching_low_vertices),
+            penetrating_low_vertices: totals.lower.map(|t| t.penetrating_low_vertices),
+            squeezed_vertices: totals.lower.map(|t| t.squeezed_vertices),
+            contact_area_low: totals.lower.map(|t| t.contact_area_low),
+            total_contact_force_low: totals.lower.map(|t| t.total_contact_force_low),
+            max_pressure_low: totals.lower.map(|t| t.max_pressure_low),
+            liftoff_area_low: totals.lower.map(|t| t.liftoff_area_low),
         }
+        .with_boundary(outcome)
+    }
+
+    /// The boundary counts, when the case has boundary heights or free edges.
+    fn with_boundary(mut self, outcome: &Outcome) -> Summary {
+        let m = &outcome.discretization.model;
+        let mesh = outcome.mesh();
+        let on_boundary = mesh.boundary_vertices();
+        let free = on_boundary
+            .iter()
+            .enumerate()
+            .filter(|(v, &b)| b && m.dofs.dof[*v].is_some())
+            .count();
+        let heights = m.boundary_values.iter().any(|&g| g != 0.0);
+        if free > 0 || heights {
+            self.fixed_vertices = Some(m.dofs.dof.iter().filter(|d| d.is_none()).count());
+            self.free_boundary_vertices = Some(free);
+        }
+        self
     }
 }

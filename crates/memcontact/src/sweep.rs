@@ -331,16 +331,13 @@ pub fn apply(base: &Model, parameter: SweepParameter, value: f64) -> Model {
             if !m.is_rigid() {
                 m.h_vertices.iter_mut().for_each(|h| *h *= value);
                 // M is where L_ii > 0: a zero factor leaves nothing to touch.
-                for (i, c) in m.can_touch.iter_mut().enumerate() {
-                    *c = *c && value > 0.0 && m.l.diag(i) > 0.0;
+                for i in 0..m.can_touch.len() {
+                    m.can_touch[i] =
+                        (m.can_touch[i] && value > 0.0 && m.l.diag(i) > 0.0) || m.rigid_at(i);
                 }
             }
         }
-        SweepParameter::Tension => {
-            let k = value / base.tension;
-            m.s.val.iter_mut().for_each(|v| *v *= k);
-            m.tension = value;
-        }
+        SweepParameter::Tension => m.set_tension(value),
         SweepParameter::ObstacleOffset => {
             m.phi.iter_mut().for_each(|p| *p += value);
             m.phi_vertices.iter_mut().for_each(|p| *p += value);
@@ -349,10 +346,9 @@ pub fn apply(base: &Model, parameter: SweepParameter, value: f64) -> Model {
     m
 }
 
-/// Scales D (and ∫f) by `k`.
+/// Scales the load f (D and ∫f) by `k`.
 fn scale_load(m: &mut Model, k: f64) {
-    m.d.iter_mut().for_each(|v| *v *= k);
-    m.total_load *= k;
+    m.scale_load(k);
 }
 
 /// Names the step (its directory name and value) in an error about its data.

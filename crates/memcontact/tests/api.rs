@@ -51,6 +51,8 @@ fn problem_in_rust() -> Problem {
             sampling: SamplingKind::Nodal,
             epsilon: None,
         },
+        boundary: Default::default(),
+        lower: None,
     }
 }
 

@@ -276,6 +276,12 @@ _MESH_KEYS = {
     "solver.method": "method",
     "solver.tolerance": "tolerance",
     "solver.max_iterations": "max_iterations",
+    "boundary.height": "boundary_height",
+    "boundary.free": "free",
+    "lower.shape": "lower_shape",
+    "lower.stiffness": "lower_stiffness",
+    "lower.foundation": "lower_foundation",
+    "lower.sampling": "lower_sampling",
 }
 
 
@@ -302,6 +308,12 @@ def solve_mesh(
     max_iterations: Optional[int] = None,
     regions: Any = None,
     region_names: Optional[Mapping[int, str]] = None,
+    boundary_height: Optional[Data] = None,
+    free: Optional[Sequence[str]] = None,
+    lower_shape: Optional[Data] = None,
+    lower_stiffness: Optional[Union[Data, str]] = None,
+    lower_foundation: str = "consistent",
+    lower_sampling: str = "nodal",
     check: bool = True,
 ) -> Result:
     """Solves the membrane problem on a mesh given as arrays (``vertices`` (n, 2),
@@ -311,10 +323,17 @@ def solve_mesh(
     ``tension`` is t > 0; ``load`` f, ``shape`` φ and ``stiffness`` h (or ``"rigid"``) are
     numbers, expressions of x and y, dicts of region names (or tags) to those, or NumPy
     arrays of one value per vertex: their P1 interpolant enters the quadrature of f and h,
-    and φ's values are its samples (nodal sampling only).
+    and φ's values are its samples (nodal sampling only). A stiffness dict may make some
+    regions ``"rigid"`` and others elastic.
     ``foundation`` is ``"consistent"`` or ``"lumped"``, ``sampling`` ``"nodal"`` or
     ``"mollified"`` (with ``epsilon``), ``method`` one of ``auto``, ``linear``,
     ``active-set``, ``qp``, ``coordinate``, ``multigrid``.
+
+    Beyond the paper's frame: ``boundary_height`` g (the same kinds of data, a dict keyed
+    by boundary region names such as ``"left"``, or an array) fixes u = g on the boundary
+    except on the boundary regions listed in ``free``; ``lower_shape`` and
+    ``lower_stiffness`` (with ``lower_foundation``, ``lower_sampling``) add a body below
+    the membrane, whose fields the result gives as ``phi_low``, ``pressure_low``, ...
 
     Raises ``ValueError`` naming the argument for bad data and :class:`SolverError` when
     the certificate does not reach ``tolerance`` (``check=False`` returns the result
@@ -329,8 +348,15 @@ def solve_mesh(
         mesh = Mesh(vertices, triangles, regions, region_names)
     # NumPy arrays (one value per vertex) go to the library as arrays; the case holds a
     # placeholder for them.
+    if (lower_shape is None) != (lower_stiffness is None):
+        raise TypeError("a body below needs both lower_shape and lower_stiffness")
     nodal: Dict[str, np.ndarray] = {}
-    given = {"load": load, "shape": shape, "stiffness": stiffness}
+    given: Dict[str, Any] = {"load": load, "shape": shape, "stiffness": stiffness}
+    if boundary_height is not None:
+        given["height"] = boundary_height
+    if lower_shape is not None:
+        given["lower_shape"] = lower_shape
+        given["lower_stiffness"] = lower_stiffness
     for name, value in given.items():
         if isinstance(value, np.ndarray):
             a = np.ascontiguousarray(value, dtype=np.float64)
@@ -353,12 +379,28 @@ def solve_mesh(
     solver: Dict[str, Any] = {"method": method, "tolerance": tolerance}
     if max_iterations is not None:
         solver["max_iterations"] = max_iterations
-    data = {
+    data: Dict[str, Any] = {
         "mesh": {"file": "(mesh given in Python)"},
         "membrane": {"tension": tension, "load": load},
         "obstacle": obstacle,
         "solver": solver,
     }
+    if boundary_height is not None or free:
+        boundary: Dict[str, Any] = {}
+        if boundary_height is not None:
+            boundary["height"] = given["height"]
+        if free:
+            if isinstance(free, str):
+                raise TypeError("free: give a list of boundary region names")
+            boundary["free"] = [str(f) for f in free]
+        data["boundary"] = boundary
+    if lower_shape is not None:
+        data["lower"] = {
+            "shape": given["lower_shape"],
+            "stiffness": given["lower_stiffness"],
+            "foundation": lower_foundation,
+            "sampling": lower_sampling,
+        }
     try:
         case = Case(data, "mesh")
     except ValueError as e:

@@ -219,7 +219,59 @@ fn structured(spec: &RectangleSpec, nx: usize, ny: usize) -> Mesh {
         regions: vec![0; n_tri],
         region_names: BTreeMap::new(),
         curve: None,
+        boundary: rectangle_sides(nx, ny),
     }
+}
+
+/// The boundary tags of the rectangle's sides, in the order of their tags.
+pub const RECTANGLE_SIDES: [&str; 4] = ["bottom", "right", "top", "left"];
+
+/// The sides of the structured `nx × ny` rectangle as boundary regions: `bottom` (tag 1),
+/// `right` (2), `top` (3), `left` (4), with the grid's row-by-row vertex numbering.
+fn rectangle_sides(nx: usize, ny: usize) -> super::BoundaryRegions {
+    let row = nx + 1;
+    let v = |i: usize, j: usize| (j * row + i) as u32;
+    let mut edges = Vec::with_capacity(2 * (nx + ny));
+    let mut tags = Vec::with_capacity(2 * (nx + ny));
+    for i in 0..nx {
+        edges.push([v(i, 0), v(i + 1, 0)]);
+        tags.push(1);
+    }
+    for j in 0..ny {
+        edges.push([v(nx, j), v(nx, j + 1)]);
+        tags.push(2);
+    }
+    for i in 0..nx {
+        edges.push([v(i + 1, ny), v(i, ny)]);
+        tags.push(3);
+    }
+    for j in 0..ny {
+        edges.push([v(0, j + 1), v(0, j)]);
+        tags.push(4);
+    }
+    let names = RECTANGLE_SIDES
+        .iter()
+        .enumerate()
+        .map(|(k, n)| (k as u32 + 1, n.to_string()))
+        .collect();
+    super::BoundaryRegions { edges, tags, names }
+}
+
+/// Tags every boundary edge of `mesh` with `tag_of(midpoint)` and names the tags.
+fn tag_boundary(
+    mesh: Mesh,
+    tag_of: impl Fn(Point) -> u32,
+    names: BTreeMap<u32, String>,
+) -> Result<Mesh> {
+    let edges = mesh.boundary_edges();
+    let tags = edges
+        .iter()
+        .map(|&[a, b]| {
+            let (p, q) = (mesh.points[a as usize], mesh.points[b as usize]);
+            tag_of([0.5 * (p[0] + q[0]), 0.5 * (p[1] + q[1])])
+        })
+        .collect();
+    mesh.with_boundary_regions(edges, tags, names)
 }
 
 /// The parents of the `2cx × 2cy` structured mesh's vertices in the `cx × cy` one, computed
@@ -319,7 +371,7 @@ pub fn disk(center: Point, radius: f64, size: f64) -> Result<Mesh> {
     }
     let mut mesh = Mesh::new(points, triangles, vec![], BTreeMap::new())?;
     mesh.curve = Some(circle);
-    Ok(mesh)
+    tag_boundary(mesh, |_| 1, BTreeMap::from([(1, "outer".to_string())]))
 }
 
 /// The triangle count that Delaunay refinement with area bound `size²·√3/4` typically
@@ -610,7 +662,45 @@ pub fn polygon(spec: &PolygonSpec) -> Result<Mesh> {
             names.insert(r as u32 + 1, name.clone());
         }
     }
-    Mesh::new(points, triangles, regions, names)
+    let mesh = Mesh::new(points, triangles, regions, names)?;
+    // Boundary regions: `outer` (tag 1) and `hole1`, `hole2`, ... (tags 2, 3, ...), each
+    // boundary edge on the ring nearest to its midpoint.
+    let rings: Vec<&Vec<Point>> = std::iter::once(&spec.outer).chain(&spec.holes).collect();
+    let mut side_names = BTreeMap::from([(1, "outer".to_string())]);
+    for h in 0..spec.holes.len() {
+        side_names.insert(h as u32 + 2, format!("hole{}", h + 1));
+    }
+    tag_boundary(
+        mesh,
+        |m| {
+            let d = |ring: &[Point]| {
+                (0..ring.len())
+                    .map(|i| segment_distance(m, ring[i], ring[(i + 1) % ring.len()]))
+                    .fold(f64::INFINITY, f64::min)
+            };
+            let mut best = (f64::INFINITY, 1);
+            for (k, ring) in rings.iter().enumerate() {
+                let dk = d(ring);
+                if dk < best.0 {
+                    best = (dk, k as u32 + 1);
+                }
+            }
+            best.1
+        },
+        side_names,
+    )
+}
+
+/// The distance from `p` to the segment `ab`.
+fn segment_distance(p: Point, a: Point, b: Point) -> f64 {
+    let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
+    let len2 = dx * dx + dy * dy;
+    let s = if len2 > 0.0 {
+        (((p[0] - a[0]) * dx + (p[1] - a[1]) * dy) / len2).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    super::dist(p, [a[0] + s * dx, a[1] + s * dy])
 }
 
 /// The region tag of a point of the domain, or `None` outside it (or in a hole).

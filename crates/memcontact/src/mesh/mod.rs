@@ -1,8 +1,11 @@
 //! Triangular meshes: the type, its checks and quality report, the boundary and the map
 //! between vertices and unknowns (SPEC §2: the unknowns are the interior vertices).
 
+pub mod boundary;
 pub mod generate;
 pub mod refine;
+
+pub use boundary::BoundaryRegions;
 
 use crate::{Error, Result};
 use std::collections::{BTreeMap, HashMap};
@@ -24,6 +27,9 @@ pub struct Mesh {
     /// The curved boundary the mesh approximates, if any: refinement moves new boundary
     /// vertices onto it so that Ω_n approaches Ω.
     pub curve: Option<Circle>,
+    /// Named boundary regions (tagged boundary edges: Gmsh physical curves, generator
+    /// sides), for boundary heights and free edges.
+    pub boundary: BoundaryRegions,
 }
 
 /// A circle: the boundary of a disc domain.
@@ -158,6 +164,7 @@ impl Mesh {
             regions,
             region_names,
             curve: None,
+            boundary: BoundaryRegions::default(),
         };
         mesh.check_vertices()?;
         mesh.check_edges()?;

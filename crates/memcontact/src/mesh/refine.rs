@@ -215,14 +215,42 @@ pub fn refine_uniform(mesh: &Mesh) -> (Mesh, Refinement) {
     for &r in &mesh.regions {
         regions.extend_from_slice(&[r; 4]);
     }
+    let boundary = refine_boundary_regions(&mesh.boundary, &edges.ends, nvu);
     let fine = Mesh {
         points,
         triangles,
         regions,
         region_names: mesh.region_names.clone(),
         curve,
+        boundary,
     };
     (fine, Refinement { parents })
+}
+
+/// The boundary regions of the refined mesh: every tagged edge `[a, b]` becomes `[a, m]`
+/// and `[m, b]` with its tag, `m = nv + (the edge's number)` its midpoint. `ends` are the
+/// coarse edges in lexicographic order (as [`number_edges`] gives them).
+fn refine_boundary_regions(
+    coarse: &super::BoundaryRegions,
+    ends: &[[u32; 2]],
+    nv: u32,
+) -> super::BoundaryRegions {
+    let mut edges = Vec::with_capacity(2 * coarse.edges.len());
+    let mut tags = Vec::with_capacity(2 * coarse.tags.len());
+    for (&[a, b], &tag) in coarse.edges.iter().zip(&coarse.tags) {
+        let key = [a.min(b), a.max(b)];
+        let Ok(id) = ends.binary_search(&key) else {
+            continue; // not an edge of the mesh: validated away by construction
+        };
+        let m = nv + id as u32;
+        edges.extend([[a, m], [m, b]]);
+        tags.extend([tag, tag]);
+    }
+    super::BoundaryRegions {
+        edges,
+        tags,
+        names: coarse.names.clone(),
+    }
 }
 
 #[cfg(test)]

@@ -29,25 +29,20 @@ use crate::{Error, Result};
 /// Default iteration limit.
 pub(crate) const MAX_ITERATIONS: usize = 500;
 
-/// A starting point: zero, moved below φ where the obstacle is rigid.
+/// A starting point: zero, moved below φ where the obstacle is rigid (and above φ_low
+/// where the body below is).
 pub fn feasible_start(model: &Model) -> Vec<f64> {
     start_from(model, None)
 }
 
-/// The start of an iteration: `start` (a warm start) or zero, projected below φ on M for
-/// the rigid obstacle.
+/// The start of an iteration: `start` (a warm start) or zero, projected onto the rigid
+/// bodies' constraints ([`Model::project`]).
 pub fn start_from(model: &Model, start: Option<&[f64]>) -> Vec<f64> {
     let mut v: Vec<f64> = match start {
         Some(s) => s.to_vec(),
         None => vec![0.0; model.n()],
     };
-    if model.is_rigid() {
-        for ((vi, fi), &c) in v.iter_mut().zip(&model.phi).zip(&model.can_touch) {
-            if c {
-                *vi = vi.min(*fi);
-            }
-        }
-    }
+    model.project(&mut v);
     v
 }
 
@@ -113,17 +108,16 @@ pub fn solve(
             chol.as_ref().expect("factorised").solve_in_place(&mut rhs)
         });
         timer.time("line search", || {
-            // For the rigid obstacle the feasible line search stops at the first vertex that
-            // hits φ; the projected full step min(V + δ, φ) lets the whole contact set move
-            // at once (as a primal-dual active-set method does). Keep whichever is lower.
-            let projected = model.is_rigid().then(|| {
+            // Where a body is rigid the feasible line search stops at the first vertex that
+            // hits it; the projected full step (V + δ projected onto the rigid constraints)
+            // lets the whole contact set move at once (as a primal-dual active-set method
+            // does). Keep whichever is lower.
+            let projected = model.has_rigid_part().then(|| {
                 let mut w = v.clone();
                 for i in 0..w.len() {
                     w[i] += rhs[i];
-                    if model.can_touch[i] && w[i] > model.phi[i] {
-                        w[i] = model.phi[i];
-                    }
                 }
+                model.project(&mut w);
                 w
             });
             line_step(model, &mut v, &rhs, &r);

@@ -13,6 +13,11 @@
 //! (it is then the exact minimiser), or whether α is a kink minimiser (`J'(α−) ≤ 0 ≤
 //! J'(α+)`); otherwise a bracketed Newton step on the monotone derivative moves on.
 //! [`apply_step`] takes the step and snaps the coordinates whose breakpoint it is onto φ.
+//!
+//! A body below (SPEC §5) adds the same terms for `J₃ = ½ qᵀ L_low q`, `q = (φ_low − V)⁺`:
+//! it is J₂ of the mirrored problem (gap `φ_low − V`, direction `−δ`), so one function
+//! computes the pieces of either body. Where a body is rigid the step is limited so that
+//! `V + αδ` keeps its constraint.
 
 use super::multigrid::transfer::{par_rows, PAR_ROWS};
 use crate::model::{FoundationMatrix, Model};
@@ -80,42 +85,58 @@ fn merge(p: Pieces, q: Pieces) -> Pieces {
     }
 }
 
-/// Penetrating on the left (bit 0) and right (bit 1) piece of α.
+/// Penetrating on the left (bit 0) and right (bit 1) piece of α, for a body whose gap at
+/// step α is `w + α d` (penetrating where positive).
 #[inline]
-fn side_code(model: &Model, v: &[f64], dir: &[f64], alpha: f64, j: usize) -> u8 {
-    if !model.can_touch[j] {
-        return 0;
-    }
-    let x = v[j] - model.phi[j] + alpha * dir[j];
+fn side_code(w: f64, d: f64, alpha: f64) -> u8 {
+    let x = w + alpha * d;
     if x > 0.0 {
         3
     } else if x < 0.0 {
         0
     } else {
-        u8::from(dir[j] < 0.0) | (u8::from(dir[j] > 0.0) << 1)
+        u8::from(d < 0.0) | (u8::from(d > 0.0) << 1)
     }
 }
 
-/// One pass at α (elastic obstacle). For the consistent L, `codes` receives the side codes
-/// of every vertex first (one light pass), so that the rows of L read them instead of
+/// One body along the line: its foundation term, the unknowns whose elastic term is
+/// present (`touch` and not held rigidly), and its gap `w_j + α d_j`: `w = V − φ`,
+/// `d = δ` above, `w = φ_low − V`, `d = −δ` below (SPEC §5: J₃ is J₂ of the mirrored
+/// problem).
+struct LineBody<'a, E, W, D> {
+    l: &'a FoundationMatrix,
+    elastic: E,
+    w: W,
+    d: D,
+}
+
+/// One pass at α over one body. For the consistent L, `codes` receives the side codes of
+/// every vertex first (one light pass), so that the rows of L read them instead of
 /// recomputing them for every neighbour.
-fn pieces(model: &Model, v: &[f64], dir: &[f64], alpha: f64, codes: &mut [u8]) -> Pieces {
-    let w = |j: usize| v[j] - model.phi[j];
-    let consistent = matches!(model.l, FoundationMatrix::Consistent(_));
+fn body_pieces<E, W, D>(body: &LineBody<E, W, D>, n: usize, alpha: f64, codes: &mut [u8]) -> Pieces
+where
+    E: Fn(usize) -> bool + Sync,
+    W: Fn(usize) -> f64 + Sync,
+    D: Fn(usize) -> f64 + Sync,
+{
+    let (w, dir) = (&body.w, &body.d);
+    let code = |j: usize| {
+        if !(body.elastic)(j) {
+            return 0;
+        }
+        side_code(w(j), dir(j), alpha)
+    };
+    let consistent = matches!(body.l, FoundationMatrix::Consistent(_));
     if consistent {
-        par_rows(codes, |j, c| *c = side_code(model, v, dir, alpha, j));
+        par_rows(codes, |j, c| *c = code(j));
     }
     let codes: &[u8] = codes;
     let side = |j: usize| -> (bool, bool) {
-        let c = if consistent {
-            codes[j]
-        } else {
-            side_code(model, v, dir, alpha, j)
-        };
+        let c = if consistent { codes[j] } else { code(j) };
         (c & 1 != 0, c & 2 != 0)
     };
     let block = |b: usize| -> Pieces {
-        let (lo, hi) = (b * BLOCK, ((b + 1) * BLOCK).min(v.len()));
+        let (lo, hi) = (b * BLOCK, ((b + 1) * BLOCK).min(n));
         let mut acc = Pieces {
             left: (0.0, 0.0),
             right: (0.0, 0.0),
@@ -123,8 +144,8 @@ fn pieces(model: &Model, v: &[f64], dir: &[f64], alpha: f64, codes: &mut [u8]) -
             above: f64::INFINITY,
         };
         for i in lo..hi {
-            let d = dir[i];
-            if d == 0.0 || !model.can_touch[i] {
+            let d = dir(i);
+            if d == 0.0 || !(body.elastic)(i) {
                 continue;
             }
             let t = -w(i) / d;
@@ -137,7 +158,7 @@ fn pieces(model: &Model, v: &[f64], dir: &[f64], alpha: f64, codes: &mut [u8]) -
             if !li && !ri {
                 continue;
             }
-            match &model.l {
+            match body.l {
                 FoundationMatrix::Lumped(l) => {
                     let (a, b) = (d * l[i] * w(i), d * l[i] * d);
                     if li {
@@ -160,11 +181,11 @@ fn pieces(model: &Model, v: &[f64], dir: &[f64], alpha: f64, codes: &mut [u8]) -
                         let (lj, rj) = side(j);
                         if lj {
                             al += lv * w(j);
-                            bl += lv * dir[j];
+                            bl += lv * dir(j);
                         }
                         if rj {
                             ar += lv * w(j);
-                            br += lv * dir[j];
+                            br += lv * dir(j);
                         }
                     }
                     if li {
@@ -181,41 +202,113 @@ fn pieces(model: &Model, v: &[f64], dir: &[f64], alpha: f64, codes: &mut [u8]) -
         }
         acc
     };
-    reduce(v.len(), block, merge)
+    reduce(n, block, merge)
+}
+
+/// The foundation pieces at α of every elastic body: the obstacle's, and the body below's
+/// (`codes_low` its side codes).
+fn pieces(
+    model: &Model,
+    v: &[f64],
+    dir: &[f64],
+    alpha: f64,
+    codes: &mut [u8],
+    codes_low: &mut [u8],
+) -> Pieces {
+    let n = v.len();
+    if !model.is_extended() {
+        let up = LineBody {
+            l: &model.l,
+            elastic: |j: usize| model.can_touch[j],
+            w: |j: usize| v[j] - model.phi[j],
+            d: |j: usize| dir[j],
+        };
+        return body_pieces(&up, n, alpha, codes);
+    }
+    let up = LineBody {
+        l: &model.l,
+        elastic: |j: usize| model.can_touch[j] && !model.rigid_at(j),
+        w: |j: usize| v[j] - model.phi[j],
+        d: |j: usize| dir[j],
+    };
+    let mut p = body_pieces(&up, n, alpha, codes);
+    if let Some(low) = &model.lower {
+        let down = LineBody {
+            l: &low.l,
+            elastic: |j: usize| low.can_touch[j] && !low.rigid_at(j),
+            w: |j: usize| low.phi[j] - v[j],
+            d: |j: usize| -dir[j],
+        };
+        p = merge(p, body_pieces(&down, n, alpha, codes_low));
+    }
+    p
+}
+
+/// The largest step the rigid bodies allow: `V + αδ ≤ φ` where the obstacle is rigid,
+/// `≥ φ_low` where the body below is (∞ without rigid parts).
+fn rigid_limit(model: &Model, v: &[f64], dir: &[f64]) -> f64 {
+    let block = |b: usize| -> f64 {
+        let (lo, hi) = (b * BLOCK, ((b + 1) * BLOCK).min(v.len()));
+        let mut m = f64::INFINITY;
+        for i in lo..hi {
+            if model.can_touch[i] && dir[i] > 0.0 && model.rigid_at(i) {
+                m = m.min((model.phi[i] - v[i]) / dir[i]);
+            }
+            if let Some(low) = &model.lower {
+                if low.can_touch[i] && dir[i] < 0.0 && low.rigid_at(i) {
+                    m = m.min((low.phi[i] - v[i]) / dir[i]);
+                }
+            }
+        }
+        m
+    };
+    reduce(v.len(), block, f64::min)
 }
 
 /// The exact minimiser α ≥ 0 of `J(V + αδ)` given `g₀ = δᵀ(SV − D)` and `s₂ = δᵀSδ`;
-/// `None` when δ is not a descent direction. For the rigid obstacle the step is limited so
-/// that `V + αδ ≤ φ` on M.
+/// `None` when δ is not a descent direction. Where a body is rigid the step is limited so
+/// that `V + αδ` stays between them (`≤ φ`, `≥ φ_low`).
 pub fn exact_step(model: &Model, v: &[f64], dir: &[f64], g0: f64, s2: f64) -> Option<f64> {
     if s2.is_nan() || s2 <= 0.0 || !g0.is_finite() {
         return None;
     }
-    if model.is_rigid() {
+    let no_elastic = model.is_rigid()
+        && model
+            .lower
+            .as_ref()
+            .is_none_or(|b| b.l.is_rigid() || !b.can_touch.iter().any(|&c| c));
+    if no_elastic {
+        // J is quadratic along the line until a rigid body stops it.
         if g0 >= 0.0 {
             return None;
         }
-        let block = |b: usize| -> f64 {
-            let (lo, hi) = (b * BLOCK, ((b + 1) * BLOCK).min(v.len()));
-            let mut m = f64::INFINITY;
-            for i in lo..hi {
-                if model.can_touch[i] && dir[i] > 0.0 {
-                    m = m.min((model.phi[i] - v[i]) / dir[i]);
-                }
-            }
-            m
-        };
-        let amax = reduce(v.len(), block, f64::min);
+        let amax = rigid_limit(model, v, dir);
         return Some((-g0 / s2).min(amax.max(0.0))).filter(|a| *a > 0.0);
     }
+    let amax = if model.is_extended() {
+        rigid_limit(model, v, dir).max(0.0)
+    } else {
+        f64::INFINITY
+    };
+    let alpha = elastic_step(model, v, dir, g0, s2)?;
+    Some(alpha.min(amax)).filter(|a| *a > 0.0)
+}
+
+/// The exact minimiser along the line of J with its elastic terms (the rigid limits are
+/// applied by the caller).
+fn elastic_step(model: &Model, v: &[f64], dir: &[f64], g0: f64, s2: f64) -> Option<f64> {
     let (mut lo, mut hi) = (0.0f64, f64::INFINITY);
     let mut alpha = 1.0f64;
     let mut codes = match model.l {
         FoundationMatrix::Consistent(_) => vec![0u8; v.len()],
         _ => Vec::new(),
     };
+    let mut codes_low = match model.lower.as_ref().map(|b| &b.l) {
+        Some(FoundationMatrix::Consistent(_)) => vec![0u8; v.len()],
+        _ => Vec::new(),
+    };
     for _ in 0..200 {
-        let p = pieces(model, v, dir, alpha, &mut codes);
+        let p = pieces(model, v, dir, alpha, &mut codes, &mut codes_low);
         let dl = g0 + alpha * s2 + p.left.0 + alpha * p.left.1;
         let dr = g0 + alpha * s2 + p.right.0 + alpha * p.right.1;
         if dl <= 0.0 && dr >= 0.0 {
@@ -252,9 +345,18 @@ pub fn exact_step(model: &Model, v: &[f64], dir: &[f64], g0: f64, s2: f64) -> Op
     Some(if hi.is_finite() { 0.5 * (lo + hi) } else { lo }).filter(|a| *a > 0.0)
 }
 
-/// `v ← v + α δ`, snapping onto φ_i every coordinate of M whose breakpoint is α (up to
-/// rounding), so that touching vertices are exactly touching.
+/// `v ← v + α δ`, snapping onto its kink every coordinate whose breakpoint is α (up to
+/// rounding), so that touching vertices are exactly touching (on φ, or on φ_low with a
+/// body below), and keeping rigid bodies' constraints exact.
 pub fn apply_step(model: &Model, v: &mut [f64], dir: &[f64], alpha: f64) {
+    let extended = model.is_extended();
+    // Snaps `new` onto the kink `f` crossed at this step, if it is one.
+    let snaps = |old: f64, new: f64, f: f64, d: f64| -> bool {
+        let t = (f - old) / d;
+        let tol = 1e-12 * alpha.abs().max(1e-300);
+        let hits = (t - alpha).abs() <= tol || (new - f).abs() <= 1e-15 * f.abs().max(old.abs());
+        hits && (old - f) * d < 0.0
+    };
     for i in 0..v.len() {
         if dir[i] == 0.0 {
             continue;
@@ -263,17 +365,29 @@ pub fn apply_step(model: &Model, v: &mut [f64], dir: &[f64], alpha: f64) {
         let new = old + alpha * dir[i];
         if model.can_touch[i] {
             let fi = model.phi[i];
-            let t = (fi - old) / dir[i];
-            let tol = 1e-12 * alpha.abs().max(1e-300);
-            let hits =
-                (t - alpha).abs() <= tol || (new - fi).abs() <= 1e-15 * fi.abs().max(old.abs());
-            if hits && (old - fi) * dir[i] < 0.0 {
+            if snaps(old, new, fi, dir[i]) {
                 v[i] = fi;
                 continue;
             }
-            if model.is_rigid() && new > fi {
+            let rigid = if extended {
+                model.rigid_at(i)
+            } else {
+                model.is_rigid()
+            };
+            if rigid && new > fi {
                 v[i] = fi;
                 continue;
+            }
+        }
+        if extended {
+            if let Some(low) = &model.lower {
+                if low.can_touch[i] {
+                    let fi = low.phi[i];
+                    if snaps(old, new, fi, dir[i]) || (low.rigid_at(i) && new < fi) {
+                        v[i] = fi;
+                        continue;
+                    }
+                }
             }
         }
         v[i] = new;

@@ -192,12 +192,16 @@ pub struct Silent;
 impl Observer for Silent {}
 
 /// Multipliers of the Kuhn-Tucker system 2e, over the vertices of M (zero elsewhere).
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, Default)]
 pub struct Multipliers {
     /// X₁: the contact forces the obstacle exerts.
     pub x1: Vec<f64>,
     /// X₂: the multipliers of `U₂ ≥ 0`.
     pub x2: Vec<f64>,
+    /// The body below's contact forces (pushing up; empty without a body below).
+    pub x1_low: Vec<f64>,
+    /// The multipliers of `U₃ ≥ 0` (the body below's penetration variables).
+    pub x2_low: Vec<f64>,
 }
 
 /// A solver's answer.

@@ -7,6 +7,10 @@
 //! *penetrating* ones (`V_i > φ_i`, elastic obstacle) carry the foundation term. The
 //! Hessian of the piece is `S + E_P L E_P` on the free vertices, its gradient
 //! `g = SV − D + E_P L p` (`p = (V − φ)⁺`), zero on truncated vertices.
+//!
+//! With a body below (SPEC §5) the vertices sunk into it (Q, elastic there) add
+//! `E_Q L_low E_Q` to the Hessian and `− E_Q L_low q` (`q = (φ_low − V)⁺`) to the gradient;
+//! vertices on either body's surface, or held by a rigid one, are truncated.
 
 use super::multigrid::transfer::{par_rows, row_chunks, PAR_ROWS};
 use crate::model::{FoundationMatrix, Model};
@@ -14,39 +18,81 @@ use crate::sparse::{Csr, Pattern};
 use rayon::prelude::*;
 
 /// The states of the truncated Newton step at V: which vertices are held (touching, or at
-/// the rigid obstacle) and which penetrate.
+/// a rigid body) and which penetrate the body above or the body below.
 #[derive(Debug, Clone)]
 pub struct NewtonStates {
-    /// Held fixed on φ_i: `V_i = φ_i` on M.
+    /// Held fixed on a kink: `V_i = φ_i` on M, or `V_i = φ_low,i` where the body below
+    /// can touch.
     pub truncated: Vec<bool>,
-    /// `V_i > φ_i` on M (elastic obstacle only).
+    /// `V_i > φ_i` on M where the obstacle is elastic.
     pub penetrating: Vec<bool>,
+    /// `V_i < φ_low,i` where the body below is elastic and can touch (empty without a body
+    /// below).
+    pub penetrating_low: Vec<bool>,
+    /// Held on the body below (`V_i = φ_low,i`) rather than on φ (empty without a body
+    /// below).
+    pub at_lower: Vec<bool>,
 }
 
 impl NewtonStates {
     /// The states of V.
     pub fn of(model: &Model, v: &[f64]) -> NewtonStates {
-        let n = model.n();
-        let mut st = NewtonStates {
-            truncated: vec![false; n],
-            penetrating: vec![false; n],
-        };
+        let mut st = NewtonStates::clear(model);
         st.update(model, v);
         st
     }
 
+    /// Every vertex free and clear of both bodies.
+    pub fn clear(model: &Model) -> NewtonStates {
+        let n = model.n();
+        let low = if model.lower.is_some() { n } else { 0 };
+        NewtonStates {
+            truncated: vec![false; n],
+            penetrating: vec![false; n],
+            penetrating_low: vec![false; low],
+            at_lower: vec![false; low],
+        }
+    }
+
+    /// `true` when vertex `i` penetrates the body below.
+    #[inline]
+    pub fn below(&self, i: usize) -> bool {
+        !self.penetrating_low.is_empty() && self.penetrating_low[i]
+    }
+
     /// Recomputes the states of V in place (no allocation).
     pub fn update(&mut self, model: &Model, v: &[f64]) {
-        let rigid = model.is_rigid();
-        let fill = |i: usize| -> (bool, bool) {
-            if model.can_touch[i] {
-                (v[i] == model.phi[i], !rigid && v[i] > model.phi[i])
-            } else {
-                (false, false)
-            }
+        if !model.is_extended() {
+            let rigid = model.is_rigid();
+            let fill = |i: usize| -> (bool, bool) {
+                if model.can_touch[i] {
+                    (v[i] == model.phi[i], !rigid && v[i] > model.phi[i])
+                } else {
+                    (false, false)
+                }
+            };
+            par_rows(&mut self.truncated, |i, t| *t = fill(i).0);
+            par_rows(&mut self.penetrating, |i, p| *p = fill(i).1);
+            return;
+        }
+        // Both bodies and rigid regions (SPEC §5).
+        let up_held = |i: usize| model.can_touch[i] && v[i] == model.phi[i];
+        let low_held = |i: usize| {
+            model
+                .lower
+                .as_ref()
+                .is_some_and(|b| b.can_touch[i] && v[i] == b.phi[i])
         };
-        par_rows(&mut self.truncated, |i, t| *t = fill(i).0);
-        par_rows(&mut self.penetrating, |i, p| *p = fill(i).1);
+        par_rows(&mut self.truncated, |i, t| *t = up_held(i) || low_held(i));
+        par_rows(&mut self.penetrating, |i, p| {
+            *p = model.can_touch[i] && !model.rigid_at(i) && v[i] > model.phi[i]
+        });
+        if let Some(low) = &model.lower {
+            par_rows(&mut self.penetrating_low, |i, p| {
+                *p = low.can_touch[i] && !low.rigid_at(i) && v[i] < low.phi[i]
+            });
+            par_rows(&mut self.at_lower, |i, a| *a = low_held(i) && !up_held(i));
+        }
     }
 }
 
@@ -70,8 +116,27 @@ pub fn newton_system(
     g: &mut [f64],
     r: &mut [f64],
 ) {
+    if model.is_extended() {
+        newton_system_with::<true>(model, v, st, a, rows, g, r)
+    } else {
+        newton_system_with::<false>(model, v, st, a, rows, g, r)
+    }
+}
+
+/// [`newton_system`]; `EXT`: with the body below's terms `− E_Q L_low q` in the gradient
+/// and `E_Q L_low E_Q` in the Hessian (`q = (φ_low − V)⁺`, Q its penetrating vertices).
+fn newton_system_with<const EXT: bool>(
+    model: &Model,
+    v: &[f64],
+    st: &NewtonStates,
+    a: &mut Csr,
+    rows: Option<&[bool]>,
+    g: &mut [f64],
+    r: &mut [f64],
+) {
     let pat = model.s.pattern.clone();
     let sval = &model.s.val;
+    let lower = if EXT { model.lower.as_ref() } else { None };
     let pen = |j: usize| {
         if model.can_touch[j] {
             (v[j] - model.phi[j]).max(0.0)
@@ -104,6 +169,28 @@ pub fn newton_system(
         } else {
             *ri
         };
+        if let Some(low) = lower {
+            if !st.truncated[i] && st.below(i) {
+                let q = |j: usize| {
+                    if low.can_touch[j] {
+                        (low.phi[j] - v[j]).max(0.0)
+                    } else {
+                        0.0
+                    }
+                };
+                *gi -= match &low.l {
+                    FoundationMatrix::Consistent(l) => {
+                        let mut lq = 0.0;
+                        for (&j, &lij) in cols.iter().zip(&l.val[s..e]) {
+                            lq += lij * q(j as usize);
+                        }
+                        lq
+                    }
+                    FoundationMatrix::Lumped(d) => d[i] * q(i),
+                    FoundationMatrix::Rigid => 0.0,
+                };
+            }
+        }
         if !rows.is_none_or(|d| d[i]) {
             return;
         }
@@ -120,6 +207,15 @@ pub fn newton_system(
             } else {
                 sval[s + k]
             };
+            if let Some(low) = lower {
+                if !st.truncated[i] && !st.truncated[j] && st.below(i) && st.below(j) {
+                    arow[k] += match &low.l {
+                        FoundationMatrix::Consistent(l) => l.val[s + k],
+                        FoundationMatrix::Lumped(d) if i == j => d[i],
+                        _ => 0.0,
+                    };
+                }
+            }
         }
     };
     let blocks = row_chunks(&pat, &mut a.val, CHUNK);
@@ -177,7 +273,9 @@ pub fn mark_dirty(
     dirty: &mut [bool],
 ) -> usize {
     par_rows(changed, |i, c| {
-        *c = old.truncated[i] != new.truncated[i] || old.penetrating[i] != new.penetrating[i];
+        *c = old.truncated[i] != new.truncated[i]
+            || old.penetrating[i] != new.penetrating[i]
+            || old.below(i) != new.below(i);
     });
     let changed: &[bool] = changed;
     par_rows(dirty, |i, d| {

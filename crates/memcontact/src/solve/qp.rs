@@ -19,6 +19,14 @@
 //! For the rigid obstacle there is no `V₂`: `min ½V₁ᵀSV₁ − V₁ᵀD` subject to `Ṽ₁ ≤ φ̃`,
 //! and `z = X₁`.
 //!
+//! **Beyond the paper (SPEC §5).** Where the obstacle is rigid in some regions only, the
+//! vertices it holds rigidly have the constraint `V₁ᵢ ≤ φᵢ` and no `V₂ᵢ`. A body below adds
+//! the variables `V₃` with `½ V₃ᵀ L̃_low V₃` in the objective and the rows
+//! `φ̃_low − Ṽ₁ − V₃ ≤ 0`, `−V₃ ≤ 0` (`−Ṽ₁ ≤ −φ̃_low` where it is rigid); their duals are the
+//! body's contact forces (pushing up) and the multipliers of `V₃ ≥ 0`. A vertex both rigid
+//! bodies hold at one height (`φ_low = φ`) gets one equality row (a zero cone) instead of
+//! two opposite inequalities, which would leave an interior point no room.
+//!
 //! **Scaling.** With a length `ℓ` (the largest |φ| on M, or the displacement one unit of
 //! force scale produces) and the force scale `F` of the certificates, the solver sees
 //! `x = ℓ y` and the objective divided by `ℓF`: `q/F` and `Pℓ/F` are of order one whatever
@@ -131,17 +139,21 @@ pub fn solve_with_report(model: &Model, settings: &Settings) -> Result<QpReport>
     timer.time("interior point", || solver.solve());
     let sol = &solver.solution;
     let iterations = sol.iterations as usize;
-    // At the iteration limit, or when the interior-point method stops making progress
-    // (often with residuals near the rounding of its own scaling), the iterate is still
-    // polished and certified: the status of the solve follows from its certificate.
-    if !matches!(
-        sol.status,
-        SolverStatus::Solved
-            | SolverStatus::AlmostSolved
-            | SolverStatus::MaxIterations
-            | SolverStatus::MaxTime
-            | SolverStatus::InsufficientProgress
-    ) {
+    // At the iteration limit (or stopped for lack of progress with finite residuals) the
+    // iterate is still polished and certified: the status of the solve follows from its
+    // certificate.
+    let stuck = sol.status == SolverStatus::InsufficientProgress
+        && sol.r_prim.is_finite()
+        && sol.r_dual.is_finite();
+    if !stuck
+        && !matches!(
+            sol.status,
+            SolverStatus::Solved
+                | SolverStatus::AlmostSolved
+                | SolverStatus::MaxIterations
+                | SolverStatus::MaxTime
+        )
+    {
         return Err(Error::Solver {
             solver: "qp".into(),
             message: format!(
@@ -204,34 +216,99 @@ pub fn solve_with_report(model: &Model, settings: &Settings) -> Result<QpReport>
 }
 
 /// The exact multipliers of 2e at U: `X₁ = D − SU` and `X₂ = L̃U₂ − X₁` with
-/// `U₂ = (U − φ)⁺`, on M (zero elsewhere; `X₂ = 0` for the rigid obstacle).
+/// `U₂ = (U − φ)⁺`, on M (zero elsewhere; `X₂ = 0` for the rigid obstacle); with a body
+/// below, the contact forces split between the bodies
+/// ([`crate::certificate::contact_forces`]) and the body below's `X₁_low`, `X₂_low`.
 pub fn exact_multipliers(model: &Model, u: &[f64]) -> Multipliers {
-    let r = model.residual(u);
+    let forces = crate::certificate::contact_forces(model, u);
     let p = model.penetration(u);
     let mut lp = vec![0.0; model.n()];
     model.l.mul_into(&p, &mut lp);
-    let rigid = model.is_rigid();
     let mut x1 = vec![0.0; model.n()];
     let mut x2 = vec![0.0; model.n()];
     for i in 0..model.n() {
         if model.can_touch[i] {
-            x1[i] = -r[i];
-            if !rigid {
-                x2[i] = lp[i] + r[i];
+            x1[i] = forces.up[i];
+            if !model.rigid_at(i) {
+                x2[i] = lp[i] - forces.up[i];
             }
         }
     }
-    Multipliers { x1, x2 }
+    let (mut x1_low, mut x2_low) = (Vec::new(), Vec::new());
+    if let Some(low) = &model.lower {
+        let q = low.penetration(u);
+        let mut lq = vec![0.0; model.n()];
+        low.l.mul_into(&q, &mut lq);
+        x1_low = vec![0.0; model.n()];
+        x2_low = vec![0.0; model.n()];
+        for i in 0..model.n() {
+            if low.can_touch[i] {
+                x1_low[i] = forces.low[i];
+                if !low.rigid_at(i) {
+                    x2_low[i] = lq[i] - forces.low[i];
+                }
+            }
+        }
+    }
+    Multipliers {
+        x1,
+        x2,
+        x1_low,
+        x2_low,
+    }
+}
+
+/// One body's constraints in Problem 2c: the unknowns it can touch (its rows of the first
+/// block), those among them with an auxiliary penetration variable (elastic), and where
+/// those variables start in x.
+struct BodyRows {
+    /// Unknowns the body can touch, ascending (one first-block row each).
+    touch: Vec<usize>,
+    /// Row of unknown i in the first block (`usize::MAX` when the body cannot touch it).
+    row: Vec<usize>,
+    /// Unknowns with a penetration variable (elastic there), ascending.
+    elastic: Vec<usize>,
+    /// Index among `elastic` of unknown i (`usize::MAX` when rigid or untouchable).
+    var: Vec<usize>,
+}
+
+impl BodyRows {
+    fn new(n: usize, can_touch: &[bool], rigid: impl Fn(usize) -> bool) -> BodyRows {
+        let touch: Vec<usize> = (0..n).filter(|&i| can_touch[i]).collect();
+        let elastic: Vec<usize> = touch.iter().copied().filter(|&i| !rigid(i)).collect();
+        let mut row = vec![usize::MAX; n];
+        for (r, &i) in touch.iter().enumerate() {
+            row[i] = r;
+        }
+        let mut var = vec![usize::MAX; n];
+        for (r, &i) in elastic.iter().enumerate() {
+            var[i] = r;
+        }
+        BodyRows {
+            touch,
+            row,
+            elastic,
+            var,
+        }
+    }
+
+    /// Rows of the body's constraints: the first block and `−V ≤ 0`.
+    fn rows(&self) -> usize {
+        self.touch.len() + self.elastic.len()
+    }
 }
 
 /// The data of Problem 2c in Clarabel's form, scaled (see the module docs).
 struct Qp2c {
-    /// Unknowns in M, ascending.
-    in_m: Vec<usize>,
+    /// Unknowns that both rigid bodies hold at one height (φ_low = φ): one equality row
+    /// each, first (an interior point needs room between two inequalities).
+    pinned: Vec<usize>,
+    /// The obstacle's constraints.
+    up: BodyRows,
+    /// The body below's constraints (SPEC §5: variables V₃), when there is one.
+    low: Option<BodyRows>,
     /// Number of unknowns m.
     n: usize,
-    /// Whether there is a `V₂` block (elastic obstacle).
-    elastic: bool,
     /// Length scale ℓ (`x = ℓ y`).
     length: f64,
     /// Force scale F (`z = F z'`).
@@ -243,29 +320,63 @@ struct Qp2c {
 }
 
 impl Qp2c {
-    /// Builds P (upper triangle of `diag(S, L̃)`), q, A and b from the model's CSR data (S
-    /// and L are symmetric, so their CSR rows are their CSC columns).
+    /// Builds P (upper triangle of `diag(S, L̃, L̃_low)`), q, A and b from the model's CSR
+    /// data (S and L are symmetric, so their CSR rows are their CSC columns). The rows are
+    /// the obstacle's `Ṽ₁ − V₂ ≤ φ̃` (no V₂ where it is rigid) and `−V₂ ≤ 0`, then the body
+    /// below's `−Ṽ₁ − V₃ ≤ −φ̃_low` and `−V₃ ≤ 0` (SPEC §5).
     fn build(model: &Model) -> Qp2c {
         let n = model.n();
-        let in_m: Vec<usize> = (0..n).filter(|&i| model.can_touch[i]).collect();
-        let mut pos = vec![usize::MAX; n];
-        for (r, &i) in in_m.iter().enumerate() {
-            pos[i] = r;
+        let pinned: Vec<usize> = match &model.lower {
+            Some(b) => (0..n)
+                .filter(|&i| {
+                    model.can_touch[i]
+                        && model.rigid_at(i)
+                        && b.can_touch[i]
+                        && b.rigid_at(i)
+                        && b.phi[i] >= model.phi[i]
+                })
+                .collect(),
+            None => Vec::new(),
+        };
+        let mut is_pinned = vec![false; n];
+        for &i in &pinned {
+            is_pinned[i] = true;
         }
-        let k = in_m.len();
-        let elastic = !model.is_rigid();
+        let touch_up: Vec<bool> = (0..n)
+            .map(|i| model.can_touch[i] && !is_pinned[i])
+            .collect();
+        let up = BodyRows::new(n, &touch_up, |i| model.rigid_at(i));
+        let low = model.lower.as_ref().map(|b| {
+            let touch: Vec<bool> = (0..n).map(|i| b.can_touch[i] && !is_pinned[i]).collect();
+            BodyRows::new(n, &touch, |i| b.rigid_at(i))
+        });
         let force = model.force_scale();
         let sdiag = model.s.diag();
         let max_diag = (0..n)
             .map(|i| sdiag[i] + model.l.diag(i).max(0.0))
             .fold(0.0f64, f64::max)
             .max(f64::MIN_POSITIVE);
-        let phi_m = in_m.iter().fold(0.0f64, |m, &i| m.max(model.phi[i].abs()));
+        let mut phi_m = up
+            .touch
+            .iter()
+            .fold(0.0f64, |m, &i| m.max(model.phi[i].abs()));
+        if let (Some(rows), Some(b)) = (&low, &model.lower) {
+            // The body below sets the length only when the obstacle touches nothing: a far
+            // body would otherwise set a scale the solution does not have.
+            if up.touch.is_empty() {
+                phi_m = rows.touch.iter().fold(phi_m, |m, &i| m.max(b.phi[i].abs()));
+            }
+        }
         let length = phi_m.max(force / max_diag);
         let pscale = length / force;
+        let (ku, kl) = (
+            up.elastic.len(),
+            low.as_ref().map_or(0, |r| r.elastic.len()),
+        );
 
-        // P: column j of S's upper triangle = row j of S with columns ≤ j.
-        let nv = if elastic { n + k } else { n };
+        // P: column j of S's upper triangle = row j of S with columns ≤ j; then the
+        // foundation blocks of the elastic variables.
+        let nv = n + ku + kl;
         let mut colptr = Vec::with_capacity(nv + 1);
         let mut rowval = Vec::new();
         let mut nzval = Vec::new();
@@ -280,59 +391,94 @@ impl Qp2c {
             }
             colptr.push(rowval.len());
         }
-        if elastic {
-            for (r, &j) in in_m.iter().enumerate() {
-                match &model.l {
+        let mut foundation_block = |l: &FoundationMatrix, rows: &BodyRows, offset: usize| {
+            for (r, &j) in rows.elastic.iter().enumerate() {
+                match l {
                     FoundationMatrix::Consistent(l) => {
                         let (cols, vals) = l.row(j);
                         for (&i, &v) in cols.iter().zip(vals) {
                             let i = i as usize;
-                            if i <= j && model.can_touch[i] && v != 0.0 {
-                                rowval.push(n + pos[i]);
+                            if i <= j && rows.var[i] != usize::MAX && v != 0.0 {
+                                rowval.push(offset + rows.var[i]);
                                 nzval.push(v * pscale);
                             }
                         }
                     }
                     FoundationMatrix::Lumped(d) => {
-                        rowval.push(n + r);
+                        rowval.push(offset + r);
                         nzval.push(d[j] * pscale);
                     }
                     FoundationMatrix::Rigid => {}
                 }
                 colptr.push(rowval.len());
             }
+        };
+        foundation_block(&model.l, &up, n);
+        if let (Some(rows), Some(b)) = (&low, &model.lower) {
+            foundation_block(&b.l, rows, n + ku);
         }
         let p = CscMatrix::new(nv, nv, colptr, rowval, nzval);
         let mut q: Vec<f64> = model.d.iter().map(|d| -d / force).collect();
         q.resize(nv, 0.0);
 
-        // A: rows 0..k are Ṽ₁ − V₂ ≤ φ̃, rows k..2k are −V₂ ≤ 0 (elastic only).
-        let rows = if elastic { 2 * k } else { k };
+        // A, by columns. Rows: the pinned unknowns' equalities (k0), the obstacle's first
+        // block (|touch|) and its −V₂ ≤ 0 (ku), then the body below's first block and
+        // −V₃ ≤ 0.
+        let k0 = pinned.len();
+        let mut pinned_row = vec![usize::MAX; n];
+        for (r, &i) in pinned.iter().enumerate() {
+            pinned_row[i] = r;
+        }
+        let up_rows = k0 + up.rows();
+        let rows_total = up_rows + low.as_ref().map_or(0, BodyRows::rows);
+        let ut = up.touch.len();
         let mut colptr = Vec::with_capacity(nv + 1);
         let mut rowval = Vec::new();
         let mut nzval = Vec::new();
         colptr.push(0);
-        for &pj in pos.iter() {
-            if pj != usize::MAX {
-                rowval.push(pj);
+        for (j, &pr) in pinned_row.iter().enumerate() {
+            if pr != usize::MAX {
+                rowval.push(pr);
                 nzval.push(1.0);
+            }
+            if up.row[j] != usize::MAX {
+                rowval.push(k0 + up.row[j]);
+                nzval.push(1.0);
+            }
+            if let Some(rows) = &low {
+                if rows.row[j] != usize::MAX {
+                    rowval.push(up_rows + rows.row[j]);
+                    nzval.push(-1.0);
+                }
             }
             colptr.push(rowval.len());
         }
-        if elastic {
-            for r in 0..k {
-                rowval.extend([r, k + r]);
+        for (r, &i) in up.elastic.iter().enumerate() {
+            rowval.extend([k0 + up.row[i], k0 + ut + r]);
+            nzval.extend([-1.0, -1.0]);
+            colptr.push(rowval.len());
+        }
+        if let Some(rows) = &low {
+            let lt = rows.touch.len();
+            for (r, &i) in rows.elastic.iter().enumerate() {
+                rowval.extend([up_rows + rows.row[i], up_rows + lt + r]);
                 nzval.extend([-1.0, -1.0]);
                 colptr.push(rowval.len());
             }
         }
-        let a = CscMatrix::new(rows, nv, colptr, rowval, nzval);
-        let mut b: Vec<f64> = in_m.iter().map(|&i| model.phi[i] / length).collect();
-        b.resize(rows, 0.0);
+        let a = CscMatrix::new(rows_total, nv, colptr, rowval, nzval);
+        let mut b: Vec<f64> = pinned.iter().map(|&i| model.phi[i] / length).collect();
+        b.extend(up.touch.iter().map(|&i| model.phi[i] / length));
+        b.resize(up_rows, 0.0);
+        if let (Some(rows), Some(body)) = (&low, &model.lower) {
+            b.extend(rows.touch.iter().map(|&i| -body.phi[i] / length));
+            b.resize(rows_total, 0.0);
+        }
         Qp2c {
-            in_m,
+            pinned,
+            up,
+            low,
             n,
-            elastic,
             length,
             force,
             p,
@@ -362,53 +508,102 @@ impl Qp2c {
             .presolve_enable(false)
             .build()
             .map_err(|e| err(format!("invalid Clarabel settings: {e}")))?;
-        let cones = [SupportedConeT::NonnegativeConeT(self.b.len())];
+        let k0 = self.pinned.len();
+        let cones = if k0 == 0 {
+            vec![SupportedConeT::NonnegativeConeT(self.b.len())]
+        } else {
+            vec![
+                SupportedConeT::ZeroConeT(k0),
+                SupportedConeT::NonnegativeConeT(self.b.len() - k0),
+            ]
+        };
         DefaultSolver::new(&self.p, &self.q, &self.a, &self.b, &cones, settings)
             .map_err(|e| err(format!("Clarabel rejected Problem 2c: {e}")))
     }
 
-    /// U and the multipliers `(X₁, X₂)` over the unknowns from Clarabel's scaled `x`, `z`.
+    /// U and the multipliers `(X₁, X₂)` (and the body below's) over the unknowns from
+    /// Clarabel's scaled `x`, `z`.
     fn unscale(&self, model: &Model, x: &[f64], z: &[f64]) -> RawAnswer {
         let u: Vec<f64> = x[..self.n].iter().map(|y| y * self.length).collect();
-        let k = self.in_m.len();
-        let mut x1 = vec![0.0; model.n()];
-        let mut x2 = vec![0.0; model.n()];
-        for (r, &i) in self.in_m.iter().enumerate() {
-            x1[i] = z[r] * self.force;
-            if self.elastic {
-                x2[i] = z[k + r] * self.force;
+        let duals = |rows: &BodyRows, offset: usize| {
+            let mut x1 = vec![0.0; model.n()];
+            let mut x2 = vec![0.0; model.n()];
+            let t = rows.touch.len();
+            for &i in &rows.touch {
+                x1[i] = z[offset + rows.row[i]] * self.force;
+                if rows.var[i] != usize::MAX {
+                    x2[i] = z[offset + t + rows.var[i]] * self.force;
+                }
+            }
+            (x1, x2)
+        };
+        let k0 = self.pinned.len();
+        let (mut x1, x2) = duals(&self.up, k0);
+        let (mut x1_low, x2_low) = match &self.low {
+            Some(rows) => duals(rows, k0 + self.up.rows()),
+            None => (Vec::new(), Vec::new()),
+        };
+        // A pinned unknown's equality carries the net force: down is the obstacle's, up
+        // the body below's.
+        for (r, &i) in self.pinned.iter().enumerate() {
+            let zf = z[r] * self.force;
+            if zf >= 0.0 {
+                x1[i] = zf;
+            } else {
+                x1_low[i] = -zf;
             }
         }
         RawAnswer {
             u,
-            multipliers: Multipliers { x1, x2 },
+            multipliers: Multipliers {
+                x1,
+                x2,
+                x1_low,
+                x2_low,
+            },
         }
     }
 
     /// The vertex states read from the interior-point answer: a constraint is active when
-    /// its (scaled) dual exceeds its (scaled) slack.
+    /// its (scaled) dual exceeds its (scaled) slack. Both of a body's constraints active:
+    /// touching (held); only the first: penetrating; a rigid body's constraint active: held.
     fn guess_states(&self, model: &Model, s: &[f64], z: &[f64]) -> NewtonStates {
-        let n = model.n();
-        let k = self.in_m.len();
-        let mut truncated = vec![false; n];
-        let mut penetrating = vec![false; n];
-        for (r, &i) in self.in_m.iter().enumerate() {
-            let first = z[r] > s[r];
-            if !self.elastic {
-                truncated[i] = first;
+        let mut st = NewtonStates::clear(model);
+        // `(held, penetrating)` per unknown for one body.
+        let read = |rows: &BodyRows, offset: usize, i: usize| -> (bool, bool) {
+            if rows.row[i] == usize::MAX {
+                return (false, false);
+            }
+            let k = offset + rows.row[i];
+            let first = z[k] > s[k];
+            if rows.var[i] == usize::MAX {
+                return (first, false);
+            }
+            let k2 = offset + rows.touch.len() + rows.var[i];
+            let second = z[k2] > s[k2];
+            (first && second, first && !second)
+        };
+        let k0 = self.pinned.len();
+        for &i in &self.pinned {
+            st.truncated[i] = true;
+        }
+        for i in 0..model.n() {
+            if st.truncated[i] {
                 continue;
             }
-            let second = z[k + r] > s[k + r];
-            if first && second {
-                truncated[i] = true;
-            } else if first {
-                penetrating[i] = true;
+            let (held, pen) = read(&self.up, k0, i);
+            st.truncated[i] = held;
+            st.penetrating[i] = pen;
+            if let Some(rows) = &self.low {
+                let (held_low, pen_low) = read(rows, k0 + self.up.rows(), i);
+                if held_low && !held {
+                    st.truncated[i] = true;
+                    st.at_lower[i] = true;
+                }
+                st.penetrating_low[i] = pen_low && !st.truncated[i];
             }
         }
-        NewtonStates {
-            truncated,
-            penetrating,
-        }
+        st
     }
 }
 
@@ -444,28 +639,46 @@ fn solve_piece(
         }
         None => chol.insert(Cholesky::new(a)?),
     };
-    // φ on the penetrating vertices, for the L φ term.
+    // Where a held vertex sits: on φ, or on φ_low when held by the body below.
+    let held_at = |j: usize| {
+        if !st.at_lower.is_empty() && st.at_lower[j] {
+            model.lower.as_ref().expect("a body below").phi[j]
+        } else {
+            model.phi[j]
+        }
+    };
+    // φ on the penetrating vertices, for the L φ term (and φ_low for L_low φ_low).
     let phi_p: Vec<f64> = (0..model.n())
         .map(|j| if st.penetrating[j] { model.phi[j] } else { 0.0 })
         .collect();
+    let phi_q: Vec<f64> = match &model.lower {
+        Some(low) => (0..model.n())
+            .map(|j| if st.below(j) { low.phi[j] } else { 0.0 })
+            .collect(),
+        None => Vec::new(),
+    };
     let mut rhs: Vec<f64> = (0..model.n())
         .map(|i| {
             if st.truncated[i] {
-                return model.phi[i];
+                return held_at(i);
             }
             let (cols, vals) = model.s.row(i);
             let held: f64 = cols
                 .iter()
                 .zip(vals)
                 .filter(|(&j, _)| st.truncated[j as usize])
-                .map(|(&j, &v)| v * model.phi[j as usize])
+                .map(|(&j, &v)| v * held_at(j as usize))
                 .sum();
             let coupling = if st.penetrating[i] {
                 model.l.row_dot(i, &phi_p)
             } else {
                 0.0
             };
-            model.d[i] - held + coupling
+            let coupling_low = match &model.lower {
+                Some(low) if st.below(i) => low.l.row_dot(i, &phi_q),
+                _ => 0.0,
+            };
+            model.d[i] - held + coupling + coupling_low
         })
         .collect();
     factor.solve_in_place(&mut rhs);
@@ -475,11 +688,11 @@ fn solve_piece(
             message: "the polishing solve produced non-finite values".into(),
         });
     }
-    // The held vertices exactly on φ (the Cholesky solve of an identity row is exact, but
-    // make it explicit).
-    for ((v, &held), &f) in rhs.iter_mut().zip(&st.truncated).zip(&model.phi) {
-        if held {
-            *v = f;
+    // The held vertices exactly on their kink (the Cholesky solve of an identity row is
+    // exact, but make it explicit).
+    for (i, v) in rhs.iter_mut().enumerate() {
+        if st.truncated[i] {
+            *v = held_at(i);
         }
     }
     Ok(rhs)
@@ -490,6 +703,9 @@ fn solve_piece(
 /// force `X₁ = D − SU` is negative becomes clear, one whose `X₂ = (L(U − φ)_P)_i − X₁` is
 /// negative becomes penetrating.
 fn update_states(model: &Model, st: &NewtonStates, u: &[f64]) -> NewtonStates {
+    if model.is_extended() {
+        return update_states_two(model, st, u);
+    }
     let n = model.n();
     let r = model.residual(u);
     let p: Vec<f64> = (0..n)
@@ -524,6 +740,84 @@ fn update_states(model: &Model, st: &NewtonStates, u: &[f64]) -> NewtonStates {
     next
 }
 
+/// [`update_states`] with a body below and rigid regions (SPEC §5): the same primal-dual
+/// rules for each body, with the contact force of a held vertex the net force less the
+/// other body's elastic force where that one penetrates.
+fn update_states_two(model: &Model, st: &NewtonStates, u: &[f64]) -> NewtonStates {
+    let n = model.n();
+    let r = model.residual(u);
+    let restricted = |pen: &dyn Fn(usize) -> bool, w: &dyn Fn(usize) -> f64| -> Vec<f64> {
+        (0..n).map(|j| if pen(j) { w(j) } else { 0.0 }).collect()
+    };
+    let p = restricted(&|j| st.penetrating[j], &|j| u[j] - model.phi[j]);
+    let mut lp = vec![0.0; n];
+    model.l.mul_into(&p, &mut lp);
+    let (low, mut lq) = (model.lower.as_ref(), vec![0.0; n]);
+    if let Some(low) = low {
+        let q = restricted(&|j| st.below(j), &|j| low.phi[j] - u[j]);
+        low.l.mul_into(&q, &mut lq);
+    }
+    let mut next = st.clone();
+    for i in 0..n {
+        let up_touch = model.can_touch[i];
+        let low_touch = low.is_some_and(|b| b.can_touch[i]);
+        if !up_touch && !low_touch {
+            continue;
+        }
+        let at_low = !st.at_lower.is_empty() && st.at_lower[i];
+        if st.truncated[i] {
+            let released = if at_low {
+                let b = low.expect("a body below");
+                // Held on the body below: its force pushes up.
+                let x = r[i] + if st.penetrating[i] { lp[i] } else { 0.0 };
+                if x < 0.0 {
+                    Some((false, false))
+                } else if !b.rigid_at(i) && lq[i] - x < 0.0 {
+                    Some((false, true))
+                } else {
+                    None
+                }
+            } else {
+                let x = -r[i] + if st.below(i) { lq[i] } else { 0.0 };
+                if x < 0.0 {
+                    Some((false, false))
+                } else if !model.rigid_at(i) && lp[i] - x < 0.0 {
+                    Some((true, false))
+                } else {
+                    None
+                }
+            };
+            if let Some((pen, pen_low)) = released {
+                next.truncated[i] = false;
+                if !next.at_lower.is_empty() {
+                    next.at_lower[i] = false;
+                    next.penetrating_low[i] = pen_low;
+                }
+                next.penetrating[i] = pen;
+            }
+            continue;
+        }
+        // Free: a vertex that crossed a kink is held there.
+        let gap = u[i] - model.phi[i];
+        let crossed_up =
+            up_touch && ((st.penetrating[i] && gap < 0.0) || (!st.penetrating[i] && gap > 0.0));
+        let crossed_low = low.is_some_and(|b| {
+            let g = b.phi[i] - u[i];
+            low_touch && ((st.below(i) && g < 0.0) || (!st.below(i) && g > 0.0))
+        });
+        if crossed_up || crossed_low {
+            next.truncated[i] = true;
+            next.penetrating[i] = false;
+            if !next.at_lower.is_empty() {
+                next.penetrating_low[i] = false;
+                // Held on the body whose kink was crossed (above when both were).
+                next.at_lower[i] = crossed_low && !crossed_up;
+            }
+        }
+    }
+    next
+}
+
 /// Polishes from the guessed states: up to [`POLISH_ROUNDS`] exact piece solves, keeping
 /// the best certificate; `None` when every piece solve failed.
 fn polish(model: &Model, guess: NewtonStates, tolerance: f64) -> Option<Polished> {
@@ -553,7 +847,12 @@ fn polish(model: &Model, guess: NewtonStates, tolerance: f64) -> Option<Polished
             });
         }
         match next {
-            Some(next) if next.truncated != st.truncated || next.penetrating != st.penetrating => {
+            Some(next)
+                if next.truncated != st.truncated
+                    || next.penetrating != st.penetrating
+                    || next.penetrating_low != st.penetrating_low
+                    || next.at_lower != st.at_lower =>
+            {
                 st = next
             }
             _ => break,
@@ -715,11 +1014,7 @@ mod tests {
             model(&m, Some(&200.0), Foundation::Lumped),
             model(&m, None, Foundation::Consistent),
         ] {
-            let n = model.n();
-            let clear = NewtonStates {
-                truncated: vec![false; n],
-                penetrating: vec![false; n],
-            };
+            let clear = NewtonStates::clear(&model);
             let p = polish(&model, clear, 1e-11).expect("the piece solves succeed");
             let reference = active_set::solve(&model, &settings(), None, &mut Silent).unwrap();
             eprintln!(
@@ -738,11 +1033,7 @@ mod tests {
 
     /// The free membrane S U = D, through the piece solver.
     fn solve_piece_for_test(model: &Model) -> Vec<f64> {
-        let n = model.n();
-        let st = NewtonStates {
-            truncated: vec![false; n],
-            penetrating: vec![false; n],
-        };
+        let st = NewtonStates::clear(model);
         let mut a = Csr::zeros(model.s.pattern.clone());
         solve_piece(model, &st, &mut a, &mut None).unwrap()
     }

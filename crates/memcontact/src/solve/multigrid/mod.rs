@@ -171,13 +171,7 @@ pub fn solve_with(
         if k > first {
             let mut next = vec![0.0; m.n()];
             levels.transfers[k - 1].prolongate(&v, &mut next);
-            if m.is_rigid() {
-                for ((x, f), &c) in next.iter_mut().zip(&m.phi).zip(&m.can_touch) {
-                    if c && *x > *f {
-                        *x = *f;
-                    }
-                }
-            }
+            m.project(&mut next);
             v = next;
         }
         let t0 = Instant::now();
@@ -255,16 +249,37 @@ fn coarse_model(fine: &Model, t: &Transfer, levels: &Levels, k: usize) -> Model 
         y
     };
     let s = galerkin(&fine.s);
-    let l = match &fine.l {
-        FoundationMatrix::Consistent(l) => FoundationMatrix::Consistent(galerkin(l)),
-        FoundationMatrix::Lumped(d) => FoundationMatrix::Lumped(restrict(d)),
-        FoundationMatrix::Rigid => FoundationMatrix::Rigid,
-    };
     let inject = t.injection();
-    let phi: Vec<f64> = inject.iter().map(|&v| fine.phi[v as usize]).collect();
-    let can_touch: Vec<bool> = (0..t.n_coarse)
-        .map(|i| l.is_rigid() || l.diag(i) > 0.0)
-        .collect();
+    // One body's Galerkin restriction: L_c = PᵀLP (or l_c = Pᵀl), φ and the rigid flags
+    // injected at the coarse vertices.
+    let body = |l: &FoundationMatrix, phi: &[f64], rigid: Option<&Vec<bool>>| {
+        let l = match l {
+            FoundationMatrix::Consistent(l) => FoundationMatrix::Consistent(galerkin(l)),
+            FoundationMatrix::Lumped(d) => FoundationMatrix::Lumped(restrict(d)),
+            FoundationMatrix::Rigid => FoundationMatrix::Rigid,
+        };
+        let phi: Vec<f64> = inject.iter().map(|&v| phi[v as usize]).collect();
+        let rigid: Option<Vec<bool>> =
+            rigid.map(|r| inject.iter().map(|&v| r[v as usize]).collect());
+        let can_touch: Vec<bool> = (0..t.n_coarse)
+            .map(|i| l.is_rigid() || l.diag(i) > 0.0 || rigid.as_ref().is_some_and(|r| r[i]))
+            .collect();
+        (l, phi, can_touch, rigid)
+    };
+    let (l, phi, can_touch, rigid) = body(&fine.l, &fine.phi, fine.rigid.as_ref());
+    let lower = fine.lower.as_ref().map(|low| {
+        let (l, phi, can_touch, rigid) = body(&low.l, &low.phi, low.rigid.as_ref());
+        crate::model::Body {
+            l,
+            phi,
+            can_touch,
+            rigid,
+            foundation: low.foundation,
+            phi_vertices: Vec::new(),
+            h_vertices: Vec::new(),
+            epsilon: low.epsilon,
+        }
+    });
     let dofs = levels.dofs[k].clone();
     let phi_vertices = dofs.to_vertices(&phi, 0.0);
     Model {
@@ -281,6 +296,10 @@ fn coarse_model(fine: &Model, t: &Transfer, levels: &Levels, k: usize) -> Model 
         total_load: fine.total_load,
         epsilon: fine.epsilon,
         dofs,
+        rigid,
+        lower,
+        boundary_values: Vec::new(),
+        lift: Vec::new(),
     }
 }
 
@@ -378,12 +397,27 @@ fn level_solve(ls: LevelSolve) -> Result<(usize, f64, Option<Certificate>)> {
             for _ in 0..options.cycles {
                 mg.v_cycle(&a, &mut delta, &g);
             }
+            let extended = model.is_extended();
             for (i, d) in delta.iter_mut().enumerate() {
                 if st.truncated[i] || !d.is_finite() {
                     *d = 0.0;
-                } else if model.is_rigid() && model.can_touch[i] {
-                    // Project onto the defect obstacle: V + δ ≤ φ.
+                    continue;
+                }
+                // Project onto the defect obstacles of the rigid bodies: V + δ ≤ φ (and
+                // V + δ ≥ φ_low).
+                if !extended {
+                    if model.is_rigid() && model.can_touch[i] {
+                        *d = d.min(model.phi[i] - v[i]);
+                    }
+                    continue;
+                }
+                if model.can_touch[i] && model.rigid_at(i) {
                     *d = d.min(model.phi[i] - v[i]);
+                }
+                if let Some(low) = &model.lower {
+                    if low.can_touch[i] && low.rigid_at(i) {
+                        *d = d.max(low.phi[i] - v[i]);
+                    }
                 }
             }
         });

@@ -1,0 +1,323 @@
+//! Named boundary regions: tagged edges of ∂Ω_n (Gmsh physical curves, the generators'
+//! sides `left`, `right`, `bottom`, `top`, `outer`, `hole1`, ...), and the split of the
+//! boundary into its fixed part Γ_D (u = g) and its free part (the natural condition
+//! t ∂u/∂n = 0) that decides which vertices carry unknowns.
+
+use super::{DofMap, Mesh, VertexTriangles};
+use crate::{Error, Result};
+use std::collections::{BTreeMap, HashMap};
+
+/// The tag of the boundary edges no region names (and of the whole boundary of a mesh
+/// without boundary regions).
+pub const UNTAGGED: u32 = 0;
+
+/// Boundary regions of a mesh: plain arrays, so that a permutation of the vertices carries
+/// them (map the vertex indices of `edges`). Boundary edges not listed belong to the region
+/// [`UNTAGGED`].
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct BoundaryRegions {
+    /// Boundary edges `[a, b]` (vertex indices, either order) that carry a tag.
+    pub edges: Vec<[u32; 2]>,
+    /// The tag of every edge of `edges`.
+    pub tags: Vec<u32>,
+    /// Names of the tags that have one (the keys of `[boundary]` tables).
+    pub names: BTreeMap<u32, String>,
+}
+
+impl BoundaryRegions {
+    /// `true` when no boundary edge is tagged.
+    pub fn is_empty(&self) -> bool {
+        self.edges.is_empty()
+    }
+
+    /// The name of tag `tag`, or the tag as text.
+    pub fn name(&self, tag: u32) -> String {
+        self.names
+            .get(&tag)
+            .cloned()
+            .unwrap_or_else(|| tag.to_string())
+    }
+
+    /// The tags named `key` (a name, or a tag written as a number), among `present`.
+    pub fn resolve(&self, key: &str, present: &[u32]) -> Vec<u32> {
+        let by_name: Vec<u32> = self
+            .names
+            .iter()
+            .filter(|(&t, n)| n.as_str() == key && present.contains(&t))
+            .map(|(&t, _)| t)
+            .collect();
+        if !by_name.is_empty() {
+            return by_name;
+        }
+        match key.trim().parse::<u32>() {
+            Ok(t) if present.contains(&t) && !self.names.values().any(|n| n == key) => vec![t],
+            _ => Vec::new(),
+        }
+    }
+}
+
+/// Every boundary edge of a mesh with its boundary region tag.
+#[derive(Debug, Clone)]
+pub struct TaggedBoundary {
+    /// The boundary edges `[a, b]` (counter-clockwise order of their triangle).
+    pub edges: Vec<[u32; 2]>,
+    /// Their tags ([`UNTAGGED`] where the mesh names none).
+    pub tags: Vec<u32>,
+}
+
+impl TaggedBoundary {
+    /// The tags present, sorted, without repetition.
+    pub fn present(&self) -> Vec<u32> {
+        let mut t = self.tags.clone();
+        t.sort_unstable();
+        t.dedup();
+        t
+    }
+}
+
+impl Mesh {
+    /// Returns the mesh with boundary regions: `edges[k]` (boundary edges, either vertex
+    /// order) carries `tags[k]`, `names` names the tags. Errors: lengths that differ, an
+    /// edge that is not a boundary edge of the mesh, an edge given twice with two tags.
+    pub fn with_boundary_regions(
+        mut self,
+        edges: Vec<[u32; 2]>,
+        tags: Vec<u32>,
+        names: BTreeMap<u32, String>,
+    ) -> Result<Mesh> {
+        if edges.len() != tags.len() {
+            return Err(Error::Mesh(format!(
+                "{} boundary region tags for {} boundary edges",
+                tags.len(),
+                edges.len()
+            )));
+        }
+        let boundary: HashMap<(u32, u32), ()> = self
+            .boundary_edges()
+            .into_iter()
+            .map(|[a, b]| ((a.min(b), a.max(b)), ()))
+            .collect();
+        let mut seen: HashMap<(u32, u32), u32> = HashMap::with_capacity(edges.len());
+        for (&[a, b], &tag) in edges.iter().zip(&tags) {
+            let key = (a.min(b), a.max(b));
+            if !boundary.contains_key(&key) {
+                return Err(Error::Mesh(format!(
+                    "boundary region {}: edge ({a}, {b}) is not an edge of the mesh's boundary",
+                    names.get(&tag).cloned().unwrap_or_else(|| tag.to_string())
+                )));
+            }
+            if let Some(other) = seen.insert(key, tag) {
+                if other != tag {
+                    return Err(Error::Mesh(format!(
+                        "boundary edge ({a}, {b}) belongs to two boundary regions ({} and {})",
+                        names
+                            .get(&other)
+                            .cloned()
+                            .unwrap_or_else(|| other.to_string()),
+                        names.get(&tag).cloned().unwrap_or_else(|| tag.to_string())
+                    )));
+                }
+            }
+        }
+        self.boundary = BoundaryRegions { edges, tags, names };
+        Ok(self)
+    }
+
+    /// Every boundary edge with its region tag ([`UNTAGGED`] where none is given).
+    pub fn tagged_boundary(&self, adj: &VertexTriangles) -> TaggedBoundary {
+        let edges = self.boundary_edges_with(adj);
+        let tags = if self.boundary.is_empty() {
+            vec![UNTAGGED; edges.len()]
+        } else {
+            let map: HashMap<(u32, u32), u32> = self
+                .boundary
+                .edges
+                .iter()
+                .zip(&self.boundary.tags)
+                .map(|(&[a, b], &t)| ((a.min(b), a.max(b)), t))
+                .collect();
+            edges
+                .iter()
+                .map(|&[a, b]| *map.get(&(a.min(b), a.max(b))).unwrap_or(&UNTAGGED))
+                .collect()
+        };
+        TaggedBoundary { edges, tags }
+    }
+
+    /// The names of the boundary regions present, for messages (`left, right, ...`).
+    pub fn boundary_listing(&self, tagged: &TaggedBoundary) -> String {
+        let names: Vec<String> = tagged
+            .present()
+            .iter()
+            .map(|&t| self.boundary.name(t))
+            .collect();
+        names.join(", ")
+    }
+}
+
+/// The fixed part Γ_D of the boundary: which vertices are fixed (`u = g` there) and which
+/// boundary regions are free.
+#[derive(Debug, Clone)]
+pub struct FixedBoundary {
+    /// `fixed[v]`: vertex `v` lies on a fixed boundary edge.
+    pub fixed: Vec<bool>,
+    /// The boundary edges of Γ_D with their tags.
+    pub edges: Vec<([u32; 2], u32)>,
+    /// The tags of the fixed boundary regions, sorted.
+    pub fixed_tags: Vec<u32>,
+    /// Vertices on the free part of the boundary only (they carry unknowns).
+    pub free_vertices: usize,
+}
+
+impl FixedBoundary {
+    /// The whole boundary fixed (the paper's frame).
+    pub fn all(mesh: &Mesh, adj: &VertexTriangles) -> FixedBoundary {
+        FixedBoundary::new(mesh, adj, &[]).expect("no free region to resolve")
+    }
+
+    /// The boundary of `mesh` without the regions named in `free` (names or tags as text).
+    /// A name that is not a boundary region of the mesh is an error listing the regions.
+    pub fn new(mesh: &Mesh, adj: &VertexTriangles, free: &[String]) -> Result<FixedBoundary> {
+        let tagged = mesh.tagged_boundary(adj);
+        let present = tagged.present();
+        let mut free_tags = Vec::new();
+        for key in free {
+            let tags = mesh.boundary.resolve(key, &present);
+            if tags.is_empty() {
+                return Err(Error::Data(format!(
+                    "boundary.free: no boundary region named '{key}' in the mesh (boundary \
+                     regions: {})",
+                    mesh.boundary_listing(&tagged)
+                )));
+            }
+            free_tags.extend(tags);
+        }
+        let mut fixed = vec![false; mesh.n_vertices()];
+        let mut on_boundary = vec![false; mesh.n_vertices()];
+        let mut edges = Vec::new();
+        for (&e, &tag) in tagged.edges.iter().zip(&tagged.tags) {
+            on_boundary[e[0] as usize] = true;
+            on_boundary[e[1] as usize] = true;
+            if !free_tags.contains(&tag) {
+                fixed[e[0] as usize] = true;
+                fixed[e[1] as usize] = true;
+                edges.push((e, tag));
+            }
+        }
+        let mut fixed_tags: Vec<u32> = edges.iter().map(|e| e.1).collect();
+        fixed_tags.sort_unstable();
+        fixed_tags.dedup();
+        let free_vertices = on_boundary
+            .iter()
+            .zip(&fixed)
+            .filter(|(&b, &f)| b && !f)
+            .count();
+        Ok(FixedBoundary {
+            fixed,
+            edges,
+            fixed_tags,
+            free_vertices,
+        })
+    }
+
+    /// Number of fixed vertices.
+    pub fn count(&self) -> usize {
+        self.fixed.iter().filter(|&&f| f).count()
+    }
+}
+
+impl DofMap {
+    /// Numbers the vertices that are not fixed, in vertex order (SPEC §5: the unknowns
+    /// are all vertices not on Γ_D, free-boundary vertices included).
+    pub fn from_fixed(fixed: &[bool]) -> DofMap {
+        let mut vertex = Vec::with_capacity(fixed.len());
+        let mut dof = vec![None; fixed.len()];
+        for (v, &f) in fixed.iter().enumerate() {
+            if !f {
+                dof[v] = Some(vertex.len() as u32);
+                vertex.push(v as u32);
+            }
+        }
+        DofMap { vertex, dof }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mesh::generate::{rectangle, Diagonal, RectangleSpec};
+
+    fn square(n: usize) -> Mesh {
+        rectangle(&RectangleSpec {
+            x0: 0.0,
+            y0: 0.0,
+            x1: 1.0,
+            y1: 1.0,
+            nx: n,
+            ny: n,
+            diagonal: Diagonal::Right,
+        })
+        .unwrap()
+        .finest()
+        .clone()
+    }
+
+    #[test]
+    fn free_sides_carry_unknowns() {
+        let m = square(4);
+        let adj = VertexTriangles::new(&m);
+        let all = FixedBoundary::all(&m, &adj);
+        assert_eq!(all.count(), 16);
+        assert_eq!(all.free_vertices, 0);
+        // The whole boundary fixed: the same unknowns as the interior numbering.
+        assert_eq!(
+            DofMap::from_fixed(&all.fixed).vertex,
+            DofMap::new(&m).vertex
+        );
+        let top = FixedBoundary::new(&m, &adj, &["top".into()]).unwrap();
+        // The top side's 5 vertices minus its two corners (on left and right).
+        assert_eq!(top.free_vertices, 3);
+        assert_eq!(top.count(), 13);
+        let e = FixedBoundary::new(&m, &adj, &["lid".into()]).unwrap_err();
+        assert!(
+            e.to_string().contains(
+                "no boundary region named 'lid' in the mesh (boundary regions: \
+                           bottom, right, top, left)"
+            ),
+            "{e}"
+        );
+        let none = FixedBoundary::new(
+            &m,
+            &adj,
+            &["left".into(), "right".into(), "top".into(), "bottom".into()],
+        )
+        .unwrap();
+        assert_eq!(none.count(), 0);
+        assert_eq!(none.free_vertices, 16);
+    }
+
+    #[test]
+    fn bad_boundary_regions_are_errors() {
+        let m = square(2);
+        let e = m
+            .clone()
+            .with_boundary_regions(vec![[0, 4]], vec![1], BTreeMap::new())
+            .unwrap_err();
+        assert!(
+            e.to_string().contains("not an edge of the mesh's boundary"),
+            "{e}"
+        );
+        let e = m
+            .clone()
+            .with_boundary_regions(vec![[0, 1], [1, 0]], vec![1, 2], BTreeMap::new())
+            .unwrap_err();
+        assert!(e.to_string().contains("two boundary regions"), "{e}");
+        let e = m
+            .with_boundary_regions(vec![[0, 1]], vec![], BTreeMap::new())
+            .unwrap_err();
+        assert!(
+            e.to_string().contains("0 boundary region tags for 1"),
+            "{e}"
+        );
+    }
+}
