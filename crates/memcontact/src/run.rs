@@ -182,6 +182,7 @@ impl Discretization {
             status: a.status,
             requested: a.requested,
             method: s.method,
+            coarsening: s.coarsening,
             choice: a.choice,
             fallback: a.fallback,
             message: a.message,
@@ -311,6 +312,8 @@ pub struct Report {
     pub requested: Method,
     /// The method that produced the iterate.
     pub method: Method,
+    /// The kind of multigrid hierarchy it ran on (multigrid only).
+    pub coarsening: Option<crate::solve::multigrid::Kind>,
     /// Why that method was used.
     pub choice: Choice,
     /// The method `auto` tried first and gave up on.
@@ -378,6 +381,7 @@ impl Report {
                 .iter()
                 .map(|p| (p.name.clone(), p.seconds))
                 .collect(),
+            coarsening: self.coarsening,
         }
     }
 }

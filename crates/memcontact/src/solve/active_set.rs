@@ -162,5 +162,6 @@ pub fn solve(
         multipliers: None,
         history,
         phases: timer.into_phases(),
+        coarsening: None,
     })
 }

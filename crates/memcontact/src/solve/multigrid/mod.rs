@@ -26,13 +26,16 @@
 //! `D_c = PᵀD`: exactly the coarse discretisation for nested meshes; φ injected at the
 //! coarse vertices), and each solution prolongated as the start of the next level.
 
+pub mod aggregation;
 pub mod cycle;
 pub mod transfer;
 
 #[cfg(test)]
+mod algebraic_tests;
+#[cfg(test)]
 pub(crate) mod tests;
 
-pub use cycle::{linear_solve, poisson_solve, Levels, LinearSolve, Multigrid};
+pub use cycle::{linear_solve, poisson_solve, Kind, Levels, LinearSolve, Multigrid};
 pub use transfer::Transfer;
 
 use super::active_set::start_from;
@@ -59,6 +62,10 @@ pub struct Options {
     pub presmoothing: usize,
     /// Linear V-cycles per Newton correction.
     pub cycles: usize,
+    /// Once the vertex states repeat from one iteration to the next, the Newton correction
+    /// is computed by up to this many flexible CG steps preconditioned by the cycle, to a
+    /// quarter of the tolerance (0: one cycle, always).
+    pub krylov_steps: usize,
     /// (pre, post) Gauss-Seidel steps per level inside a V-cycle.
     pub smoothing: (usize, usize),
     /// Solve the coarser levels first and start from the prolongated solution.
@@ -66,6 +73,9 @@ pub struct Options {
     /// Scaled KKT residual to which the coarser levels are solved in nested iteration
     /// (never below `settings.tolerance`).
     pub nested_tolerance: f64,
+    /// Algebraic hierarchies: coarsen down to about this many unknowns (the coarsest level
+    /// is factorised).
+    pub coarsest: usize,
 }
 
 impl Default for Options {
@@ -73,10 +83,20 @@ impl Default for Options {
         Options {
             presmoothing: 1,
             cycles: 1,
+            krylov_steps: 30,
             smoothing: (1, 1),
             nested: true,
             nested_tolerance: 1e-6,
+            coarsest: aggregation::COARSEST,
         }
+    }
+}
+
+impl Options {
+    /// These options with algebraic hierarchies coarsened down to about `coarsest`
+    /// unknowns.
+    pub fn with_coarsest(self, coarsest: usize) -> Options {
+        Options { coarsest, ..self }
     }
 }
 
@@ -101,20 +121,39 @@ pub struct Report {
     pub levels: Vec<LevelReport>,
 }
 
-/// Solves Problem 2b by TNNMG with the default [`Options`]. `hierarchy` must end with the
-/// mesh the model was assembled on; anything else is an error. With a `start` (a warm
-/// start, e.g. the answer of a neighbouring load step) the iteration begins there on the
-/// finest level, without nested iteration.
+/// The coarse levels TNNMG runs on.
+#[derive(Debug, Clone, Copy)]
+pub enum Coarsening<'a> {
+    /// Nested meshes of uniform refinement; the last must be the mesh the model was
+    /// assembled on (anything else is an error).
+    Geometric(&'a Hierarchy),
+    /// An aggregation hierarchy built from the model's matrices ([`aggregation`]).
+    Algebraic,
+}
+
+impl Coarsening<'_> {
+    /// Geometric or algebraic.
+    pub fn kind(&self) -> Kind {
+        match self {
+            Coarsening::Geometric(_) => Kind::Geometric,
+            Coarsening::Algebraic => Kind::Algebraic,
+        }
+    }
+}
+
+/// Solves Problem 2b by TNNMG with the default [`Options`] on the given coarse levels.
+/// With a `start` (a warm start, e.g. the answer of a neighbouring load step) the
+/// iteration begins there on the finest level, without nested iteration.
 pub fn solve(
     model: &Model,
-    hierarchy: &Hierarchy,
+    coarsening: Coarsening,
     settings: &Settings,
     start: Option<&[f64]>,
     observer: &mut dyn Observer,
 ) -> Result<Solution> {
     solve_with(
         model,
-        hierarchy,
+        coarsening,
         settings,
         &Options::default(),
         start,
@@ -123,26 +162,44 @@ pub fn solve(
     .map(|r| r.0)
 }
 
-/// [`solve`] with explicit options, also returning the per-level report.
+/// The matrix an algebraic hierarchy is built from: S plus the foundation's diagonal
+/// (where the membrane penetrates, the Newton matrices add L to S).
+fn setup_matrix(model: &Model) -> Csr {
+    let mut a = model.s.clone();
+    for (i, k) in a.pattern.diagonal_positions().into_iter().enumerate() {
+        if model.can_touch[i] {
+            a.val[k] += model.l.diag(i);
+        }
+    }
+    a
+}
+
+/// [`solve`] with explicit options, also returning the per-level report. Nested iteration
+/// runs on geometric hierarchies only (aggregates are no meshes to restrict φ to).
 pub fn solve_with(
     model: &Model,
-    hierarchy: &Hierarchy,
+    coarsening: Coarsening,
     settings: &Settings,
     options: &Options,
     start: Option<&[f64]>,
     observer: &mut dyn Observer,
 ) -> Result<(Solution, Report)> {
     let mut timer = PhaseTimer::default();
-    let levels = timer.time("setup", || {
-        Levels::new(hierarchy, &model.dofs, model.s.pattern.clone())
+    let levels = timer.time("setup", || match coarsening {
+        Coarsening::Geometric(h) => Levels::new(h, &model.dofs, model.s.pattern.clone()),
+        Coarsening::Algebraic => Ok(Levels::algebraic(&setup_matrix(model), options.coarsest)),
     })?;
     let top = levels.len() - 1;
+    if std::env::var("MC_DEBUG").is_ok() {
+        let nnz: Vec<usize> = levels.patterns.iter().map(|p| p.nnz()).collect();
+        eprintln!("levels {:?} nnz {:?}", levels.sizes, nnz);
+    }
     let max = settings.max_iterations.unwrap_or(MAX_ITERATIONS);
     let mut report = Report::default();
     let mut history = Vec::new();
 
     // Nested iteration: the Galerkin models of the coarser levels, coarsest first.
-    let first = if options.nested && start.is_none() {
+    let first = if options.nested && start.is_none() && levels.kind == Kind::Geometric {
         0
     } else {
         top
@@ -235,6 +292,7 @@ pub fn solve_with(
             multipliers: None,
             history,
             phases: timer.into_phases(),
+            coarsening: Some(levels.kind),
         },
         report,
     ))
@@ -333,8 +391,11 @@ fn level_solve(ls: LevelSolve) -> Result<(usize, f64, Option<Certificate>)> {
     let mut kkt;
     let mut certificate = None;
     let mut watch = crate::certificate::FloorWatch::default();
+    let mut fcg = cycle::FcgWork::default();
+    let mut scale;
     loop {
         let ev = timer.time("certificate", || crate::certificate::evaluate(model, v));
+        scale = ev.certificate.force_scale;
         kkt = ev.certificate.kkt();
         if iterations > 0 {
             let record = IterationRecord::new(iterations, &ev);
@@ -362,10 +423,14 @@ fn level_solve(ls: LevelSolve) -> Result<(usize, f64, Option<Certificate>)> {
         });
         // The truncated Newton system at the smoothed iterate.
         let st = NewtonStates::of(model, v);
-        let rows = prev
+        let dirty_rows = prev
             .as_ref()
             .map(|p| mark_dirty(&pattern, p, &st, &mut changed, &mut dirty));
-        let rows = rows.map(|_| dirty.as_slice());
+        // The states are those of the last iteration: the piece of J is likely the
+        // solution's, and an accurate Newton step on it finishes the solve.
+        let frac: usize = std::env::var("MC_FRAC").map(|v| v.parse().unwrap()).unwrap_or(1000);
+        let settled = dirty_rows.is_some_and(|d| if frac == 0 { d == 0 } else { d <= n / frac });
+        let rows = dirty_rows.map(|_| dirty.as_slice());
         timer.time("newton system", || {
             newton_system(model, v, &st, &mut a, rows, &mut g, &mut r)
         });
@@ -375,8 +440,29 @@ fn level_solve(ls: LevelSolve) -> Result<(usize, f64, Option<Certificate>)> {
                 *x = -*x;
             }
             delta.iter_mut().for_each(|d| *d = 0.0);
-            for _ in 0..options.cycles {
-                mg.v_cycle(&a, &mut delta, &g);
+            if settled && options.krylov_steps > 0 {
+                // Solve the Newton system to within a quarter of the tolerance.
+                let target = 0.25 * tolerance * scale;
+                let steps = mg.fcg(
+                    &a,
+                    &mut delta,
+                    &g,
+                    target,
+                    options.krylov_steps,
+                    &st.truncated,
+                    &mut fcg,
+                );
+                if std::env::var("MC_DEBUG").is_ok() {
+                    eprintln!("fcg steps {steps}");
+                }
+            } else if let Ok(k) = std::env::var("MC_UNSETTLED") {
+                let k: usize = k.parse().unwrap();
+                let steps = mg.fcg(&a, &mut delta, &g, 0.0, k, &st.truncated, &mut fcg);
+                let _ = steps;
+            } else {
+                for _ in 0..options.cycles {
+                    mg.cycle(&a, &mut delta, &g);
+                }
             }
             for (i, d) in delta.iter_mut().enumerate() {
                 if st.truncated[i] || !d.is_finite() {
