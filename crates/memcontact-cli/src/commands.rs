@@ -3,9 +3,9 @@
 use crate::output;
 use crate::progress::{Progress, Verbosity};
 use anyhow::{bail, Result};
-use memcontact::io::result_set::ResultSet;
-use memcontact::output::{write_files, write_result_set, write_sweep_csv, WriteOptions};
+use memcontact::output::WriteOptions;
 use memcontact::{Case, Discretization, Outcome};
+use memcontact_plot::write::{self, SweepWriter};
 use std::path::Path;
 use std::time::Instant;
 
@@ -34,19 +34,24 @@ pub struct SolveFlags<'a> {
 pub fn solve(case_path: &Path, flags: &SolveFlags) -> Result<()> {
     let started = Instant::now();
     let case = Case::load(case_path, flags.sets)?;
-    if case.sweep.is_some() || !case.load_cases.is_empty() {
-        return sweep(case_path, &case, flags, started);
-    }
+    let label = case_path.display().to_string();
     let mut progress = Progress::new(flags.verbosity);
-    let outcome = memcontact::run(&case.problem, &case.settings, &mut progress)?;
+    let discretization = Discretization::new(&case.problem, &mut progress)?;
+    // Everything that needs the mesh is checked before anything is solved.
+    write::check_on_mesh(&case, discretization.mesh())?;
+    if case.is_sweep() {
+        return sweep(&label, &case, discretization, flags, progress, started);
+    }
+    let report = discretization.solve(&case.settings, &mut progress)?;
     progress.finish();
+    let outcome = Outcome {
+        discretization,
+        report,
+    };
     print_warnings(&outcome.discretization);
     let accepted = outcome.report.accepted;
     if !accepted && !flags.write_unconverged {
-        eprint!(
-            "{}",
-            output::human(&case_path.display().to_string(), &outcome, None)
-        );
+        eprint!("{}", output::human(&label, &outcome, None));
         bail!(
             "{}; no result files were written (pass --write-unconverged to keep the \
              iterate, marked as not accepted in summary.json){}",
@@ -56,19 +61,15 @@ pub fn solve(case_path: &Path, flags: &SolveFlags) -> Result<()> {
                 .unwrap_or_default()
         );
     }
-    let label = case_path.display().to_string();
-    let plots = output::plot_options(&case, &label);
+    let plots = write::plot_options(&case, &label);
     let options = WriteOptions {
         label,
         vtu: case.output.vtu,
         force: flags.force,
         started,
-        plot_options: serde_json::to_value(&plots).ok(),
+        plot_options: None,
     };
-    let summary = {
-        let mut pictures = output::pictures(&outcome, &plots);
-        write_result_set(flags.out, &outcome, &case, &options, &mut pictures)?
-    };
+    let summary = write::write_result(flags.out, &outcome, &case, &options, &plots)?;
     print!(
         "{}",
         output::human(&options.label, &outcome, Some((&summary, flags.out)))
@@ -93,75 +94,55 @@ pub fn solve(case_path: &Path, flags: &SolveFlags) -> Result<()> {
 /// `memcontact solve` on a case with `[sweep]` or `[[load_case]]`: every step in turn,
 /// warm-started from the previous one, written into one result set: a subdirectory per
 /// step, `sweep.csv` and `sweep.png` (the force-deflection curve).
-fn sweep(case_path: &Path, case: &Case, flags: &SolveFlags, started: Instant) -> Result<()> {
-    let label = case_path.display().to_string();
-    let plots = output::plot_options(case, &label);
-    let set = ResultSet::begin(flags.out, flags.force)?;
-    let steps = memcontact::sweep::steps(case)?;
-    let total = steps.len();
-    let mut progress = Progress::new(flags.verbosity);
+fn sweep(
+    label: &str,
+    case: &Case,
+    base: Discretization,
+    flags: &SolveFlags,
+    mut progress: Progress,
+    started: Instant,
+) -> Result<()> {
+    print_warnings(&base);
+    let mut writer =
+        SweepWriter::begin(flags.out, flags.force, case, label, case.output.vtu, true)?;
+    let total = memcontact::sweep::steps(case)?.len();
     let mut rows = Vec::new();
-    let mut written = 0;
-    let result =
-        memcontact::sweep::run_sweep(case, true, &mut progress, &mut |step, outcome, row| {
+    let mut unaccepted = Vec::new();
+    let result = memcontact::sweep::run_sweep_on(
+        case,
+        base,
+        true,
+        &mut progress,
+        &mut |step, outcome, row| {
             rows.push(row.clone());
-            if !outcome.report.accepted && !flags.write_unconverged {
-                return Ok(());
+            if !outcome.report.accepted {
+                unaccepted.push(step.name.clone());
+                if !flags.write_unconverged {
+                    return Ok(());
+                }
             }
-            let dir = set.dir().join(&step.name);
-            std::fs::create_dir(&dir).map_err(|source| memcontact::Error::Io {
-                path: dir.clone(),
-                source,
-            })?;
-            let options = WriteOptions {
-                label: format!("{label} [{}]", step.name),
-                vtu: case.output.vtu,
-                force: false,
-                started: Instant::now(),
-                plot_options: serde_json::to_value(&plots).ok(),
-            };
-            let mut step_plots = plots.clone();
-            step_plots.title = Some(options.label.clone());
-            let mut pictures = output::pictures(outcome, &step_plots);
-            write_files(&dir, outcome, case, &options, &mut pictures)?;
-            written += 1;
+            writer.write_step(case, step, outcome, row.seconds)?;
             Ok(())
-        });
-    progress.finish();
-    let result = match result {
-        Err(e) if !flags.write_unconverged => return Err(e.into()),
-        other => other.map(|_| ()),
-    };
-    let (tag, value_name) = match &case.sweep {
-        Some(s) => ("sweep", s.parameter.name().replace('_', " ")),
-        None => ("load cases", "load factor".to_string()),
-    };
-    write_sweep_csv(&set.dir().join("sweep.csv"), &rows)?;
-    let force = match &case.units.force {
-        Some(f) => format!(" [{f}]"),
-        None => String::new(),
-    };
-    let length = match &case.units.length {
-        Some(l) => format!(" [{l}]"),
-        None => String::new(),
-    };
-    memcontact_plot::line_plot(
-        &set.dir().join("sweep.png"),
-        &memcontact_plot::LinePlot {
-            title: format!("Force-deflection ({tag}): {label}"),
-            x_label: format!("max deflection{length}"),
-            y_label: format!("force{force}"),
-            series: vec![memcontact_plot::Series {
-                name: "total contact force".into(),
-                points: rows
-                    .iter()
-                    .map(|r| (r.max_deflection, r.total_contact_force))
-                    .collect(),
-            }],
         },
-    )?;
-    set.commit()?;
-    println!("memcontact: {label} ({tag}: {total} steps, {value_name})");
+    );
+    progress.finish();
+    // Bad input, or a step that did not converge: nothing is written unless the
+    // unconverged step was asked for.
+    let failed = match result {
+        Ok(_) => None,
+        Err(e) if unaccepted.is_empty() => return Err(e.into()),
+        Err(e) if !flags.write_unconverged => bail!(
+            "{e}; no result files were written (pass --write-unconverged to keep the steps \
+             solved and the unconverged iterate, marked as not accepted in summary.json)"
+        ),
+        Err(e) => Some(e),
+    };
+    let written = writer.steps_written();
+    writer.finish(&rows)?;
+    println!(
+        "memcontact: {label} ({}: {total} steps)",
+        write::steps_kind(case)
+    );
     println!(
         "  {:>5} {:>16} {:>12} {:>12} {:>12} {:>12} {:>6} {:>10}",
         "step", "name", "value", "max |u|", "contact area", "force", "iters", "KKT"
@@ -180,14 +161,24 @@ fn sweep(case_path: &Path, case: &Case, flags: &SolveFlags, started: Instant) ->
         );
     }
     let iterations: usize = rows.iter().map(|r| r.iterations).sum();
+    let picture = if case.output.pictures().is_empty() {
+        ""
+    } else {
+        ", sweep.png"
+    };
     println!(
-        "  total        {iterations} iterations, {:.3} s; wrote {}/{{{} step directories, \
-         sweep.csv, sweep.png}}",
+        "  total        {iterations} iterations, {:.3} s; wrote {}/{{{written} step \
+         directories, sweep.csv{picture}}}",
         started.elapsed().as_secs_f64(),
         flags.out.display(),
-        written
     );
-    result?;
+    if let Some(e) = failed {
+        bail!(
+            "{e}; the directories of the steps that did not converge ({}) hold their \
+             unconverged iterates (summary.json: \"accepted\": false)",
+            unaccepted.join(", ")
+        );
+    }
     Ok(())
 }
 
@@ -204,8 +195,11 @@ fn not_converged(outcome: &Outcome) -> String {
 pub fn check(case_path: &Path, sets: &[String]) -> Result<()> {
     let case = Case::load(case_path, sets)?;
     // Building the mesh, binding and assembling checks the data on the mesh (regions,
-    // signs, NaN), everything `solve` checks before it solves.
+    // signs, NaN), everything `solve` checks before it solves; the load cases' data are
+    // assembled on the mesh too, and the profile line checked against it.
     let d = Discretization::new(&case.problem, &mut Progress::new(Verbosity::Quiet))?;
+    write::check_on_mesh(&case, d.mesh())?;
+    memcontact::sweep::check_on_mesh(&case, d.mesh(), true)?;
     print_warnings(&d);
     let mesh = d.mesh();
     println!("case {}: valid", case_path.display());
@@ -219,6 +213,16 @@ pub fn check(case_path: &Path, sets: &[String]) -> Result<()> {
         d.model.foundation.name(),
         if d.model.is_rigid() { ", rigid" } else { "" }
     );
+    if case.is_sweep() {
+        let steps = memcontact::sweep::steps(&case)?;
+        let names: Vec<&str> = steps.iter().map(|s| s.name.as_str()).collect();
+        println!(
+            "  steps        {} ({}): {}",
+            steps.len(),
+            write::steps_kind(&case),
+            names.join(", ")
+        );
+    }
     let (method, choice) = d.auto_choice();
     println!(
         "  solver       {} (auto picks {}: {})",

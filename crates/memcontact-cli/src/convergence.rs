@@ -2,6 +2,7 @@
 //! and log-log plot, the lumped/consistent and nodal/mollified comparisons and the
 //! rigid-limit sweep. The numerics are in `memcontact::convergence`.
 
+use crate::progress::{Progress, Verbosity};
 use anyhow::{anyhow, bail, Context, Result};
 use memcontact::convergence::{
     self as study, LevelResult, ManufacturedLoad, Study, StudySettings, Sweep, Target,
@@ -320,14 +321,16 @@ pub fn run(args: &Args) -> Result<()> {
         };
         let v = &variants(&case, None)[0];
         let data = data_for(v);
-        if !args.quiet {
-            eprintln!(
-                "h sweep on {} vertices: rigid, then h = {:?}",
-                hierarchy.finest().n_vertices(),
-                hs
-            );
-        }
-        let sweep = study::rigid_limit_sweep(&hierarchy, &data, &hs, &settings)?;
+        let spinner = Progress::new(Verbosity::of(args.quiet, false));
+        spinner.line(&format!(
+            "h sweep on {} vertices: rigid, then h = {:?}",
+            hierarchy.finest().n_vertices(),
+            hs
+        ));
+        spinner.message("solving …");
+        let sweep = study::rigid_limit_sweep(&hierarchy, &data, &hs, &settings);
+        spinner.finish();
+        let sweep = sweep?;
         let disk = match &exact {
             Some(Exact::Disk(d)) => Some(d),
             _ => None,
@@ -361,25 +364,29 @@ pub fn run(args: &Args) -> Result<()> {
             (None, None) => Target::Finest,
             (None, Some((_, first))) => Target::Discrete(&first.finest_u),
         };
-        let quiet = args.quiet;
-        let label = v.name;
+        let label = if v.name.is_empty() {
+            String::new()
+        } else {
+            format!("[{}] ", v.name)
+        };
+        // A bar over the K + 1 levels on a terminal; one line per level either way.
+        let total = args.levels + 1;
+        let mut bar = Progress::new(Verbosity::of(args.quiet, false));
+        bar.set_prefix(&label);
+        bar.steps(0, total);
+        bar.message("level 0 …");
         let mut progress = |r: &LevelResult| {
-            if !quiet {
-                eprintln!(
-                    "  {}level {}: {} vertices, {} {} iterations, assembly {:.2} s, solve {:.2} s",
-                    if label.is_empty() {
-                        String::new()
-                    } else {
-                        format!("[{label}] ")
-                    },
-                    r.level,
-                    r.vertices,
-                    r.method.name(),
-                    r.iterations,
-                    r.assembly_seconds,
-                    r.solve_seconds
-                );
-            }
+            bar.line(&format!(
+                "  {label}level {}: {} vertices, {} {} iterations, assembly {:.2} s, solve {:.2} s",
+                r.level,
+                r.vertices,
+                r.method.name(),
+                r.iterations,
+                r.assembly_seconds,
+                r.solve_seconds
+            ));
+            bar.steps(r.level + 1, total);
+            bar.message(&format!("level {} …", r.level + 1));
         };
         let s = study::run(
             hierarchy.clone(),
@@ -387,8 +394,9 @@ pub fn run(args: &Args) -> Result<()> {
             target,
             &study_settings,
             &mut progress,
-        )?;
-        studies.push((v, s));
+        );
+        bar.finish();
+        studies.push((v, s?));
     }
     let reference_note = match (&exact, args.compare) {
         (Some(_), _) => None,

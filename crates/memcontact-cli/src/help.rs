@@ -27,6 +27,12 @@ CASE FILE (TOML; paths relative to the case file; unknown keys are errors)
               allowable_pressure = p     force/area: pressure.png maps pressure / p
               profile = [[x0, y0], [x1, y1]]  the line of profile.png (default: mid-height)
 [units]       length = \"m\", force = \"kN\"   names for the labels of the pictures
+[sweep]       parameter = \"load_factor\"  or stiffness_factor | tension | obstacle_offset (+ φ)
+              values = [v, ...]          or from = a, to = b, steps = n (evenly, both ends)
+                                         one solve per value, each from the previous answer
+[[load_case]] name = \"...\"               one entry per combination (its output directory)
+              load, load_factor (1),     override the base case's data
+              shape, stiffness
 
 Units: any consistent system (e.g. m, kN: t in kN/m, f in kN/m², h in kN/m³).
 Expressions: x, y, r, pi, e; + - * / ^; < <= > >= == != && || !; sin cos tan asin acos atan

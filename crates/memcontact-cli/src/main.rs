@@ -32,11 +32,13 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Command {
-    /// Solve a case and write solution.vtu, nodes.csv and summary.json.
+    /// Solve a case and write solution.vtu, nodes.csv, the pictures and summary.json.
     ///
     /// The files are written as one set: the output directory is replaced as a whole when
     /// all are complete, so it never mixes two runs. A solve that does not reach the
-    /// tolerance writes nothing and exits with status 1 (see --write-unconverged).
+    /// tolerance writes nothing and exits with status 1 (see --write-unconverged). A case
+    /// with [sweep] or [[load_case]] entries solves every step in turn, each from the
+    /// previous answer, into a directory per step, with sweep.csv and sweep.png.
     #[command(after_long_help = help::CASE_KEYS)]
     Solve {
         /// The case file (TOML).
@@ -50,14 +52,16 @@ enum Command {
         /// Show no progress.
         #[arg(short, long)]
         quiet: bool,
-        /// Print every phase and iteration (energy J and the KKT residual).
+        /// Print every phase and iteration (energy J, the KKT residual and those of 2e
+        /// and 2f, the vertex state counts).
         #[arg(short, long, conflicts_with = "quiet")]
         verbose: bool,
         /// Replace the output directory even if it holds files that are not a result.
         #[arg(long)]
         force: bool,
         /// Write the files of a solve that did not converge (summary.json says
-        /// "converged": false); the exit status is still 1.
+        /// "accepted": false; in a sweep, the steps before it too); the exit status is
+        /// still 1.
         #[arg(long)]
         write_unconverged: bool,
     },
@@ -89,7 +93,8 @@ enum Command {
         phases: bool,
     },
     /// Redraw the pictures of a result directory (deflection.png, pressure.png,
-    /// liftoff.png, profile.png) from its solution.vtu and summary.json, without solving.
+    /// liftoff.png, profile.png) from its solution.vtu and summary.json, without solving
+    /// (identical files); on a sweep's directory, every step's.
     Plot(plot_cmd::Args),
     /// List the example cases, or write one (and any mesh it needs) to a directory.
     Example {

@@ -1,12 +1,8 @@
-//! What `memcontact solve` shows: the human summary on the terminal and the pictures it
-//! adds to the result set. The result files themselves are the library's
-//! (`memcontact::output`).
+//! What `memcontact solve` shows: the human summary on the terminal. The result files are
+//! the library's (`memcontact::output`), with their pictures (`memcontact_plot::write`).
 
 use memcontact::mesh::{Mesh, MeshQuality};
-use memcontact::problem::PictureKind;
-use memcontact::results::NodalFields;
-use memcontact::{Case, Outcome, Summary};
-use memcontact_plot::{draw_all, PlotData, PlotKind, PlotOptions, Units};
+use memcontact::{Outcome, Summary};
 use std::fmt::Write as _;
 use std::path::Path;
 
@@ -35,60 +31,6 @@ pub fn mesh_report(mesh: &Mesh, q: &MeshQuality, levels: usize) -> String {
         let _ = writeln!(s, "  regions      {}", names.join(", "));
     }
     s
-}
-
-/// The options of the pictures of `case` (the `[output]` and `[units]` keys), titled
-/// with `label`.
-pub fn plot_options(case: &Case, label: &str) -> PlotOptions {
-    PlotOptions {
-        plots: case
-            .output
-            .pictures()
-            .into_iter()
-            .map(|k| match k {
-                PictureKind::Deflection => PlotKind::Deflection,
-                PictureKind::Pressure => PlotKind::Pressure,
-                PictureKind::Liftoff => PlotKind::Liftoff,
-                PictureKind::Profile => PlotKind::Profile,
-            })
-            .collect(),
-        allowable_pressure: case.output.allowable_pressure,
-        profile: case.output.profile,
-        units: Units {
-            length: case.units.length.clone(),
-            force: case.units.force.clone(),
-        },
-        title: Some(label.to_string()),
-    }
-}
-
-/// The pictures `solve` adds to the result set (`[output] plots`): a function that draws
-/// them into the staging directory and returns their names.
-pub fn pictures<'a>(
-    outcome: &'a Outcome,
-    options: &'a PlotOptions,
-) -> impl FnMut(&Path, &NodalFields) -> memcontact::Result<Vec<String>> + 'a {
-    move |dir: &Path, fields: &NodalFields| {
-        if options.plots.is_empty() {
-            return Ok(Vec::new());
-        }
-        let mesh = outcome.mesh();
-        let data = PlotData {
-            points: &mesh.points,
-            triangles: &mesh.triangles,
-            u: &fields.u,
-            phi: &fields.phi,
-            state: &fields.state,
-            pressure: &fields.pressure,
-            covered: &fields.covered,
-        };
-        let files = draw_all(dir, &data, options)
-            .map_err(|e| memcontact::Error::Data(format!("pictures: {e}")))?;
-        Ok(files
-            .iter()
-            .filter_map(|f| f.file_name().map(|n| n.to_string_lossy().into_owned()))
-            .collect())
-    }
 }
 
 /// What to do when a solve stopped at the rounding floor above the tolerance.

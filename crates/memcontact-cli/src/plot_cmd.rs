@@ -1,15 +1,17 @@
 //! `memcontact plot DIR`: redraws the pictures of a result directory from its
-//! `solution.vtu` and `summary.json`, with the plot options stored when the case was solved.
+//! `solution.vtu` and `summary.json`, with the plot options stored when the case was solved
+//! (so the files are the same); on a sweep's directory, those of every step.
 
-use anyhow::{Context, Result};
+use anyhow::{bail, Context, Result};
 use memcontact_plot::{draw_all, result, PlotKind};
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 /// Arguments of `memcontact plot`.
 #[derive(clap::Args)]
 pub struct Args {
-    /// The result directory (written by `memcontact solve`).
+    /// The result directory (written by `memcontact solve`), or a sweep's directory (then
+    /// every step's pictures are redrawn).
     pub dir: PathBuf,
     /// The pictures to draw, comma-separated: deflection, pressure, liftoff, profile
     /// (default: those chosen in the case's [output] section).
@@ -17,11 +19,37 @@ pub struct Args {
     pub plots: Option<Vec<String>>,
 }
 
-/// Runs `memcontact plot`.
+/// Runs `memcontact plot`: on a result directory, or on a sweep's (every step directory
+/// that `sweep.csv` lists).
 pub fn run(args: &Args) -> Result<()> {
+    let sweep_csv = args.dir.join("sweep.csv");
+    if !args.dir.join("solution.vtu").exists() && sweep_csv.exists() {
+        let text = std::fs::read_to_string(&sweep_csv)
+            .with_context(|| format!("cannot read {}", sweep_csv.display()))?;
+        let mut any = false;
+        for name in text.lines().skip(1).filter_map(|l| l.split(',').nth(1)) {
+            let step = args.dir.join(name);
+            if step.join("solution.vtu").exists() {
+                redraw(&step, args)?;
+                any = true;
+            }
+        }
+        if !any {
+            bail!(
+                "{} lists no step directory with a solution.vtu",
+                sweep_csv.display()
+            );
+        }
+        return Ok(());
+    }
+    redraw(&args.dir, args)
+}
+
+/// Redraws the pictures of one result directory.
+fn redraw(dir: &Path, args: &Args) -> Result<()> {
     let t0 = Instant::now();
-    let loaded = result::load(&args.dir)
-        .with_context(|| format!("cannot read the results in {}", args.dir.display()))?;
+    let loaded = result::load(dir)
+        .with_context(|| format!("cannot read the results in {}", dir.display()))?;
     for note in &loaded.notes {
         eprintln!("note: {note}");
     }
@@ -37,14 +65,14 @@ pub fn run(args: &Args) -> Result<()> {
         println!("no pictures to draw (the case's [output] plots is empty)");
         return Ok(());
     }
-    let files = draw_all(&args.dir, &loaded.data.view(), &options)?;
+    let files = draw_all(dir, &loaded.data.view(), &options)?;
     let names: Vec<String> = files
         .iter()
         .filter_map(|f| f.file_name().map(|n| n.to_string_lossy().into_owned()))
         .collect();
     println!(
         "wrote {}/{{{}}} in {:.2} s",
-        args.dir.display(),
+        dir.display(),
         names.join(", "),
         t0.elapsed().as_secs_f64()
     );

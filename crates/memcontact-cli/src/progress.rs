@@ -1,6 +1,7 @@
 //! Progress on the terminal: a spinner with the current phase and, while solving, the
-//! iteration and its certificate (hidden when stderr is not a terminal or with --quiet);
-//! with --verbose, one line per iteration instead. The library reports progress through
+//! iteration and its certificate; a bar with its position where the number of steps is
+//! known (sweep steps, refinement levels). Hidden when stderr is not a terminal or with
+//! --quiet; with --verbose, one line per phase and iteration instead. The library reports progress through
 //! its `Observer`; only this module draws.
 
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
@@ -40,15 +41,17 @@ pub struct Progress {
     prefix: String,
 }
 
+/// The spinner: phase, iteration and certificate, no known end.
+const SPINNER: &str = "{spinner} {elapsed:>4} {prefix}{wide_msg}";
+/// The bar, where the number of steps is known (sweep steps, refinement levels).
+const BAR: &str = "{spinner} {elapsed:>4} [{bar:20}] {pos}/{len} {prefix}{wide_msg}";
+
 impl Progress {
     /// A progress display for `verbosity`.
     pub fn new(verbosity: Verbosity) -> Progress {
         let bar = (verbosity == Verbosity::Normal && std::io::stderr().is_terminal()).then(|| {
             let bar = ProgressBar::with_draw_target(None, ProgressDrawTarget::stderr());
-            bar.set_style(
-                ProgressStyle::with_template("{spinner} {elapsed:>4} {prefix}{msg}")
-                    .unwrap_or_else(|_| ProgressStyle::default_spinner()),
-            );
+            bar.set_style(style(SPINNER));
             bar.enable_steady_tick(Duration::from_millis(120));
             bar
         });
@@ -59,11 +62,38 @@ impl Progress {
         }
     }
 
-    /// Sets the prefix of the messages (e.g. `step 3/10: `).
+    /// Sets the prefix of the messages (e.g. `step-003: `).
     pub fn set_prefix(&mut self, prefix: &str) {
         self.prefix = prefix.to_string();
         if let Some(b) = &self.bar {
             b.set_prefix(prefix.to_string());
+        }
+    }
+
+    /// Turns the spinner into a bar of `total` steps, `done` of them done.
+    pub fn steps(&mut self, done: usize, total: usize) {
+        if let Some(b) = &self.bar {
+            if b.length() != Some(total as u64) {
+                b.set_length(total as u64);
+                b.set_style(style(BAR));
+            }
+            b.set_position(done as u64);
+        }
+    }
+
+    /// Sets the message after the prefix.
+    pub fn message(&self, message: &str) {
+        if let Some(b) = &self.bar {
+            b.set_message(message.to_string());
+        }
+    }
+
+    /// Prints a line above the bar (or on stderr when there is none), unless quiet.
+    pub fn line(&self, line: &str) {
+        match (&self.bar, self.verbosity) {
+            (Some(b), _) => b.println(line),
+            (None, Verbosity::Quiet) => {}
+            (None, _) => eprintln!("{line}"),
         }
     }
 
@@ -73,6 +103,13 @@ impl Progress {
             b.finish_and_clear();
         }
     }
+}
+
+/// An indicatif style from a template known to be valid.
+fn style(template: &str) -> ProgressStyle {
+    ProgressStyle::with_template(template)
+        .unwrap_or_else(|_| ProgressStyle::default_spinner())
+        .progress_chars("=> ")
 }
 
 impl Drop for Progress {
@@ -118,7 +155,11 @@ impl Observer for Progress {
     }
 
     fn step_started(&mut self, index: usize, total: usize, name: &str) {
-        self.set_prefix(&format!("step {}/{total} ({name}): ", index + 1));
+        self.steps(index, total);
+        self.set_prefix(&format!("{name}: "));
+        if self.verbosity == Verbosity::Verbose {
+            eprintln!("step {}/{total}: {name}", index + 1);
+        }
     }
 
     fn phase_finished(&mut self, name: &str, seconds: f64) {

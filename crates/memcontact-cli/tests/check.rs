@@ -153,6 +153,73 @@ fn check_refuses_what_solve_refuses() {
             "below",
         ),
         (
+            "profile-off-mesh",
+            with("[output]\nprofile = [[100, 100], [200, 200]]\n"),
+            "output.profile",
+        ),
+        (
+            "sweep-parameter",
+            with("[sweep]\nparameter = \"gravity\"\nvalues = [1, 2]\n"),
+            "gravity",
+        ),
+        (
+            "sweep-values",
+            with("[sweep]\nparameter = \"tension\"\nvalues = [1, -2]\n"),
+            "sweep.values",
+        ),
+        (
+            "sweep-and-load-cases",
+            with(
+                "[sweep]\nparameter = \"load_factor\"\nvalues = [1]\n\
+                 [[load_case]]\nname = \"a\"\n",
+            ),
+            "not both",
+        ),
+        (
+            "load-case-name",
+            with("[[load_case]]\nname = \"../up\"\n"),
+            "load_case.0.name",
+        ),
+        (
+            "load-case-key",
+            with("[[load_case]]\nname = \"a\"\ntension = 2\n"),
+            "tension",
+        ),
+        (
+            "load-case-negative-h",
+            with("[[load_case]]\nname = \"a\"\nstiffness = -1\n"),
+            "load_case.0.stiffness",
+        ),
+        // Errors only the mesh reveals, in a load case: refused before any step is solved
+        // (the first load case is good), naming the load case's key.
+        (
+            "load-case-region",
+            with(
+                "[[load_case]]\nname = \"dead\"\n\
+                 [[load_case]]\nname = \"wet\"\nstiffness = { clay = 5.0 }\n",
+            ),
+            "load_case.1.stiffness",
+        ),
+        (
+            "load-case-expression",
+            with(
+                "[[load_case]]\nname = \"dead\"\n\
+                 [[load_case]]\nname = \"snow\"\nload = \"sqrt(x - 2)\"\n",
+            ),
+            "load_case.1.load",
+        ),
+        // NaN inside the domain only: found by assembling (check assembles every load
+        // case; solve assembles the step, after solving the first).
+        (
+            "load-case-interior-nan",
+            with(
+                "[[load_case]]\nname = \"dead\"\n\
+                 [[load_case]]\nname = \"snow\"\n\
+                 load = \"if(abs(x - 0.5) + abs(y - 0.5) < 0.2, sqrt(-1), 1)\"\n",
+            ),
+            "load_case.1.load f is NaN",
+        ),
+        (
             "missing-mesh",
             GOOD.replace(
                 "generator = \"rectangle\"\nnx = 8",

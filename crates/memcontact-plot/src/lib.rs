@@ -17,7 +17,8 @@
 //! mesh of a million vertices is drawn in a fraction of a second. Also here: the log-log
 //! convergence plot and an x-y line plot (e.g. a force-deflection curve), and a reader for
 //! the VTU files the library writes, so that pictures can be redrawn from a result
-//! directory ([`result`]).
+//! directory ([`result`]), and the writers of result sets with their pictures, single
+//! solves and sweeps alike ([`write`]).
 //!
 //! The crate prints nothing: errors are returned, notes are handed back to the caller.
 
@@ -33,6 +34,7 @@ pub mod result;
 pub mod text;
 pub mod ticks;
 pub mod vtu;
+pub mod write;
 
 pub use axes::{hatch_color, HATCH_SPACING};
 pub use canvas::{Canvas, PixelRect};

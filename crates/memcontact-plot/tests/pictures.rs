@@ -380,3 +380,92 @@ fn manufactured_square_pictures() {
     assert!(d.state.iter().any(|&st| st >= 0), "the case has contact");
     check_case(s);
 }
+
+/// With an allowable pressure, the pressure map shows pressure / allowable and outlines the
+/// area above 1: the outline's pixels lie where the P1 ratio crosses 1 (triangles with
+/// vertices above and at or below the allowable), and every such crossing along a mesh
+/// edge has outline pixels next to it.
+#[test]
+fn allowable_pressure_outlines_the_area_above_one() {
+    let s = common::roof();
+    let d = s.data.view();
+    let opts = PlotOptions {
+        plots: vec![PlotKind::Pressure],
+        ..options(&s)
+    };
+    let allowable = opts
+        .allowable_pressure
+        .expect("the roof has an allowable pressure");
+    let ratio = |v: u32| d.pressure[v as usize] / allowable;
+    let above = d.pressure.iter().filter(|&&p| p > allowable).count();
+    assert!(
+        above > 10 && above < d.pressure.len() / 2,
+        "{above} vertices above the allowable: the case must have both sides"
+    );
+    let pics = render(&d, &opts).unwrap();
+    let p = &pics[0];
+    let (transform, frame) = p.map.unwrap();
+    let layout = MapLayout::new(&d);
+    // The colour bar spans the ratio.
+    let hi = d.pressure.iter().fold(0.0f64, |m, &v| m.max(v)) / allowable;
+    assert_eq!(p.range.map(|r| r.1), Some(hi));
+    let in_text = |x: i32, y: i32| {
+        p.text_boxes
+            .iter()
+            .any(|b| x >= b.x0 - 1 && x < b.x1 + 1 && y >= b.y0 - 1 && y < b.y1 + 1)
+    };
+    let mut line = HashSet::new();
+    let mut crossing = HashSet::new();
+    for y in frame.y0..frame.y1 {
+        for x in frame.x0..frame.x1 {
+            if p.canvas.get(x as u32, y as u32) == [0, 0, 0] && !in_text(x, y) {
+                line.insert((x, y));
+            }
+            if let Some(t) = layout.triangle_at(x, y) {
+                let tri = d.triangles[t as usize];
+                let up = tri.iter().filter(|&&v| ratio(v) > 1.0).count();
+                if up > 0 && up < 3 {
+                    crossing.insert((x, y));
+                }
+            }
+        }
+    }
+    assert!(line.len() > 100, "{} outline pixels", line.len());
+    let near = |set: &HashSet<(i32, i32)>, x: i32, y: i32, r: i32| {
+        (-r..=r).any(|dy| (-r..=r).any(|dx| set.contains(&(x + dx, y + dy))))
+    };
+    let far: Vec<_> = line
+        .iter()
+        .filter(|&&(x, y)| !near(&crossing, x, y, 3))
+        .collect();
+    assert!(
+        far.is_empty(),
+        "outline pixels away from where the ratio crosses 1: {:?}",
+        &far[..far.len().min(5)]
+    );
+    // Where the ratio crosses 1 along a mesh edge, the outline passes.
+    let (mut edges, mut outlined) = (0, 0);
+    for tri in d.triangles {
+        for k in 0..3 {
+            let (v, w) = (tri[k], tri[(k + 1) % 3]);
+            let (rv, rw) = (ratio(v), ratio(w));
+            if (rv > 1.0) == (rw > 1.0) {
+                continue;
+            }
+            let t = (1.0 - rv) / (rw - rv);
+            let (a, b) = (d.points[v as usize], d.points[w as usize]);
+            let q = [a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1])];
+            let (x, y) = transform.pixel_of(q);
+            if in_text(x, y) {
+                continue;
+            }
+            edges += 1;
+            outlined += near(&line, x, y, 2) as usize;
+        }
+    }
+    assert!(edges > 20, "{edges} edges cross the allowable");
+    assert!(
+        outlined as f64 >= 0.95 * edges as f64,
+        "{outlined} of {edges} crossings outlined"
+    );
+}

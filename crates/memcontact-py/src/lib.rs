@@ -1,11 +1,12 @@
 //! The `memcontact` Python module's native part (`memcontact._memcontact`): cases,
-//! meshes as NumPy arrays, solves with the GIL released, results that pickle. The typed
-//! Python package `memcontact` wraps it.
+//! meshes as NumPy arrays, solves and sweeps with the GIL released, results that pickle. The
+//! typed Python package `memcontact` wraps it.
 
 mod case;
 mod convert;
 mod mesh;
 mod result;
+mod sweep;
 
 use case::PyCase;
 use convert::py_err;
@@ -21,16 +22,41 @@ use result::PyResult_;
 use std::collections::HashMap;
 use std::time::Instant;
 
-/// Solves a case end to end (mesh, assembly, solve) with the GIL released. Returns the
-/// result whatever the status; bad data raises `ValueError`.
+/// A case with steps is refused by `solve` (which would solve its base case alone).
+fn refuse_sweep(case: &memcontact::Case) -> PyResult<()> {
+    if !case.is_sweep() {
+        return Ok(());
+    }
+    let what = if case.sweep.is_some() {
+        "a [sweep]"
+    } else {
+        "[[load_case]] entries"
+    };
+    Err(PyValueError::new_err(format!(
+        "the case has {what}: solve would solve only its base case; solve every step with \
+         memcontact.sweep(case)"
+    )))
+}
+
+/// Solves a case end to end (mesh, assembly, checks on the mesh, solve) with the GIL
+/// released. Returns the result whatever the status; bad data raises `ValueError`, and so
+/// does a case with steps (`[sweep]`, `[[load_case]]`: see `sweep`).
 #[pyfunction]
 fn solve(py: Python<'_>, case: PyRef<'_, PyCase>) -> PyResult<PyResult_> {
+    refuse_sweep(&case.case)?;
     let c = case.case.clone();
     let label = case.label.clone();
     drop(case);
     py.detach(move || {
         let started = Instant::now();
-        let outcome = memcontact::run(&c.problem, &c.settings, &mut Silent)?;
+        c.settings.validate().map_err(Invalid::into_error)?;
+        let discretization = Discretization::new(&c.problem, &mut Silent)?;
+        memcontact_plot::write::check_on_mesh(&c, discretization.mesh())?;
+        let report = discretization.solve(&c.settings, &mut Silent)?;
+        let outcome = Outcome {
+            discretization,
+            report,
+        };
         let mesh = PyMesh::new_from(outcome.discretization.hierarchy.clone());
         Ok(PyResult_::new(label, c, mesh, outcome, started))
     })
@@ -48,6 +74,7 @@ fn solve_on(
     case: PyRef<'_, PyCase>,
     nodal: Option<HashMap<String, PyReadonlyArray1<'_, f64>>>,
 ) -> PyResult<PyResult_> {
+    refuse_sweep(&case.case)?;
     let mut c = case.case.clone();
     let label = case.label.clone();
     let mesh = mesh.clone();
@@ -70,6 +97,7 @@ fn solve_on(
         c.settings.validate().map_err(Invalid::into_error)?;
         let discretization =
             Discretization::assemble(&c.problem, (*mesh.hierarchy).clone(), &mut Silent)?;
+        memcontact_plot::write::check_on_mesh(&c, discretization.mesh())?;
         let report = discretization.solve(&c.settings, &mut Silent)?;
         let outcome = Outcome {
             discretization,
@@ -86,7 +114,9 @@ fn _memcontact(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<PyCase>()?;
     m.add_class::<PyMesh>()?;
     m.add_class::<PyResult_>()?;
+    m.add_class::<sweep::PySweep>()?;
     m.add_function(wrap_pyfunction!(solve, m)?)?;
+    m.add_function(wrap_pyfunction!(sweep::sweep, m)?)?;
     m.add_function(wrap_pyfunction!(solve_on, m)?)?;
     m.add_function(wrap_pyfunction!(mesh::rectangle, m)?)?;
     m.add_function(wrap_pyfunction!(mesh::disk, m)?)?;

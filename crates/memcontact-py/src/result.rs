@@ -5,13 +5,14 @@ use crate::case::PyCase;
 use crate::convert::{py_err, to_py};
 use crate::mesh::{hierarchy_from_state, mesh_state, PyMesh};
 use memcontact::model::Certificate;
-use memcontact::output::{input_hash, new_run_id, write_result_set, WriteOptions};
-use memcontact::problem::{PictureKind, VtuFormat};
+use memcontact::output::{input_hash, new_run_id, WriteOptions};
+use memcontact::problem::VtuFormat;
 use memcontact::results::NodalFields;
 use memcontact::run::Phase;
 use memcontact::solve::{Choice, Fallback, IterationRecord, Multipliers, Silent};
+use memcontact::sweep::step_discretization;
 use memcontact::{Case, Discretization, Method, Outcome, Report, Status, Summary};
-use memcontact_plot::{draw_all, PlotData, PlotKind, PlotOptions, Units};
+use memcontact_plot::write::{plot_options, write_result};
 use numpy::{PyArray1, PyReadonlyArray1};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
@@ -39,6 +40,9 @@ pub struct ResultData {
     pub warnings: Vec<String>,
     /// Seconds from the start of the run to the end of the solve.
     pub seconds: f64,
+    /// For a step of a sweep or a load case: its index among the case's steps (the model
+    /// is the step's, not the base case's).
+    pub step: Option<usize>,
 }
 
 /// The result of a solve: the vertex fields as NumPy arrays, the status, the report and
@@ -60,38 +64,79 @@ impl PyResult_ {
         outcome: Outcome,
         started: Instant,
     ) -> PyResult_ {
-        let (fields, totals) = outcome.fields();
-        let quality = outcome.mesh().quality();
-        let mut summary = Summary::new(&label, &outcome, &quality, &totals);
-        summary.run_id = new_run_id();
-        summary.input_hash = input_hash(&case);
         let seconds = started.elapsed().as_secs_f64();
-        summary.time_total_s = seconds;
+        let data = Self::data_of(label, case, mesh, &outcome, seconds, None);
         PyResult_ {
-            data: Arc::new(ResultData {
+            data: Arc::new(data),
+            outcome: Mutex::new(Some(Arc::new(outcome))),
+        }
+    }
+
+    /// The result of step `index` of a sweep of `case`, solved as `outcome` in `seconds`
+    /// (`label` is the step's label). The outcome is not kept: `write` rebuilds the step's
+    /// model on the mesh when it needs it.
+    pub fn of_step(
+        label: String,
+        case: Case,
+        mesh: PyMesh,
+        outcome: &Outcome,
+        seconds: f64,
+        index: usize,
+    ) -> PyResult_ {
+        PyResult_ {
+            data: Arc::new(Self::data_of(
                 label,
                 case,
                 mesh,
-                fields,
-                summary,
-                report: outcome.report.clone(),
-                warnings: outcome.discretization.warnings.clone(),
+                outcome,
                 seconds,
-            }),
-            outcome: Mutex::new(Some(Arc::new(outcome))),
+                Some(index),
+            )),
+            outcome: Mutex::new(None),
+        }
+    }
+
+    /// What a result holds.
+    fn data_of(
+        label: String,
+        case: Case,
+        mesh: PyMesh,
+        outcome: &Outcome,
+        seconds: f64,
+        step: Option<usize>,
+    ) -> ResultData {
+        let (fields, totals) = outcome.fields();
+        let quality = outcome.mesh().quality();
+        let mut summary = Summary::new(&label, outcome, &quality, &totals);
+        summary.run_id = new_run_id();
+        summary.input_hash = input_hash(&case);
+        summary.time_total_s = seconds;
+        ResultData {
+            label,
+            case,
+            mesh,
+            fields,
+            summary,
+            report: outcome.report.clone(),
+            warnings: outcome.discretization.warnings.clone(),
+            seconds,
+            step,
         }
     }
 
     /// The outcome, rebuilt (assembled again on the stored mesh) when the result was
     /// unpickled.
-    fn outcome(&self) -> memcontact::Result<Arc<Outcome>> {
+    pub fn outcome(&self) -> memcontact::Result<Arc<Outcome>> {
         let mut slot = self.outcome.lock().unwrap_or_else(|p| p.into_inner());
         if let Some(o) = slot.as_ref() {
             return Ok(o.clone());
         }
         let d = &self.data;
-        let discretization =
-            Discretization::assemble(&d.case.problem, (*d.mesh.hierarchy).clone(), &mut Silent)?;
+        let hierarchy = (*d.mesh.hierarchy).clone();
+        let discretization = match d.step {
+            Some(index) => step_discretization(&d.case, index, hierarchy, &mut Silent)?,
+            None => Discretization::assemble(&d.case.problem, hierarchy, &mut Silent)?,
+        };
         let o = Arc::new(Outcome {
             discretization,
             report: d.report.clone(),
@@ -135,6 +180,8 @@ struct Meta {
     report: ReportState,
     warnings: Vec<String>,
     seconds: f64,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    step: Option<usize>,
 }
 
 fn phases_out(p: &[Phase]) -> Vec<(String, f64)> {
@@ -271,6 +318,12 @@ impl PyResult_ {
         self.data.warnings.clone()
     }
 
+    /// For a step of a sweep: its index among the case's steps (None for a single solve).
+    #[getter]
+    fn step(&self) -> Option<usize> {
+        self.data.step
+    }
+
     /// Writes the result set the command-line tool writes (`solution.vtu`, `nodes.csv`,
     /// the pictures of the case's `[output] plots` unless `pictures` is false, and
     /// `summary.json`) into `directory`, atomically; `vtu` ("binary" or "ascii") defaults
@@ -285,16 +338,7 @@ impl PyResult_ {
         vtu: Option<&str>,
         pictures: bool,
     ) -> PyResult<Bound<'py, PyAny>> {
-        let vtu = match vtu {
-            None => self.data.case.output.vtu,
-            Some("binary") => VtuFormat::Binary,
-            Some("ascii") => VtuFormat::Ascii,
-            Some(other) => {
-                return Err(PyValueError::new_err(format!(
-                    "vtu: \"{other}\" is unknown (choose binary or ascii)"
-                )))
-            }
-        };
+        let vtu = vtu_format(vtu, &self.data.case)?;
         let summary = py
             .detach(|| {
                 let outcome = self.outcome()?;
@@ -310,30 +354,9 @@ impl PyResult_ {
                     started: now
                         .checked_sub(Duration::from_secs_f64(self.data.seconds))
                         .unwrap_or(now),
-                    plot_options: serde_json::to_value(&plots).ok(),
+                    plot_options: None,
                 };
-                let mesh = outcome.mesh();
-                let mut draw = |dir: &std::path::Path, fields: &NodalFields| {
-                    if plots.plots.is_empty() {
-                        return Ok(Vec::new());
-                    }
-                    let data = PlotData {
-                        points: &mesh.points,
-                        triangles: &mesh.triangles,
-                        u: &fields.u,
-                        phi: &fields.phi,
-                        state: &fields.state,
-                        pressure: &fields.pressure,
-                        covered: &fields.covered,
-                    };
-                    let files = draw_all(dir, &data, &plots)
-                        .map_err(|e| memcontact::Error::Data(format!("pictures: {e}")))?;
-                    Ok(files
-                        .iter()
-                        .filter_map(|f| f.file_name().map(|n| n.to_string_lossy().into_owned()))
-                        .collect())
-                };
-                write_result_set(&directory, &outcome, &self.data.case, &options, &mut draw)
+                write_result(&directory, &outcome, &self.data.case, &options, &plots)
             })
             .map_err(py_err)?;
         to_py(py, &summary)
@@ -379,6 +402,7 @@ impl PyResult_ {
             },
             warnings: d.warnings.clone(),
             seconds: d.seconds,
+            step: d.step,
         };
         let state = PyDict::new(py);
         // TOML, not JSON: it keeps NaN (residuals that were not computed).
@@ -415,28 +439,15 @@ fn vec_bool(a: &Bound<'_, PyAny>) -> PyResult<Vec<bool>> {
     Ok(a.as_array().to_vec())
 }
 
-/// The pictures of `case` as the command-line tool draws them (`[output]`, `[units]`),
-/// titled with `label`.
-fn plot_options(case: &Case, label: &str) -> PlotOptions {
-    PlotOptions {
-        plots: case
-            .output
-            .pictures()
-            .into_iter()
-            .map(|k| match k {
-                PictureKind::Deflection => PlotKind::Deflection,
-                PictureKind::Pressure => PlotKind::Pressure,
-                PictureKind::Liftoff => PlotKind::Liftoff,
-                PictureKind::Profile => PlotKind::Profile,
-            })
-            .collect(),
-        allowable_pressure: case.output.allowable_pressure,
-        profile: case.output.profile,
-        units: Units {
-            length: case.units.length.clone(),
-            force: case.units.force.clone(),
-        },
-        title: Some(label.to_string()),
+/// The encoding of `solution.vtu`: `vtu` ("binary" or "ascii"), or the case's.
+pub fn vtu_format(vtu: Option<&str>, case: &Case) -> PyResult<VtuFormat> {
+    match vtu {
+        None => Ok(case.output.vtu),
+        Some("binary") => Ok(VtuFormat::Binary),
+        Some("ascii") => Ok(VtuFormat::Ascii),
+        Some(other) => Err(PyValueError::new_err(format!(
+            "vtu: \"{other}\" is unknown (choose binary or ascii)"
+        ))),
     }
 }
 
@@ -503,6 +514,7 @@ pub fn _result_from_state(state: &Bound<'_, PyDict>) -> PyResult<PyResult_> {
             report,
             warnings: meta.warnings,
             seconds: meta.seconds,
+            step: meta.step,
         }),
         outcome: Mutex::new(None),
     })

@@ -64,6 +64,41 @@ BAD = [
     ("exact.kind", "foo", "exact", "foo"),
     ("membrane", DELETE, "membrane", "missing"),
     ("material.e", 1.0, "material", "unknown field"),
+    # Pictures: [output] plots, allowable_pressure, profile; [units].
+    ("output.plots", ["contours"], "output.plots", "contours"),
+    ("output.plots", "deflection", "output.plots", "array"),
+    ("output.plots", ["pressure", "pressure"], "output.plots", "twice"),
+    ("output.allowable_pressure", -1.0, "output.allowable_pressure", "> 0"),
+    ("output.allowable_pressure", math.inf, "output.allowable_pressure", "finite"),
+    ("output.allowable_pressure", "high", "output.allowable_pressure", "a number"),
+    ("output.profile", [[0, 0], [0, 0]], "output.profile", "distinct"),
+    ("output.profile", [[0, 0]], "output.profile", "length 2"),
+    ("output.profile", [[0, 0], [1, math.nan]], "output.profile", "finite"),
+    ("units.time", "s", "units.time", "unknown field"),
+    ("units.length", 3, "units.length", "a string"),
+    # Steps: [sweep] and [[load_case]].
+    ("sweep", {"parameter": "gravity", "values": [1]}, "sweep.parameter", "gravity"),
+    ("sweep", {"values": [1.0]}, "sweep", "parameter"),
+    ("sweep", {"parameter": "tension", "values": [1, -1]}, "sweep.values", "tension"),
+    ("sweep", {"parameter": "load_factor", "values": []}, "sweep.values", "empty"),
+    ("sweep", {"parameter": "load_factor", "values": [math.nan]}, "sweep.values", "NaN"),
+    ("sweep", {"parameter": "load_factor", "from": 0, "to": 1}, "sweep", "steps"),
+    (
+        "sweep",
+        {"parameter": "load_factor", "from": 0, "to": 1, "steps": 1},
+        "sweep.steps",
+        "at least 2",
+    ),
+    ("sweep", {"parameter": "load_factor", "values": [1], "step": 2}, "sweep.step", "unknown"),
+    ("load_case", [{"name": "../x"}], "load_case.0.name", "directory"),
+    ("load_case", [{"name": "a"}, {"name": "a"}], "load_case.1.name", "twice"),
+    ("load_case", [{"load": 1.0}], "load_case", "name"),
+    ("load_case", [{"name": "a", "tension": 2.0}], "load_case", "unknown field"),
+    ("load_case", [{"name": "a", "stiffness": -1.0}], "load_case.0.stiffness", "≥ 0"),
+    ("load_case", [{"name": "a", "load": math.nan}], "load_case.0.load", "finite"),
+    ("load_case", [{"name": "a", "load_factor": math.inf}], "load_case.0.load_factor", "finite"),
+    ("load_case", [{"name": "a", "shape": "x +"}], "load_case", "expression"),
+    ("load_case", {"name": "a"}, "load_case", "array"),
 ]
 
 
@@ -95,10 +130,17 @@ def toml_value(v):
 def to_toml(d):
     lines = []
     for section, table in d.items():
-        lines.append(f"[{section}]")
-        for k, v in table.items():
-            lines.append(f"{k} = {toml_value(v)}")
-        lines.append("")
+        # A list of tables is an array of tables: [[section]] per entry.
+        entries = table if isinstance(table, list) else [table]
+        header = f"[[{section}]]" if isinstance(table, list) else f"[{section}]"
+        for entry in entries:
+            if not isinstance(entry, dict):
+                lines.append(f"{section} = {toml_value(table)}")
+                break
+            lines.append(header)
+            for k, v in entry.items():
+                lines.append(f"{k} = {toml_value(v)}")
+            lines.append("")
     return "\n".join(lines)
 
 
@@ -156,6 +198,25 @@ def test_values_python_cannot_put_in_a_case():
 def test_region_tables_are_checked_against_the_mesh():
     case = mc.Case(with_value("obstacle.stiffness", {"clay": 10.0}))
     with pytest.raises(ValueError, match="no region named 'clay'"):
+        mc.solve(case)
+
+
+def test_what_only_the_mesh_reveals_is_refused_before_solving():
+    # A load case's region the mesh lacks: refused before the first step, naming the key.
+    case = mc.Case(
+        with_value("load_case", [{"name": "a"}, {"name": "b", "stiffness": {"clay": 5.0}}])
+    )
+    with pytest.raises(ValueError, match=r"load_case\.1\.stiffness: no region named 'clay'"):
+        mc.sweep(case)
+    # A load case's expression that is NaN inside the domain.
+    case = mc.Case(
+        with_value("load_case", [{"name": "a", "load": "if(r < 0.3, sqrt(-1), 8)"}])
+    )
+    with pytest.raises(ValueError, match=r"load_case\.0\.load f is NaN"):
+        mc.sweep(case)
+    # A profile line that misses the mesh.
+    case = mc.Case(with_value("output.profile", [[10, 10], [20, 20]]))
+    with pytest.raises(ValueError, match=r"output\.profile: the line .* does not cross the mesh"):
         mc.solve(case)
 
 

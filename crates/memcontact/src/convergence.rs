@@ -87,10 +87,10 @@ pub enum Target<'a> {
 pub struct StudySettings {
     /// Refinement levels beyond the base mesh (`K ≥ 1`): `K + 1` levels are solved.
     pub levels: usize,
-    /// The solver settings of every level. With [`Method::Auto`], each level is solved as
-    /// [`solve::solve`] would (multigrid when the hierarchy allows it), except that a level
-    /// where multigrid fails is solved again by the active-set method (the row's `method`
-    /// and `note` say so).
+    /// The solver settings of every level. With [`Method::Auto`], each level is solved by
+    /// the library's one policy ([`solve::attempt`]: multigrid when the hierarchy allows
+    /// it, the active-set method when multigrid does not converge; the row's `method` and
+    /// `note` say so).
     pub solver: Settings,
 }
 
@@ -331,39 +331,33 @@ fn at_level(level: usize, e: Error) -> Error {
     }
 }
 
-/// Solves one level with `settings` on the finest mesh of `hierarchy` (see
-/// [`StudySettings::solver`] for the multigrid fallback of [`Method::Auto`]).
+/// Solves one level with `settings` on the finest mesh of `hierarchy`, by the library's
+/// one policy ([`solve::attempt`]: with [`Method::Auto`], multigrid when the hierarchy
+/// allows it and the active-set method when multigrid does not converge). A status the
+/// settings do not accept is an error; a fallback is returned as a note.
 fn solve_level(
     model: &Model,
     hierarchy: &Hierarchy,
     settings: &Settings,
 ) -> Result<(Solution, Option<String>)> {
-    if settings.method == Method::Auto
-        && solve::auto_method(model, Some(hierarchy)) == Method::Multigrid
-    {
-        let mg = Settings {
-            method: Method::Multigrid,
-            ..settings.clone()
-        };
-        match solve::solve(model, Some(hierarchy), &mg, &mut Silent) {
-            Ok(s) => return Ok((s, None)),
-            Err(e) => {
-                let fallback = Settings {
-                    method: Method::ActiveSet,
-                    ..settings.clone()
-                };
-                let s = solve::solve(model, Some(hierarchy), &fallback, &mut Silent)?;
-                return Ok((
-                    s,
-                    Some(format!("auto: multigrid failed ({e}); active-set used")),
-                ));
-            }
-        }
+    let a = solve::attempt(model, Some(hierarchy), settings, &mut Silent)?;
+    if !a.status.is_accepted(settings) {
+        return Err(solve::not_converged(&a, settings));
     }
-    Ok((
-        solve::solve(model, Some(hierarchy), settings, &mut Silent)?,
-        None,
-    ))
+    let note = a.fallback.as_ref().map(|f| {
+        format!(
+            "auto: {} ended {} at KKT {:.1e}{}; {} used",
+            f.from.name(),
+            f.status.name().replace('_', " "),
+            f.residual,
+            f.message
+                .as_deref()
+                .map(|m| format!(" ({m})"))
+                .unwrap_or_default(),
+            a.solution.method.name()
+        )
+    });
+    Ok((a.solution, note))
 }
 
 /// `[‖e‖_{L²}, |e|_{H¹}, max_i |e_i|]` of the P1 function with vertex values `e` on `mesh`,

@@ -1,7 +1,8 @@
 //! The result files of a run, written as one atomic result set ([`ResultSet`]):
 //! `solution.vtu` (ParaView), `nodes.csv` (one row per vertex), any extra files of the
 //! caller (pictures), and `summary.json` (the [`Summary`], with the run id, the input's hash
-//! and the size and hash of every other file, so a mixed directory is detectable).
+//! and the size and hash of every other file, so a mixed directory is detectable). A sweep
+//! or a set of load cases is one [`SweepSet`]: a directory per step and `sweep.csv`.
 
 use crate::io::csv::write_columns_csv;
 use crate::io::json::write_json;
@@ -11,7 +12,7 @@ use crate::problem::{Case, VtuFormat};
 use crate::results::NodalFields;
 use crate::run::Outcome;
 use crate::summary::{FileRecord, Summary};
-use crate::sweep::StepRow;
+use crate::sweep::{StepRow, StepSpec};
 use crate::{Error, Result};
 use std::path::Path;
 use std::time::Instant;
@@ -160,6 +161,74 @@ pub fn write_result_set(
     let summary = write_files(set.dir(), outcome, case, options, extra)?;
     set.commit()?;
     Ok(summary)
+}
+
+/// The label of a step's results (`summary.json`'s `case`, the pictures' titles):
+/// `label [step-003]` or `label [name of the load case]`.
+pub fn step_label(label: &str, step: &StepSpec) -> String {
+    format!("{label} [{}]", step.name)
+}
+
+/// The result set of a sweep or of load cases, written as one atomic [`ResultSet`]: a
+/// directory per step (`step-000`, … or the load case's name) holding that step's files
+/// ([`write_files`]), then `sweep.csv` (one row per step) and whatever the caller adds
+/// beside it (the force-deflection picture).
+#[derive(Debug)]
+pub struct SweepSet {
+    set: ResultSet,
+    steps: usize,
+}
+
+impl SweepSet {
+    /// Starts the set for directory `target` (see [`ResultSet::begin`]).
+    pub fn begin(target: &Path, force: bool) -> Result<SweepSet> {
+        Ok(SweepSet {
+            set: ResultSet::begin(target, force)?,
+            steps: 0,
+        })
+    }
+
+    /// The staging directory.
+    pub fn dir(&self) -> &Path {
+        self.set.dir()
+    }
+
+    /// The directories written so far.
+    pub fn steps_written(&self) -> usize {
+        self.steps
+    }
+
+    /// Writes the files of `step` (solved as `outcome`) into its directory; `options.label`
+    /// is the step's label ([`step_label`]). Returns the step's summary.
+    pub fn write_step(
+        &mut self,
+        step: &StepSpec,
+        outcome: &Outcome,
+        case: &Case,
+        options: &WriteOptions,
+        extra: &mut dyn FnMut(&Path, &NodalFields) -> Result<Vec<String>>,
+    ) -> Result<Summary> {
+        let dir = self.set.dir().join(&step.name);
+        std::fs::create_dir(&dir).map_err(|source| Error::Io {
+            path: dir.clone(),
+            source,
+        })?;
+        let summary = write_files(&dir, outcome, case, options, extra)?;
+        self.steps += 1;
+        Ok(summary)
+    }
+
+    /// Writes `sweep.csv` of `rows` and what `extra` writes into the set's directory
+    /// (it receives the directory and the rows), then moves the set into place.
+    pub fn commit(
+        self,
+        rows: &[StepRow],
+        extra: &mut dyn FnMut(&Path, &[StepRow]) -> Result<()>,
+    ) -> Result<()> {
+        write_sweep_csv(&self.set.dir().join("sweep.csv"), rows)?;
+        extra(self.set.dir(), rows)?;
+        self.set.commit()
+    }
 }
 
 /// Writes `sweep.csv`: one row per step, with the columns of [`StepRow::HEADER`].

@@ -903,6 +903,12 @@ impl Problem {
 }
 
 impl Case {
+    /// Whether the case has steps to solve in turn (a `[sweep]` or `[[load_case]]`
+    /// entries): then it is run by [`crate::sweep::run_sweep`], not [`crate::run`].
+    pub fn is_sweep(&self) -> bool {
+        self.sweep.is_some() || !self.load_cases.is_empty()
+    }
+
     /// Checks the whole case (problem, settings, output, exact solution) without the mesh.
     pub fn validate(&self) -> std::result::Result<(), Invalid> {
         self.problem.validate()?;
@@ -1089,15 +1095,37 @@ fn line_of(text: &str, at: usize) -> usize {
 
 /// The span of the value of dotted `key` in TOML `text` (the deepest part found).
 fn key_span(text: &str, key: &str) -> Option<std::ops::Range<usize>> {
+    use toml::de::DeValue;
     let doc = toml::de::DeTable::parse(text).ok()?;
     let mut table = doc.get_ref();
     let mut span = None;
-    for part in key.split('.') {
-        let (_, v) = table.iter().find(|(k, _)| k.get_ref().as_ref() == part)?;
+    let mut parts = key.split('.').peekable();
+    'parts: while let Some(part) = parts.next() {
+        let (_, mut v) = table.iter().find(|(k, _)| k.get_ref().as_ref() == part)?;
         span = Some(v.span());
-        match v.get_ref() {
-            toml::de::DeValue::Table(t) => table = t,
-            _ => break,
+        loop {
+            match v.get_ref() {
+                DeValue::Table(t) => {
+                    table = t;
+                    continue 'parts;
+                }
+                // `name.N`: element N of an array (an array of tables: `[[name]]`).
+                DeValue::Array(a) => {
+                    let element = parts
+                        .peek()
+                        .and_then(|p| p.parse::<usize>().ok())
+                        .and_then(|i| a.get(i));
+                    match element {
+                        Some(e) => {
+                            parts.next();
+                            v = e;
+                            span = Some(v.span());
+                        }
+                        None => break 'parts,
+                    }
+                }
+                _ => break 'parts,
+            }
         }
     }
     span
@@ -1186,6 +1214,16 @@ stiffness = 100
         assert!(e.to_string().contains("membrane.load"), "{e}");
         let e = err(&DISK.replace("stiffness = 100", "stiffness = -3"));
         assert!(e.to_string().contains("obstacle.stiffness"), "{e}");
+        // A key inside an array of tables points at its own line.
+        let e = err(&format!(
+            "{DISK}\n[[load_case]]\nname = \"a\"\n\n[[load_case]]\nname = \"b\"\n\
+             stiffness = -4\n"
+        ));
+        let Error::Case { key, line, .. } = &e else {
+            panic!("{e}")
+        };
+        assert_eq!(key, "load_case.1.stiffness");
+        assert_eq!(*line, Some(20), "{e}");
     }
 
     #[test]

@@ -120,11 +120,7 @@ impl Discretization {
     ) -> Result<Discretization> {
         observer.phase_started("assembly");
         let t0 = Instant::now();
-        let mesh = hierarchy.finest();
-        let bound = BoundData::new(problem, mesh)?;
-        check_boundary_data(mesh, &bound)?;
-        let model = Model::assemble(mesh, &bound.data(problem))?;
-        check_overflow(mesh, &model)?;
+        let model = assemble_model(problem, hierarchy.finest())?;
         let seconds = t0.elapsed().as_secs_f64();
         observer.phase_finished("assembly", seconds);
         Ok(Discretization {
@@ -201,6 +197,23 @@ impl Discretization {
             multipliers: s.multipliers,
         })
     }
+}
+
+/// Binds the problem's data to `mesh`, checks it (on the boundary, and for overflow) and
+/// assembles the model S, L, D, φₙ, M of the paper's §2. `problem.mesh` is not used.
+pub fn assemble_model(problem: &Problem, mesh: &Mesh) -> Result<Model> {
+    let bound = bind_and_check(problem, mesh)?;
+    let model = Model::assemble(mesh, &bound.data(problem))?;
+    check_overflow(mesh, &model)?;
+    Ok(model)
+}
+
+/// Binds the problem's data to `mesh` and checks it where assembly does not sample it (on
+/// the boundary): the checks of [`assemble_model`] that need no assembly.
+pub fn bind_and_check(problem: &Problem, mesh: &Mesh) -> Result<BoundData> {
+    let bound = BoundData::new(problem, mesh)?;
+    check_boundary_data(mesh, &bound)?;
+    Ok(bound)
 }
 
 /// Checks the data where assembly does not sample it: f on the boundary vertices (a load

@@ -9,9 +9,11 @@
 //! assembles once on the same mesh.
 
 use crate::field::{Field, Stiffness};
+use crate::mesh::refine::Hierarchy;
+use crate::mesh::Mesh;
 use crate::model::{FoundationMatrix, Model};
 use crate::problem::{Case, Invalid, Problem};
-use crate::run::{Discretization, Outcome};
+use crate::run::{assemble_model, bind_and_check, Discretization, Outcome};
 use crate::solve::Observer;
 use crate::{Error, Result};
 use serde::{Deserialize, Serialize};
@@ -152,8 +154,45 @@ impl LoadCase {
     }
 
     /// Whether the case needs its own assembly (new data, not just a factor).
-    fn assembles(&self) -> bool {
+    pub fn assembles(&self) -> bool {
         self.load.is_some() || self.shape.is_some() || self.stiffness.is_some()
+    }
+
+    /// `text` (a key or a message about the base case's data) with the keys of the data
+    /// this load case overrides renamed to its own: `membrane.load` → `load_case.N.load`,
+    /// `obstacle.shape` → `load_case.N.shape`, `obstacle.stiffness` →
+    /// `load_case.N.stiffness`.
+    fn rename_keys(&self, index: usize, text: &str) -> String {
+        let mut out = text.to_string();
+        for (given, base, own) in [
+            (self.load.is_some(), "membrane.load", "load"),
+            (self.shape.is_some(), "obstacle.shape", "shape"),
+            (self.stiffness.is_some(), "obstacle.stiffness", "stiffness"),
+        ] {
+            if given {
+                out = out.replace(base, &format!("load_case.{index}.{own}"));
+            }
+        }
+        out
+    }
+
+    /// An error about this load case's problem, naming the load case's keys.
+    fn rename_error(&self, index: usize, e: Error) -> Error {
+        match e {
+            Error::Case {
+                file,
+                line,
+                key,
+                message,
+            } => Error::Case {
+                file,
+                line,
+                key: self.rename_keys(index, &key),
+                message: self.rename_keys(index, &message),
+            },
+            Error::Data(m) => Error::Data(self.rename_keys(index, &m)),
+            other => other,
+        }
     }
 }
 
@@ -208,7 +247,27 @@ pub fn validate(case: &Case) -> std::result::Result<(), Invalid> {
         }
         let p = lc.problem(&case.problem);
         p.validate()
-            .map_err(|e| Invalid::new(e.key.replace("membrane.", &key("")), e.message))?;
+            .map_err(|e| Invalid::new(lc.rename_keys(i, &e.key), lc.rename_keys(i, &e.message)))?;
+    }
+    Ok(())
+}
+
+/// Checks the load cases' data on the mesh before any step is solved: binds each load
+/// case's f, φ and h to the mesh's regions (or vertices) and checks them on the boundary;
+/// with `assemble`, also assembles each load case's model (everything its step will
+/// check). Errors name the load case's keys (`load_case.N.stiffness`, ...).
+pub fn check_on_mesh(case: &Case, mesh: &Mesh, assemble: bool) -> Result<()> {
+    for (i, lc) in case.load_cases.iter().enumerate() {
+        if !lc.assembles() {
+            continue;
+        }
+        let p = lc.problem(&case.problem);
+        let checked = if assemble {
+            assemble_model(&p, mesh).map(drop)
+        } else {
+            bind_and_check(&p, mesh).map(drop)
+        };
+        checked.map_err(|e| lc.rename_error(i, e))?;
     }
     Ok(())
 }
@@ -319,6 +378,26 @@ pub struct StepRow {
 }
 
 impl StepRow {
+    /// The row of `step`, solved as `outcome` in `seconds`.
+    pub fn of(step: &StepSpec, outcome: &Outcome, seconds: f64) -> StepRow {
+        let (_, t) = outcome.fields();
+        let r = &outcome.report;
+        StepRow {
+            step: step.index,
+            name: step.name.clone(),
+            value: step.value,
+            max_deflection: t.max_deflection,
+            contact_area: t.contact_area,
+            liftoff_area: t.liftoff_area,
+            total_contact_force: t.total_contact_force,
+            max_pressure: t.max_pressure,
+            energy: r.energy,
+            iterations: r.iterations,
+            kkt_residual: r.certificate.kkt(),
+            seconds,
+        }
+    }
+
     /// The header of `sweep.csv`.
     pub const HEADER: [&'static str; 12] = [
         "step",
@@ -336,12 +415,80 @@ impl StepRow {
     ];
 }
 
+/// The model of `step` of `case` on `mesh`, from the base case's model `base`: the sweep's
+/// parameter applied to it, or the load case's model (assembled when the load case has
+/// data of its own) with its load factor. The observer sees the assembly.
+pub fn step_model(
+    case: &Case,
+    step: &StepSpec,
+    base: &Model,
+    mesh: &Mesh,
+    observer: &mut dyn Observer,
+) -> Result<Model> {
+    if let Some(s) = &case.sweep {
+        return Ok(apply(base, s.parameter, step.value));
+    }
+    let lc = case.load_cases.get(step.index).ok_or_else(|| {
+        Error::Data(format!(
+            "step {} is not one of the {} load cases",
+            step.index,
+            case.load_cases.len()
+        ))
+    })?;
+    let mut m = if lc.assembles() {
+        observer.phase_started("assembly");
+        let t0 = Instant::now();
+        let m = assemble_model(&lc.problem(&case.problem), mesh)
+            .map_err(|e| lc.rename_error(step.index, e))?;
+        observer.phase_finished("assembly", t0.elapsed().as_secs_f64());
+        m
+    } else {
+        base.clone()
+    };
+    scale_load(&mut m, step.value);
+    Ok(m)
+}
+
+/// The discretisation step `index` of `case` was solved on, rebuilt on the mesh levels
+/// `hierarchy` (to write or derive a step's results again without running the sweep).
+pub fn step_discretization(
+    case: &Case,
+    index: usize,
+    hierarchy: Hierarchy,
+    observer: &mut dyn Observer,
+) -> Result<Discretization> {
+    let all = steps(case)?;
+    let step = all.get(index).ok_or_else(|| {
+        Error::Data(format!(
+            "step {index} is not one of the {} steps of the case",
+            all.len()
+        ))
+    })?;
+    let mut d = Discretization::assemble(&case.problem, hierarchy, observer)?;
+    d.model = step_model(case, step, &d.model, d.mesh(), observer)?;
+    Ok(d)
+}
+
 /// Runs the steps of a case's sweep or load cases in turn, each warm-started from the
 /// previous answer (`warm = false`: every step from the usual start). `on_step` receives
 /// each step's outcome (to write it) before the next runs; a step the settings do not
 /// accept ends the sweep with its error after `on_step` has seen it.
 pub fn run_sweep(
     case: &Case,
+    warm: bool,
+    observer: &mut dyn Observer,
+    on_step: &mut dyn FnMut(&StepSpec, &Outcome, &StepRow) -> Result<()>,
+) -> Result<Vec<StepRow>> {
+    let base = Discretization::new(&case.problem, observer)?;
+    run_sweep_on(case, base, warm, observer, on_step)
+}
+
+/// [`run_sweep`] on the base case's discretisation, built (and maybe checked further) by
+/// the caller. Every load case's data is checked on the mesh ([`check_on_mesh`]) before
+/// the first step is solved.
+pub fn run_sweep_on(
+    case: &Case,
+    base: Discretization,
     warm: bool,
     observer: &mut dyn Observer,
     on_step: &mut dyn FnMut(&StepSpec, &Outcome, &StepRow) -> Result<()>,
@@ -355,32 +502,25 @@ pub fn run_sweep(
             message: "the case has no [sweep] and no [[load_case]]".into(),
         });
     }
-    let base = Discretization::new(&case.problem, observer)?;
+    check_on_mesh(case, base.mesh(), false)?;
     let base_model = base.model.clone();
+    let base_phases = base.phases.clone();
     let mut current = base;
     let mut start: Option<Vec<f64>> = None;
     let mut rows = Vec::with_capacity(steps.len());
     for step in &steps {
         observer.step_started(step.index, steps.len(), &step.name);
         let t0 = Instant::now();
-        if let Some(s) = &case.sweep {
-            current.model = apply(&base_model, s.parameter, step.value);
-        } else {
-            let lc = &case.load_cases[step.index];
-            if lc.assembles() {
-                let p = lc.problem(&case.problem);
-                let hierarchy = std::mem::replace(
-                    &mut current.hierarchy,
-                    crate::mesh::refine::Hierarchy {
-                        levels: Vec::new(),
-                        refinements: Vec::new(),
-                    },
-                );
-                current = Discretization::assemble(&p, hierarchy, observer)?;
-            } else {
-                current.model = base_model.clone();
-            }
-            scale_load(&mut current.model, step.value);
+        current.model = step_model(case, step, &base_model, current.mesh(), observer)?;
+        current.phases = base_phases.clone();
+        if case.sweep.is_none() && case.load_cases[step.index].assembles() {
+            // This step assembled its own model: its assembly time replaces the base's.
+            let seconds = t0.elapsed().as_secs_f64();
+            current.phases.retain(|p| p.name != "assembly");
+            current.phases.push(crate::run::Phase {
+                name: "assembly".into(),
+                seconds,
+            });
         }
         let report = current.solve_from(
             &case.settings,
@@ -392,22 +532,7 @@ pub fn run_sweep(
             discretization: current,
             report,
         };
-        let (_, t) = outcome.fields();
-        let r = &outcome.report;
-        let row = StepRow {
-            step: step.index,
-            name: step.name.clone(),
-            value: step.value,
-            max_deflection: t.max_deflection,
-            contact_area: t.contact_area,
-            liftoff_area: t.liftoff_area,
-            total_contact_force: t.total_contact_force,
-            max_pressure: t.max_pressure,
-            energy: r.energy,
-            iterations: r.iterations,
-            kkt_residual: r.certificate.kkt(),
-            seconds,
-        };
+        let row = StepRow::of(step, &outcome, seconds);
         on_step(step, &outcome, &row)?;
         rows.push(row);
         if let Some(e) = outcome.report.error() {
@@ -516,6 +641,61 @@ stiffness = 300
         let e = Case::from_toml_str(&format!("{BASE}[[load_case]]\nname = \"../x\"\n"), None)
             .unwrap_err();
         assert!(e.to_string().contains("load_case.0.name"), "{e}");
+    }
+
+    #[test]
+    fn load_case_errors_name_the_load_case() {
+        let case = |t: &str| Case::from_toml_str(&format!("{BASE}{t}"), None);
+        let e = case("[[load_case]]\nname = \"a\"\nstiffness = -2\n").unwrap_err();
+        assert!(e.to_string().contains("load_case.0.stiffness"), "{e}");
+        let e = case("[[load_case]]\nname = \"a\"\nload = nan\n").unwrap_err();
+        assert!(e.to_string().contains("load_case.0.load"), "{e}");
+        // A region the mesh lacks: found on the mesh, before any step.
+        let c = case(
+            "[[load_case]]\nname = \"a\"\n[[load_case]]\nname = \"b\"\n\
+             shape = { clay = 0.2 }\n",
+        )
+        .unwrap();
+        let d = Discretization::new(&c.problem, &mut Silent).unwrap();
+        for assemble in [false, true] {
+            let e = check_on_mesh(&c, d.mesh(), assemble)
+                .unwrap_err()
+                .to_string();
+            assert!(e.contains("load_case.1.shape") && e.contains("clay"), "{e}");
+        }
+        let mut solved = 0;
+        let e = run_sweep(&c, true, &mut Silent, &mut |_, _, _| {
+            solved += 1;
+            Ok(())
+        })
+        .unwrap_err();
+        assert!(e.to_string().contains("load_case.1.shape"), "{e}");
+        assert_eq!(solved, 0, "no step was solved");
+    }
+
+    #[test]
+    fn a_rebuilt_step_has_the_model_it_was_solved_on() {
+        for steps in [
+            "[sweep]\nparameter = \"obstacle_offset\"\nvalues = [0, -0.05]\n",
+            "[[load_case]]\nname = \"a\"\nload_factor = 2\n\
+             [[load_case]]\nname = \"b\"\nload = \"5 + y\"\nload_factor = 0.5\n",
+        ] {
+            let case = Case::from_toml_str(&format!("{BASE}{steps}"), None).unwrap();
+            let mut models = Vec::new();
+            run_sweep(&case, true, &mut Silent, &mut |_, o, _| {
+                models.push(o.discretization.model.clone());
+                Ok(())
+            })
+            .unwrap();
+            let (hierarchy, _) = case.problem.mesh.build().unwrap();
+            for (k, m) in models.iter().enumerate() {
+                let d = step_discretization(&case, k, hierarchy.clone(), &mut Silent).unwrap();
+                assert_eq!(d.model.d, m.d, "{steps} step {k}: D");
+                assert_eq!(d.model.phi, m.phi, "{steps} step {k}: φ");
+                assert_eq!(d.model.s.val, m.s.val, "{steps} step {k}: S");
+                assert_eq!(d.model.h_vertices, m.h_vertices, "{steps} step {k}: h");
+            }
+        }
     }
 
     #[test]

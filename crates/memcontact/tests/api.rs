@@ -144,6 +144,23 @@ fn every_status_carries_the_iterate_and_its_certificate() {
     );
     assert_eq!(r.certificate, d2.model.certificate(&r.u));
     assert!(r.error().unwrap().to_string().contains("rigid"));
+    // On the same data the interior-point method stops short of its iteration limit (no
+    // more progress), far above the rounding floor: stalled, with its iterate and
+    // certificate.
+    let qp = Settings {
+        method: Method::Qp,
+        ..Settings::default()
+    };
+    let r = d2.solve(&qp, &mut Silent).unwrap();
+    assert_eq!(r.status, Status::Stalled);
+    assert!(r.iterations >= 1 && r.iterations < Method::Qp.default_max_iterations());
+    assert_eq!(r.u.len(), d2.model.n());
+    assert_eq!(r.certificate, d2.model.certificate(&r.u));
+    assert!(r.certificate.kkt() > 1e6 * r.certificate.rounding_floor);
+    assert!(!r.accepted);
+    let e = r.error().unwrap().to_string();
+    assert!(e.contains("stalled after"), "{e}");
+    assert!(e.contains(&format!("{:.3e}", r.certificate.kkt())), "{e}");
 }
 
 #[test]

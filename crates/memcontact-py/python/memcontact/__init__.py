@@ -16,6 +16,10 @@ The same cases as the ``memcontact`` command-line tool, from Python::
     case = mc.load_case("examples/disk.toml", {"mesh.size": 0.1})
     results = mc.solve_many([case, ...], executor=client)   # any concurrent.futures-like
 
+    s = mc.sweep("roof-sweep.toml")   # a case with [sweep] or [[load_case]] entries
+    s.rows                            # the rows of sweep.csv
+    s.write("out/roof-sweep")         # a directory per step, sweep.csv, sweep.png
+
 Solves run with the GIL released. Bad data raises ``ValueError`` naming the key; a solve
 that does not reach its tolerance raises :class:`SolverError`, whose ``result`` holds the
 iterate, its status and its certificate.
@@ -41,7 +45,7 @@ from typing import (
 import numpy as np
 
 from . import _memcontact as _native
-from ._memcontact import Case, Mesh, Result
+from ._memcontact import Case, Mesh, Result, Sweep
 
 __version__: str = _native.__version__
 
@@ -49,6 +53,7 @@ __all__ = [
     "Case",
     "Mesh",
     "Result",
+    "Sweep",
     "SolverError",
     "load_case",
     "rectangle",
@@ -59,6 +64,7 @@ __all__ = [
     "solve",
     "solve_mesh",
     "solve_many",
+    "sweep",
 ]
 
 PathLike = Union[str, "os.PathLike[str]"]
@@ -72,12 +78,15 @@ Point = Tuple[float, float]
 
 class SolverError(RuntimeError):
     """A solve whose outcome the settings do not accept (iteration limit, stall, numerical
-    failure, or the rounding floor when the settings do not allow it). ``result`` is the :class:`Result` with the best iterate, its ``status`` and
-    its certificate (``result.kkt_residual``)."""
+    failure, or the rounding floor when the settings do not allow it). ``result`` is the
+    :class:`Result` with the best iterate, its ``status`` and its certificate
+    (``result.kkt_residual``); for a sweep, ``sweep`` holds the steps solved until then
+    (``result`` is the last of them)."""
 
-    def __init__(self, message: str, result: Result) -> None:
+    def __init__(self, message: str, result: Result, sweep: Optional[Sweep] = None) -> None:
         super().__init__(message, result)
         self.result: Result = result
+        self.sweep: Optional[Sweep] = sweep
 
     def __str__(self) -> str:
         return str(self.args[0])
@@ -219,8 +228,35 @@ def solve(case: CaseLike) -> Result:
     case file) end to end, as ``memcontact solve`` does, with the GIL released.
 
     Raises ``ValueError`` for bad data and :class:`SolverError` (with the result) when the
-    certificate does not reach the tolerance."""
+    certificate does not reach the tolerance. A case with a ``[sweep]`` or
+    ``[[load_case]]`` entries raises ``ValueError``: solve its steps with :func:`sweep`."""
     return _check(_native.solve(_as_case(case)))
+
+
+def sweep(case: CaseLike, warm: bool = True, *, check: bool = True) -> Sweep:
+    """Solves the steps of a case with a ``[sweep]`` (one parameter over a list of values)
+    or ``[[load_case]]`` entries in turn on one mesh, as ``memcontact solve`` does: each
+    step is warm-started from the previous answer (``warm=False``: each from the usual
+    start), with the GIL released.
+
+    Returns a :class:`Sweep`: ``results`` (one :class:`Result` per step), ``rows`` (the
+    rows of ``sweep.csv``: step, name, value, max_deflection, contact_area, liftoff_area,
+    total_contact_force, max_pressure, energy, iterations, kkt_residual, seconds), and
+    ``write(directory)``, which writes the command-line tool's files (a directory per
+    step, ``sweep.csv``, ``sweep.png``).
+
+    Raises ``ValueError`` for bad data (every load case's data is checked on the mesh
+    before the first step is solved). A step the settings do not accept ends the sweep:
+    with ``check`` that raises :class:`SolverError` (its ``sweep`` holds the steps solved,
+    its ``result`` the failed one); ``check=False`` returns the shorter sweep instead."""
+    s = _native.sweep(_as_case(case), bool(warm))
+    results = s.results
+    if results:
+        for note in results[0].warnings:
+            warnings.warn(note, stacklevel=2)
+    if check and not s.accepted:
+        raise SolverError(s.message or "the sweep did not complete", results[-1], s)
+    return s
 
 
 def _solve_any(case: Case) -> Result:

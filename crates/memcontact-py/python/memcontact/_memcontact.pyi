@@ -96,6 +96,10 @@ class Result:
     def case(self) -> Case: ...
     @property
     def warnings(self) -> List[str]: ...
+    @property
+    def step(self) -> Optional[int]:
+        """For a step of a sweep: its index among the case's steps (None otherwise)."""
+        ...
     def write(
         self,
         directory: Union[str, PathLike[str]],
@@ -104,7 +108,60 @@ class Result:
         pictures: bool = True,
     ) -> Dict[str, Any]: ...
 
+class Sweep:
+    """The solved steps of a case's ``[sweep]`` or ``[[load_case]]`` entries."""
+
+    @property
+    def results(self) -> List[Result]:
+        """One result per step solved, in order (the last is the failed step when the
+        sweep stopped early)."""
+        ...
+    @property
+    def rows(self) -> List[Dict[str, Any]]:
+        """The rows of ``sweep.csv`` (keys: the ``columns``), one per step solved."""
+        ...
+    @property
+    def columns(self) -> List[str]:
+        """The columns of ``sweep.csv``, in order."""
+        ...
+    @property
+    def parameter(self) -> str:
+        """``load_factor``, ``stiffness_factor``, ``tension``, ``obstacle_offset`` or
+        ``load_case``."""
+        ...
+    @property
+    def names(self) -> List[str]:
+        """The names of all the case's steps (``step-000``, ... or the load cases')."""
+        ...
+    @property
+    def values(self) -> List[float]:
+        """The values of all the case's steps (a load case's: its load factor)."""
+        ...
+    @property
+    def accepted(self) -> bool:
+        """Whether every step was solved and accepted."""
+        ...
+    @property
+    def message(self) -> Optional[str]:
+        """Why the sweep stopped early (None when it did not)."""
+        ...
+    @property
+    def case(self) -> Case: ...
+    def write(
+        self,
+        directory: Union[str, PathLike[str]],
+        force: bool = False,
+        vtu: Optional[str] = None,
+        pictures: bool = True,
+    ) -> List[Dict[str, Any]]:
+        """Writes the command-line tool's result set (a directory per step, ``sweep.csv``,
+        ``sweep.png``) atomically; returns the steps' summaries."""
+        ...
+    def __len__(self) -> int: ...
+    def __getitem__(self, index: int) -> Result: ...
+
 def solve(case: Case) -> Result: ...
+def sweep(case: Case, warm: bool = True) -> Sweep: ...
 def solve_on(
     mesh: Mesh, case: Case, nodal: Optional[Mapping[str, npt.NDArray[np.float64]]] = None
 ) -> Result: ...

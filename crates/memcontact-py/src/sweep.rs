@@ -1,0 +1,250 @@
+//! `Sweep`: the steps of a case's `[sweep]` or `[[load_case]]` entries, solved in turn on
+//! one mesh (each warm-started from the previous answer), as `memcontact solve` solves
+//! them; its `write` writes the command-line tool's result set.
+
+use crate::case::PyCase;
+use crate::convert::{py_err, to_py};
+use crate::mesh::PyMesh;
+use crate::result::{vtu_format, PyResult_};
+use memcontact::output::step_label;
+use memcontact::solve::Silent;
+use memcontact::sweep::{run_sweep_on, steps, StepRow, StepSpec};
+use memcontact::{Case, Discretization, Error};
+use memcontact_plot::write::{check_on_mesh, SweepWriter};
+use pyo3::exceptions::{PyIndexError, PyValueError};
+use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyList};
+use std::path::PathBuf;
+
+/// The solved steps of a sweep (or of load cases): one `Result` per step, the rows of
+/// `sweep.csv`, and, when a step was not accepted, its message (the sweep stopped there).
+#[pyclass(name = "Sweep", module = "memcontact._memcontact", frozen)]
+pub struct PySweep {
+    label: String,
+    case: Case,
+    steps: Vec<StepSpec>,
+    results: Vec<Py<PyResult_>>,
+    rows: Vec<StepRow>,
+    message: Option<String>,
+}
+
+/// What the solve of a sweep produced, before it becomes Python objects.
+struct Solved {
+    results: Vec<PyResult_>,
+    rows: Vec<StepRow>,
+    message: Option<String>,
+}
+
+/// Solves the steps of `case` in turn (the GIL is released by the caller).
+fn solve_steps(case: &Case, label: &str, warm: bool) -> memcontact::Result<Solved> {
+    if !case.is_sweep() {
+        return Err(Error::Data(
+            "the case has no [sweep] and no [[load_case]] entries: solve it with \
+             memcontact.solve(case)"
+                .into(),
+        ));
+    }
+    let base = Discretization::new(&case.problem, &mut Silent)?;
+    check_on_mesh(case, base.mesh())?;
+    let mesh = PyMesh::new_from(base.hierarchy.clone());
+    let mut results = Vec::new();
+    let mut rows = Vec::new();
+    let mut unaccepted = false;
+    let outcome = run_sweep_on(case, base, warm, &mut Silent, &mut |step, outcome, row| {
+        results.push(PyResult_::of_step(
+            step_label(label, step),
+            case.clone(),
+            mesh.clone(),
+            outcome,
+            row.seconds,
+            step.index,
+        ));
+        rows.push(row.clone());
+        unaccepted = !outcome.report.accepted;
+        Ok(())
+    });
+    let message = match outcome {
+        Ok(_) => None,
+        // A step the settings do not accept ends the sweep: its result is kept.
+        Err(e) if unaccepted => Some(e.to_string()),
+        Err(e) => return Err(e),
+    };
+    Ok(Solved {
+        results,
+        rows,
+        message,
+    })
+}
+
+/// Solves the steps of a case with `[sweep]` or `[[load_case]]` in turn on one mesh, each
+/// warm-started from the previous answer (`warm=False`: each from the usual start), with
+/// the GIL released. A step that is not accepted ends the sweep (its result is the last);
+/// bad data raises `ValueError`.
+#[pyfunction]
+#[pyo3(signature = (case, warm=true))]
+pub fn sweep(py: Python<'_>, case: PyRef<'_, PyCase>, warm: bool) -> PyResult<PySweep> {
+    let c = case.case.clone();
+    let label = case.label.clone();
+    drop(case);
+    let (solved, all_steps, c, label) = py
+        .detach(move || -> memcontact::Result<_> {
+            let solved = solve_steps(&c, &label, warm)?;
+            let all_steps = steps(&c)?;
+            Ok((solved, all_steps, c, label))
+        })
+        .map_err(py_err)?;
+    let results = solved
+        .results
+        .into_iter()
+        .map(|r| Py::new(py, r))
+        .collect::<PyResult<Vec<_>>>()?;
+    Ok(PySweep {
+        label,
+        case: c,
+        steps: all_steps,
+        results,
+        rows: solved.rows,
+        message: solved.message,
+    })
+}
+
+#[pymethods]
+impl PySweep {
+    /// The results of the steps solved, in order (all of them unless a step was not
+    /// accepted: then that step's result is the last).
+    #[getter]
+    fn results<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyList>> {
+        PyList::new(py, self.results.iter().map(|r| r.clone_ref(py)))
+    }
+
+    /// The rows of `sweep.csv` (dicts with its columns, in its order), one per step
+    /// solved.
+    #[getter]
+    fn rows<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyList>> {
+        let list = PyList::empty(py);
+        for r in &self.rows {
+            let value = serde_json::to_value(r)
+                .map_err(|e| PyValueError::new_err(format!("cannot convert a row: {e}")))?;
+            let row = PyDict::new(py);
+            for column in StepRow::HEADER {
+                row.set_item(column, to_py(py, &value[column])?)?;
+            }
+            list.append(row)?;
+        }
+        Ok(list)
+    }
+
+    /// The columns of `sweep.csv`, in order.
+    #[getter]
+    fn columns(&self) -> Vec<&'static str> {
+        StepRow::HEADER.to_vec()
+    }
+
+    /// What varies: the `[sweep]` parameter (`load_factor`, `stiffness_factor`,
+    /// `tension`, `obstacle_offset`), or `load_case`.
+    #[getter]
+    fn parameter(&self) -> &'static str {
+        match &self.case.sweep {
+            Some(s) => s.parameter.name(),
+            None => "load_case",
+        }
+    }
+
+    /// The names of all the case's steps (`step-000`, ... or the load cases' names), which
+    /// are also the directories `write` creates.
+    #[getter]
+    fn names(&self) -> Vec<String> {
+        self.steps.iter().map(|s| s.name.clone()).collect()
+    }
+
+    /// The values of all the case's steps (the swept value, or a load case's load factor).
+    #[getter]
+    fn values(&self) -> Vec<f64> {
+        self.steps.iter().map(|s| s.value).collect()
+    }
+
+    /// Whether every step was solved and accepted.
+    #[getter]
+    fn accepted(&self) -> bool {
+        self.message.is_none() && self.results.len() == self.steps.len()
+    }
+
+    /// Why the sweep stopped early (None when every step was accepted).
+    #[getter]
+    fn message(&self) -> Option<String> {
+        self.message.clone()
+    }
+
+    /// The case swept.
+    #[getter]
+    fn case(&self) -> PyCase {
+        PyCase {
+            case: self.case.clone(),
+            label: self.label.clone(),
+        }
+    }
+
+    /// Writes the result set the command-line tool writes for this case into
+    /// `directory`, atomically: a directory per step solved (`step-000`, ... or the load
+    /// case's name) with `solution.vtu`, `nodes.csv`, the pictures of the case's `[output]
+    /// plots` (unless `pictures` is false) and `summary.json`; then `sweep.csv` and
+    /// `sweep.png`. `vtu` ("binary" or "ascii") defaults to the case's `[output] vtu`. A
+    /// directory holding other files is refused unless `force`. Returns the steps'
+    /// summaries.
+    #[pyo3(signature = (directory, force=false, vtu=None, pictures=true))]
+    fn write<'py>(
+        &self,
+        py: Python<'py>,
+        directory: PathBuf,
+        force: bool,
+        vtu: Option<&str>,
+        pictures: bool,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let vtu = vtu_format(vtu, &self.case)?;
+        let summaries = py
+            .detach(|| -> memcontact::Result<_> {
+                let mut writer =
+                    SweepWriter::begin(&directory, force, &self.case, &self.label, vtu, pictures)?;
+                let mut summaries = Vec::with_capacity(self.results.len());
+                for (result, row) in self.results.iter().zip(&self.rows) {
+                    let outcome = result.get().outcome()?;
+                    let step = &self.steps[row.step];
+                    summaries.push(writer.write_step(&self.case, step, &outcome, row.seconds)?);
+                }
+                writer.finish(&self.rows)?;
+                Ok(summaries)
+            })
+            .map_err(py_err)?;
+        to_py(py, &summaries)
+    }
+
+    fn __len__(&self) -> usize {
+        self.results.len()
+    }
+
+    fn __getitem__(&self, py: Python<'_>, index: isize) -> PyResult<Py<PyResult_>> {
+        let n = self.results.len() as isize;
+        let i = if index < 0 { index + n } else { index };
+        if !(0..n).contains(&i) {
+            return Err(PyIndexError::new_err(format!(
+                "step {index} is not one of the {n} steps solved"
+            )));
+        }
+        Ok(self.results[i as usize].clone_ref(py))
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "Sweep({:?}, {}, {}/{} steps solved{})",
+            self.label,
+            self.parameter(),
+            self.results.len(),
+            self.steps.len(),
+            if self.accepted() {
+                String::new()
+            } else {
+                ", not accepted".to_string()
+            }
+        )
+    }
+}
