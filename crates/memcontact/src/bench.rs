@@ -127,8 +127,14 @@ pub fn run_bench(
             let model = model(hierarchy.finest(), foundation)?;
             let time_assembly = t0.elapsed().as_secs_f64();
             let t0 = Instant::now();
-            let (solution, report) =
-                multigrid::solve_with(&model, multigrid::Coarsening::Geometric(&hierarchy), &settings, options, None, &mut Silent)?;
+            let (solution, report) = multigrid::solve_with(
+                &model,
+                multigrid::Coarsening::Geometric(&hierarchy),
+                &settings,
+                options,
+                None,
+                &mut Silent,
+            )?;
             let time_solve = t0.elapsed().as_secs_f64();
             let (time_poisson, poisson_cycles, poisson_phases) = match &poisson {
                 Some(p) => p.clone(),

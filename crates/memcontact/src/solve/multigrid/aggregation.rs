@@ -132,11 +132,6 @@ fn pairwise(a: &Csr) -> (Vec<u32>, usize) {
         }
         count += 1;
     }
-    if std::env::var("MC_DEBUG").is_ok() {
-        let excluded = agg.iter().filter(|&&g| g == NONE).count();
-        let pairs = n - excluded - count as usize;
-        eprintln!("pairwise n {n}: aggregates {count}, pairs {pairs}, excluded {excluded}");
-    }
     (agg, count as usize)
 }
 

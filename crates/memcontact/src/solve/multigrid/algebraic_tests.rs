@@ -34,7 +34,8 @@ fn site() -> Mesh {
 /// soil 1000) or constant, or rigid (`h = None`).
 fn model(mesh: &Mesh, h: Option<&dyn Coefficient>, foundation: Foundation) -> Model {
     use std::f64::consts::PI;
-    let phi = ByRegion(|p: Point, _| 0.3 + 0.05 * (2.0 * PI * p[0]).sin() * (2.0 * PI * p[1]).cos());
+    let phi =
+        ByRegion(|p: Point, _| 0.3 + 0.05 * (2.0 * PI * p[0]).sin() * (2.0 * PI * p[1]).cos());
     Model::assemble(
         mesh,
         &ProblemData {
@@ -88,7 +89,11 @@ fn agrees_with_active_set(model: &Model, what: &str) -> usize {
     )
     .unwrap();
     assert_eq!(sol.coarsening, Some(Kind::Algebraic));
-    assert!(sol.certificate.kkt() <= 1e-11, "{what}: {:?}", sol.certificate);
+    assert!(
+        sol.certificate.kkt() <= 1e-11,
+        "{what}: {:?}",
+        sol.certificate
+    );
     let reference = active_set::solve(model, &settings(), None, &mut Silent).unwrap();
     let d = rel_diff(&sol.u, &reference.u);
     assert!(d < 1e-8, "{what}: differs from active set by {d:e}");
@@ -183,7 +188,6 @@ fn iteration_counts_stay_bounded_under_refinement() {
                 )
                 .unwrap();
                 assert!(sol.certificate.kkt() <= 1e-11);
-                eprintln!("n {} its {}: {:?}", m.n(), sol.iterations, sol.history.iter().map(|h| (h.residual, h.states.penetrating, h.states.touching)).collect::<Vec<_>>());
                 sol.iterations
             })
             .collect();

@@ -60,11 +60,14 @@ const STALL_LIMIT: usize = 3;
 pub struct Options {
     /// ν₁: nonsmooth Gauss-Seidel sweeps before each Newton correction.
     pub presmoothing: usize,
-    /// Linear V-cycles per Newton correction.
+    /// Multigrid cycles per Newton correction while the vertex states change (flexible CG
+    /// steps preconditioned by the cycle when `krylov_steps > 0`).
     pub cycles: usize,
-    /// Once the vertex states repeat from one iteration to the next, the Newton correction
-    /// is computed by up to this many flexible CG steps preconditioned by the cycle, to a
-    /// quarter of the tolerance (0: one cycle, always).
+    /// Once the vertex states (nearly) repeat from one iteration to the next, up to this
+    /// many flexible CG steps preconditioned by the cycle per Newton correction. The
+    /// correction is inexact Newton: its linear residual is driven below the square of the
+    /// current scaled KKT residual (a quarter of the tolerance at the end). 0: `cycles`
+    /// plain cycles, always.
     pub krylov_steps: usize,
     /// (pre, post) Gauss-Seidel steps per level inside a V-cycle.
     pub smoothing: (usize, usize),
@@ -82,7 +85,7 @@ impl Default for Options {
     fn default() -> Self {
         Options {
             presmoothing: 1,
-            cycles: 1,
+            cycles: 2,
             krylov_steps: 30,
             smoothing: (1, 1),
             nested: true,
@@ -190,10 +193,6 @@ pub fn solve_with(
         Coarsening::Algebraic => Ok(Levels::algebraic(&setup_matrix(model), options.coarsest)),
     })?;
     let top = levels.len() - 1;
-    if std::env::var("MC_DEBUG").is_ok() {
-        let nnz: Vec<usize> = levels.patterns.iter().map(|p| p.nnz()).collect();
-        eprintln!("levels {:?} nnz {:?}", levels.sizes, nnz);
-    }
     let max = settings.max_iterations.unwrap_or(MAX_ITERATIONS);
     let mut report = Report::default();
     let mut history = Vec::new();
@@ -426,10 +425,9 @@ fn level_solve(ls: LevelSolve) -> Result<(usize, f64, Option<Certificate>)> {
         let dirty_rows = prev
             .as_ref()
             .map(|p| mark_dirty(&pattern, p, &st, &mut changed, &mut dirty));
-        // The states are those of the last iteration: the piece of J is likely the
-        // solution's, and an accurate Newton step on it finishes the solve.
-        let frac: usize = std::env::var("MC_FRAC").map(|v| v.parse().unwrap()).unwrap_or(1000);
-        let settled = dirty_rows.is_some_and(|d| if frac == 0 { d == 0 } else { d <= n / frac });
+        // The states are (nearly) those of the last iteration: the piece of J is likely the
+        // solution's, and the Newton step on it is worth computing accurately.
+        let settled = dirty_rows.is_some_and(|d| d <= n / 1000);
         let rows = dirty_rows.map(|_| dirty.as_slice());
         timer.time("newton system", || {
             newton_system(model, v, &st, &mut a, rows, &mut g, &mut r)
@@ -440,25 +438,27 @@ fn level_solve(ls: LevelSolve) -> Result<(usize, f64, Option<Certificate>)> {
                 *x = -*x;
             }
             delta.iter_mut().for_each(|d| *d = 0.0);
-            if settled && options.krylov_steps > 0 {
-                // Solve the Newton system to within a quarter of the tolerance.
-                let target = 0.25 * tolerance * scale;
-                let steps = mg.fcg(
+            if options.krylov_steps > 0 {
+                // Inexact Newton: the linear residual is driven below a forcing term, the
+                // square of the current scaled KKT residual (a quarter of the tolerance at
+                // the end); until the states repeat, a few steps only.
+                let (eta, steps) = if settled {
+                    (
+                        kkt.min(0.5).powi(2).max(0.25 * tolerance),
+                        options.krylov_steps,
+                    )
+                } else {
+                    (0.0, options.cycles)
+                };
+                mg.fcg(
                     &a,
                     &mut delta,
                     &g,
-                    target,
-                    options.krylov_steps,
+                    eta * scale,
+                    steps,
                     &st.truncated,
                     &mut fcg,
                 );
-                if std::env::var("MC_DEBUG").is_ok() {
-                    eprintln!("fcg steps {steps}");
-                }
-            } else if let Ok(k) = std::env::var("MC_UNSETTLED") {
-                let k: usize = k.parse().unwrap();
-                let steps = mg.fcg(&a, &mut delta, &g, 0.0, k, &st.truncated, &mut fcg);
-                let _ = steps;
             } else {
                 for _ in 0..options.cycles {
                     mg.cycle(&a, &mut delta, &g);
