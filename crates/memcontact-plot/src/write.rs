@@ -134,7 +134,8 @@ pub fn write_result(
         plot_options: serde_json::to_value(plots).ok(),
         ..options.clone()
     };
-    let mut draw = pictures(outcome.mesh(), plots);
+    let mesh = outcome.mesh();
+    let mut draw = pictures(&mesh, plots);
     write_result_set(target, outcome, case, &options, &mut draw)
 }
 
@@ -204,7 +205,8 @@ impl SweepWriter {
                 .unwrap_or(now),
             plot_options: serde_json::to_value(&plots).ok(),
         };
-        let mut draw = pictures(outcome.mesh(), &plots);
+        let mesh = outcome.mesh();
+        let mut draw = pictures(&mesh, &plots);
         self.set
             .write_step(step, outcome, case, &options, &mut draw)
     }

@@ -371,6 +371,7 @@ pub fn hierarchy_from_state(state: &Bound<'_, PyAny>) -> PyResult<Hierarchy> {
                 center: [x, y],
                 radius: r,
             }),
+            numbering: None,
         });
     }
     let mut refinements = Vec::new();

@@ -102,7 +102,7 @@ pub fn write_fields(
     vtu_points.push(("covered", DataArray::I32(&covered)));
     write_vtu(
         &dir.join("solution.vtu"),
-        mesh,
+        &mesh,
         &vtu_points,
         &[("region", DataArray::I32(&region))],
         match vtu {
@@ -133,7 +133,8 @@ pub fn write_files(
     write_fields(dir, outcome, &fields, options.vtu)?;
     let mut names = vec!["solution.vtu".to_string(), "nodes.csv".to_string()];
     names.extend(extra(dir, &fields)?);
-    let quality = outcome.mesh().quality();
+    // Order-independent: the mesh in the solver's numbering will do.
+    let quality = outcome.discretization.mesh().quality();
     let mut summary = Summary::new(&options.label, outcome, &quality, &totals);
     summary.run_id = new_run_id();
     summary.input_hash = input_hash(case);

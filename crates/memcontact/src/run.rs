@@ -112,12 +112,19 @@ impl Discretization {
     }
 
     /// Assembles the problem's data on a given mesh hierarchy (the finest level is solved
-    /// on; its coarser levels serve multigrid). `problem.mesh` is not used.
+    /// on; its coarser levels serve multigrid). `problem.mesh` is not used. Levels whose
+    /// numbering is scattered are first renumbered for locality
+    /// ([`crate::mesh::reorder`]); outputs come back in the user's numbering.
     pub fn assemble(
         problem: &Problem,
         hierarchy: Hierarchy,
         observer: &mut dyn Observer,
     ) -> Result<Discretization> {
+        observer.phase_started("reorder");
+        let t0 = Instant::now();
+        let (hierarchy, _) = hierarchy.reordered();
+        let t_reorder = t0.elapsed().as_secs_f64();
+        observer.phase_finished("reorder", t_reorder);
         observer.phase_started("assembly");
         let t0 = Instant::now();
         let model = assemble_model(problem, hierarchy.finest())?;
@@ -127,16 +134,62 @@ impl Discretization {
             hierarchy,
             model,
             warnings: Vec::new(),
-            phases: vec![Phase {
-                name: "assembly".into(),
-                seconds,
-            }],
+            phases: vec![
+                Phase {
+                    name: "reorder".into(),
+                    seconds: t_reorder,
+                },
+                Phase {
+                    name: "assembly".into(),
+                    seconds,
+                },
+            ],
         })
     }
 
-    /// The solved mesh.
+    /// The solved mesh, in the solver's numbering (see [`Mesh::numbering`]).
     pub fn mesh(&self) -> &Mesh {
         self.hierarchy.finest()
+    }
+
+    /// The mesh levels in the user's numbering (the renumbering for locality undone).
+    pub fn user_hierarchy(&self) -> Hierarchy {
+        let levels: Vec<Mesh> = self
+            .hierarchy
+            .levels
+            .iter()
+            .map(|m| m.in_user_numbering().into_owned())
+            .collect();
+        let refinements = self
+            .hierarchy
+            .refinements
+            .iter()
+            .enumerate()
+            .map(|(k, r)| {
+                let (coarse, fine) = (&self.hierarchy.levels[k], &self.hierarchy.levels[k + 1]);
+                let to_user = |v: u32| {
+                    coarse
+                        .numbering
+                        .as_ref()
+                        .map_or(v, |n| n.vertices.old_of_new[v as usize])
+                };
+                let parents = (0..fine.n_vertices() as u32)
+                    .map(|u| {
+                        // User vertex u of the fine level is its vertex `v` here.
+                        let v = fine
+                            .numbering
+                            .as_ref()
+                            .map_or(u, |n| n.vertices.new_of_old[u as usize]);
+                        r.parents[v as usize].map(to_user)
+                    })
+                    .collect();
+                crate::mesh::refine::Refinement { parents }
+            })
+            .collect();
+        Hierarchy {
+            levels,
+            refinements,
+        }
     }
 
     /// The mesh levels multigrid can use (`None` for a single level).
@@ -414,18 +467,30 @@ impl Outcome {
         self.report.status
     }
 
-    /// The solved mesh.
-    pub fn mesh(&self) -> &Mesh {
-        self.discretization.mesh()
+    /// The solved mesh in the user's numbering (the numbering of every output).
+    pub fn mesh(&self) -> std::borrow::Cow<'_, Mesh> {
+        self.discretization.mesh().in_user_numbering()
     }
 
-    /// The vertex fields (u, φ, penetration, pressure, contact forces, states) and totals.
+    /// The vertex fields (u, φ, penetration, pressure, contact forces, states) in the
+    /// user's vertex numbering, and the totals.
     pub fn fields(&self) -> (NodalFields, Totals) {
-        derive_from(
-            self.discretization.mesh(),
-            &self.discretization.model,
-            &self.report.u,
-        )
+        let mesh = self.discretization.mesh();
+        let (f, totals) = derive_from(mesh, &self.discretization.model, &self.report.u);
+        if mesh.numbering.is_none() {
+            return (f, totals);
+        }
+        let user = |x: &[f64]| mesh.vertex_values_to_user(x);
+        let fields = NodalFields {
+            u: user(&f.u),
+            phi: user(&f.phi),
+            penetration: user(&f.penetration),
+            pressure: user(&f.pressure),
+            contact_force: user(&f.contact_force),
+            state: mesh.vertex_values_to_user(&f.state),
+            covered: mesh.vertex_values_to_user(&f.covered),
+        };
+        (fields, totals)
     }
 }
 

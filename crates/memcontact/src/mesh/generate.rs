@@ -219,6 +219,7 @@ fn structured(spec: &RectangleSpec, nx: usize, ny: usize) -> Mesh {
         regions: vec![0; n_tri],
         region_names: BTreeMap::new(),
         curve: None,
+        numbering: None,
     }
 }
 

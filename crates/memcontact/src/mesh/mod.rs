@@ -3,6 +3,7 @@
 
 pub mod generate;
 pub mod refine;
+pub mod reorder;
 
 use crate::{Error, Result};
 use std::collections::{BTreeMap, HashMap};
@@ -24,6 +25,10 @@ pub struct Mesh {
     /// The curved boundary the mesh approximates, if any: refinement moves new boundary
     /// vertices onto it so that Ω_n approaches Ω.
     pub curve: Option<Circle>,
+    /// For a mesh renumbered for locality before assembly: how it was renumbered from the
+    /// mesh the user gave (whose numbering nodal input data and all outputs use); `None`
+    /// for a mesh in the user's own numbering.
+    pub numbering: Option<std::sync::Arc<reorder::Reordering>>,
 }
 
 /// A circle: the boundary of a disc domain.
@@ -158,6 +163,7 @@ impl Mesh {
             regions,
             region_names,
             curve: None,
+            numbering: None,
         };
         mesh.check_vertices()?;
         mesh.check_edges()?;

@@ -221,6 +221,7 @@ pub fn refine_uniform(mesh: &Mesh) -> (Mesh, Refinement) {
         regions,
         region_names: mesh.region_names.clone(),
         curve,
+        numbering: None,
     };
     (fine, Refinement { parents })
 }
