@@ -359,7 +359,7 @@ mod tests {
                 .collect(),
         );
         assert!(
-            n % 7919 != 0,
+            !n.is_multiple_of(7919),
             "7919 is a prime: the scramble is a bijection"
         );
         let user = Reordering {
