@@ -1,5 +1,5 @@
-//! `cargo bench -p memcontact --bench tnnmg [-- N1 N2 ...] [-- --lumped|--consistent]`:
-//! the standard benchmark table of issue 4 (see `memcontact::bench`). Sizes default to
+//! `cargo bench -p memcontact-cli --bench tnnmg [-- N1 N2 ...] [-- --lumped|--consistent]`:
+//! the standard benchmark table of `memcontact bench` (see `memcontact::bench`). Sizes default to
 //! 128 … 2048 cells per side. Environment: `MEMCONTACT_PHASES=1` prints the phases,
 //! `MEMCONTACT_NESTED_TOL`, `MEMCONTACT_CYCLES`, `MEMCONTACT_SMOOTHING`,
 //! `MEMCONTACT_NO_NESTED` override the TNNMG options.
@@ -39,9 +39,9 @@ fn main() {
     } else {
         vec![Foundation::Lumped, Foundation::Consistent]
     };
-    println!("{}", memcontact::bench::table_header());
+    println!("{}", memcontact_cli::bench::square_header());
     let phases = std::env::var_os("MEMCONTACT_PHASES").is_some();
-    let mut print = |r: &BenchRow| println!("{}", memcontact::bench::table_row(r, phases));
+    let mut print = |r: &BenchRow| println!("{}", memcontact_cli::bench::square_row(r, phases));
     let mut options = Options::default();
     if let Some(t) = std::env::var("MEMCONTACT_NESTED_TOL")
         .ok()
