@@ -1,7 +1,7 @@
 //! `memcontact`: the command-line tool. Parses arguments, reads the case, runs the library,
 //! prints a summary and writes the outputs. All the numerics live in the library.
 
-mod bench;
+mod bench_cmd;
 mod commands;
 mod convergence;
 mod examples;
@@ -78,19 +78,43 @@ enum Command {
     /// against the case's [exact] solution, rates, convergence.csv and convergence.png
     /// (or, with --h-sweep, the distance to the rigid limit).
     Convergence(convergence::Args),
-    /// The standard benchmark: TNNMG on the N × N unit square against one
-    /// linear Poisson multigrid solve; prints unknowns, iterations (total and per level),
-    /// mesh / assembly / solve seconds, peak memory and the final KKT certificate.
+    /// Benchmarks (release build recommended). Without --case or --mesh: the standard
+    /// benchmark, TNNMG on the N × N unit square against one linear Poisson multigrid
+    /// solve (unknowns, iterations in total and per level, mesh / assembly / solve
+    /// seconds, peak memory, the final KKT certificate). With --case and/or --mesh: the
+    /// whole run of that case as `solve` does it, phase by phase (reading or generating
+    /// the mesh, renumbering, assembly, the solver's setup and iterations, writing the
+    /// result set to a scratch directory), with iterations, peak memory and certificate.
     Bench {
-        /// Cells per side, comma-separated (release build recommended).
+        /// Cells per side of the standard benchmark, comma-separated.
         #[arg(long, value_delimiter = ',', default_values_t = [128usize, 256, 512, 1024, 2048])]
         sizes: Vec<usize>,
-        /// lumped, consistent or both.
+        /// Standard benchmark: lumped, consistent or both.
         #[arg(long, default_value = "both")]
         foundation: String,
-        /// Also print the time per solver phase.
+        /// Standard benchmark: also print the time per solver phase.
         #[arg(long)]
         phases: bool,
+        /// Benchmark this case file.
+        #[arg(long, value_name = "FILE")]
+        case: Option<PathBuf>,
+        /// Benchmark on this Gmsh mesh (the case's data, or without --case the standard
+        /// benchmark's data: t = 1, f = 20, h = 1000, φ = 0.5 + 0.1 sin 2πx cos 2πy).
+        #[arg(long, value_name = "FILE")]
+        mesh: Option<PathBuf>,
+        /// Override a key of the --case file.
+        #[arg(long = "set", value_name = "KEY=VALUE")]
+        sets: Vec<String>,
+        /// Multigrid levels: auto, geometric, algebraic, or both (each in turn, to compare
+        /// them on a mesh with refinement levels).
+        #[arg(long, default_value = "auto")]
+        hierarchy: String,
+        /// Runs of each configuration (one row each).
+        #[arg(long, default_value_t = 1)]
+        repeat: usize,
+        /// Also draw the pictures when writing.
+        #[arg(long)]
+        pictures: bool,
     },
     /// Redraw the pictures of a result directory (deflection.png, pressure.png,
     /// liftoff.png, profile.png) from its solution.vtu and summary.json, without solving
@@ -147,7 +171,26 @@ fn main() -> ExitCode {
             sizes,
             foundation,
             phases,
-        } => bench::run(&sizes, &foundation, phases),
+            case,
+            mesh,
+            sets,
+            hierarchy,
+            repeat,
+            pictures,
+        } => {
+            if case.is_some() || mesh.is_some() {
+                memcontact_cli::bench::run_case_bench(&memcontact_cli::bench::CaseBench {
+                    case,
+                    mesh,
+                    sets,
+                    hierarchy,
+                    repeat,
+                    pictures,
+                })
+            } else {
+                bench_cmd::run(&sizes, &foundation, phases)
+            }
+        }
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

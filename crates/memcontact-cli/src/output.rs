@@ -159,8 +159,13 @@ pub fn human(label: &str, outcome: &Outcome, written: Option<(&Summary, &Path)>)
     };
     let _ = writeln!(
         o,
-        "  solver       {}{why}: {} iterations, J(U) = {:.12e}, {}",
+        "  solver       {}{}{why}: {} iterations, J(U) = {:.12e}, {}",
         r.method.name(),
+        match r.coarsening {
+            Some(memcontact::solve::multigrid::Kind::Geometric) => " on the mesh levels",
+            Some(memcontact::solve::multigrid::Kind::Algebraic) => " on algebraic levels",
+            None => "",
+        },
         r.iterations,
         r.energy,
         r.status.name().replace('_', " ")

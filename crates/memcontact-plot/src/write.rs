@@ -162,7 +162,8 @@ pub fn write_result(
         plot_options: serde_json::to_value(plots).ok(),
         ..options.clone()
     };
-    let mut draw = pictures(outcome.mesh(), plots);
+    let mesh = outcome.mesh();
+    let mut draw = pictures(&mesh, plots);
     write_result_set(target, outcome, case, &options, &mut draw)
 }
 
@@ -234,7 +235,8 @@ impl SweepWriter {
             // The set's own run id (SweepSet::write_step).
             run_id: None,
         };
-        let mut draw = pictures(outcome.mesh(), &plots);
+        let mesh = outcome.mesh();
+        let mut draw = pictures(&mesh, &plots);
         self.set
             .write_step(step, outcome, case, &options, &mut draw)
     }

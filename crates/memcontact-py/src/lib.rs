@@ -57,7 +57,7 @@ fn solve(py: Python<'_>, case: PyRef<'_, PyCase>) -> PyResult<PyResult_> {
             discretization,
             report,
         };
-        let mesh = PyMesh::new_from(outcome.discretization.hierarchy.clone());
+        let mesh = PyMesh::new_from(outcome.discretization.user_hierarchy());
         Ok(PyResult_::new(label, c, mesh, outcome, started))
     })
     .map_err(py_err)

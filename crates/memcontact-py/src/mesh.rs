@@ -498,6 +498,7 @@ pub fn hierarchy_from_state(state: &Bound<'_, PyAny>) -> PyResult<Hierarchy> {
                 radius: r,
             }),
             boundary: boundary.get(levels.len()).cloned().unwrap_or_default(),
+            numbering: None,
         });
     }
     let mut refinements = Vec::new();

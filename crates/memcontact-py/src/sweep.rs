@@ -46,7 +46,7 @@ fn solve_steps(case: &Case, label: &str, warm: bool) -> memcontact::Result<Solve
     }
     let base = Discretization::new(&case.problem, &mut Silent)?;
     check_on_mesh(case, base.mesh())?;
-    let mesh = PyMesh::new_from(base.hierarchy.clone());
+    let mesh = PyMesh::new_from(base.user_hierarchy());
     let mut results = Vec::new();
     let mut rows = Vec::new();
     let mut unaccepted = false;

@@ -1,4 +1,4 @@
-//! The standard benchmark (issue 4), so that results can be compared with other codes:
+//! The standard benchmark, so that results can be compared with other codes:
 //! Ω = (0,1)², u = 0 on ∂Ω, t = 1, f = 20, h = 1000,
 //! φ(x, y) = 0.5 + 0.1 sin(2πx) cos(2πy), a structured N × N mesh with every square cut
 //! along the diagonal from `(x_i, y_j)` to `(x_{i+1}, y_{j+1})` (the rectangle generator
@@ -133,8 +133,14 @@ pub fn run_bench(
             let model = model(hierarchy.finest(), foundation)?;
             let time_assembly = t0.elapsed().as_secs_f64();
             let t0 = Instant::now();
-            let (solution, report) =
-                multigrid::solve_with(&model, &hierarchy, &settings, options, None, &mut Silent)?;
+            let (solution, report) = multigrid::solve_with(
+                &model,
+                multigrid::Coarsening::Geometric(&hierarchy),
+                &settings,
+                options,
+                None,
+                &mut Silent,
+            )?;
             let time_solve = t0.elapsed().as_secs_f64();
             let (time_poisson, poisson_cycles, poisson_phases) = match &poisson {
                 Some(p) => p.clone(),
@@ -202,59 +208,6 @@ pub fn cpu_seconds() -> Option<f64> {
 /// silently does nothing where that is not possible.
 pub fn reset_peak_memory() {
     let _ = std::fs::write("/proc/self/clear_refs", "5");
-}
-
-/// The header line of the benchmark table (see [`table_row`]).
-pub fn table_header() -> String {
-    format!(
-        "{:>5} {:>10} {:>10} {:>5} {:>24} {:>7} {:>7} {:>7} {:>8} {:>9} {:>8} {:>6} {:>6}",
-        "N",
-        "unknowns",
-        "foundation",
-        "its",
-        "its per level",
-        "mesh",
-        "asm",
-        "solve",
-        "mem MiB",
-        "KKT",
-        "poisson",
-        "cycles",
-        "ratio"
-    )
-}
-
-/// One row of the benchmark table: times in seconds, memory in MiB, `ratio` = solve time
-/// over the Poisson multigrid time; with `phases`, two more lines with the time per phase.
-pub fn table_row(r: &BenchRow, phases: bool) -> String {
-    let levels: Vec<String> = r.level_iterations.iter().map(|i| i.to_string()).collect();
-    let mut s = format!(
-        "{:>5} {:>10} {:>10} {:>5} {:>24} {:>7.3} {:>7.3} {:>7.3} {:>8.0} {:>9.2e} {:>8.3} {:>6} {:>6.2}",
-        r.n,
-        r.unknowns,
-        r.foundation.name(),
-        r.iterations,
-        levels.join(","),
-        r.time_mesh,
-        r.time_assembly,
-        r.time_solve,
-        r.peak_memory.map_or(f64::NAN, |b| b as f64 / 1048576.0),
-        r.certificate,
-        r.time_poisson,
-        r.poisson_cycles,
-        r.time_solve / r.time_poisson
-    );
-    if phases {
-        let f = |p: &[(String, f64)]| {
-            p.iter()
-                .map(|(n, t)| format!("{n} {t:.3}"))
-                .collect::<Vec<_>>()
-                .join(", ")
-        };
-        s.push_str(&format!("\n        tnnmg: {}", f(&r.phases)));
-        s.push_str(&format!("\n        poisson: {}", f(&r.poisson_phases)));
-    }
-    s
 }
 
 #[cfg(test)]

@@ -117,8 +117,8 @@ impl Grid {
 }
 
 impl NodalP1 {
-    /// The interpolant of `values` (one per vertex of `mesh`). `name` names the field in
-    /// errors.
+    /// The interpolant of `values` (one per vertex of `mesh`, in the user's numbering: see
+    /// [`Mesh::numbering`]). `name` names the field in errors.
     pub fn new(name: &str, mesh: &Mesh, values: Arc<[f64]>) -> Result<NodalP1> {
         if values.len() != mesh.n_vertices() {
             return Err(Error::Data(format!(
@@ -134,6 +134,11 @@ impl NodalP1 {
                 values[i]
             )));
         }
+        // The values follow the user's numbering; a renumbered mesh takes them in its own.
+        let values: Arc<[f64]> = match &mesh.numbering {
+            Some(_) => mesh.vertex_values_from_user(&values).into(),
+            None => values,
+        };
         Ok(NodalP1 {
             grid: Grid::new(&mesh.points, &mesh.triangles),
             points: mesh.points.clone(),

@@ -235,12 +235,19 @@ impl Discretization {
     }
 
     /// Assembles the problem's data on a given mesh hierarchy (the finest level is solved
-    /// on; its coarser levels serve multigrid). `problem.mesh` is not used.
+    /// on; its coarser levels serve multigrid). `problem.mesh` is not used. Levels whose
+    /// numbering is scattered are first renumbered for locality
+    /// ([`crate::mesh::reorder`]); outputs come back in the user's numbering.
     pub fn assemble(
         problem: &Problem,
         hierarchy: Hierarchy,
         observer: &mut dyn Observer,
     ) -> Result<Discretization> {
+        observer.phase_started("reorder");
+        let t0 = Instant::now();
+        let (hierarchy, _) = hierarchy.reordered();
+        let t_reorder = t0.elapsed().as_secs_f64();
+        observer.phase_finished("reorder", t_reorder);
         observer.phase_started("assembly");
         let t0 = Instant::now();
         let model = assemble_model(problem, hierarchy.finest())?;
@@ -250,16 +257,62 @@ impl Discretization {
             hierarchy,
             model,
             warnings: Vec::new(),
-            phases: vec![Phase {
-                name: "assembly".into(),
-                seconds,
-            }],
+            phases: vec![
+                Phase {
+                    name: "reorder".into(),
+                    seconds: t_reorder,
+                },
+                Phase {
+                    name: "assembly".into(),
+                    seconds,
+                },
+            ],
         })
     }
 
-    /// The solved mesh.
+    /// The solved mesh, in the solver's numbering (see [`Mesh::numbering`]).
     pub fn mesh(&self) -> &Mesh {
         self.hierarchy.finest()
+    }
+
+    /// The mesh levels in the user's numbering (the renumbering for locality undone).
+    pub fn user_hierarchy(&self) -> Hierarchy {
+        let levels: Vec<Mesh> = self
+            .hierarchy
+            .levels
+            .iter()
+            .map(|m| m.in_user_numbering().into_owned())
+            .collect();
+        let refinements = self
+            .hierarchy
+            .refinements
+            .iter()
+            .enumerate()
+            .map(|(k, r)| {
+                let (coarse, fine) = (&self.hierarchy.levels[k], &self.hierarchy.levels[k + 1]);
+                let to_user = |v: u32| {
+                    coarse
+                        .numbering
+                        .as_ref()
+                        .map_or(v, |n| n.vertices.old_of_new[v as usize])
+                };
+                let parents = (0..fine.n_vertices() as u32)
+                    .map(|u| {
+                        // User vertex u of the fine level is its vertex `v` here.
+                        let v = fine
+                            .numbering
+                            .as_ref()
+                            .map_or(u, |n| n.vertices.new_of_old[u as usize]);
+                        r.parents[v as usize].map(to_user)
+                    })
+                    .collect();
+                crate::mesh::refine::Refinement { parents }
+            })
+            .collect();
+        Hierarchy {
+            levels,
+            refinements,
+        }
     }
 
     /// The mesh levels multigrid can use (`None` for a single level).
@@ -320,7 +373,7 @@ impl Discretization {
         // The fields and totals of the answer (pressures, forces, areas) must be finite
         // too: refused here, before any caller reports or writes them.
         let (fields, totals) = derive_from(self.mesh(), &self.model, &a.solution.u);
-        crate::checks::check_results(self.mesh(), &fields, &totals)?;
+        crate::checks::check_results(&self.mesh(), &fields, &totals)?;
         let seconds = t0.elapsed().as_secs_f64();
         observer.phase_finished("solve", seconds);
         let mut phases = self.phases.clone();
@@ -334,6 +387,7 @@ impl Discretization {
             status: a.status,
             requested: a.requested,
             method: s.method,
+            coarsening: s.coarsening,
             choice: a.choice,
             fallback: a.fallback,
             message: a.message,
@@ -382,6 +436,8 @@ pub struct Report {
     pub requested: Method,
     /// The method that produced the iterate.
     pub method: Method,
+    /// The kind of multigrid hierarchy it ran on (multigrid only).
+    pub coarsening: Option<crate::solve::multigrid::Kind>,
     /// Why that method was used.
     pub choice: Choice,
     /// The method `auto` tried first and gave up on.
@@ -449,6 +505,7 @@ impl Report {
                 .iter()
                 .map(|p| (p.name.clone(), p.seconds))
                 .collect(),
+            coarsening: self.coarsening,
         }
     }
 }
@@ -468,25 +525,45 @@ impl Outcome {
         self.report.status
     }
 
-    /// The solved mesh.
-    pub fn mesh(&self) -> &Mesh {
-        self.discretization.mesh()
+    /// The solved mesh in the user's numbering (the numbering of every output).
+    pub fn mesh(&self) -> std::borrow::Cow<'_, Mesh> {
+        self.discretization.mesh().in_user_numbering()
     }
 
-    /// The vertex fields (u, φ, penetration, pressure, contact forces, states) and totals.
+    /// The vertex fields (u, φ, penetration, pressure, contact forces, states) in the
+    /// user's vertex numbering, and the totals.
     pub fn fields(&self) -> (NodalFields, Totals) {
-        derive_from(
-            self.discretization.mesh(),
-            &self.discretization.model,
-            &self.report.u,
-        )
+        let mesh = self.discretization.mesh();
+        let (f, totals) = derive_from(mesh, &self.discretization.model, &self.report.u);
+        if mesh.numbering.is_none() {
+            return (f, totals);
+        }
+        let user = |x: &[f64]| mesh.vertex_values_to_user(x);
+        let fields = NodalFields {
+            u: user(&f.u),
+            phi: user(&f.phi),
+            penetration: user(&f.penetration),
+            pressure: user(&f.pressure),
+            contact_force: user(&f.contact_force),
+            state: mesh.vertex_values_to_user(&f.state),
+            covered: mesh.vertex_values_to_user(&f.covered),
+            lower: f.lower.as_ref().map(|l| crate::results::LowerFields {
+                phi: user(&l.phi),
+                penetration: user(&l.penetration),
+                pressure: user(&l.pressure),
+                contact_force: user(&l.contact_force),
+                state: mesh.vertex_values_to_user(&l.state),
+                covered: mesh.vertex_values_to_user(&l.covered),
+            }),
+        };
+        (fields, totals)
     }
 
     /// [`Outcome::fields`], refused when a field or total is not a finite number
     /// ([`crate::checks::check_results`]): what result files are written from.
     pub fn checked_fields(&self) -> Result<(NodalFields, Totals)> {
         let (fields, totals) = self.fields();
-        crate::checks::check_results(self.mesh(), &fields, &totals)?;
+        crate::checks::check_results(&self.mesh(), &fields, &totals)?;
         Ok((fields, totals))
     }
 }

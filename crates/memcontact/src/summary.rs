@@ -123,6 +123,10 @@ pub struct Summary {
     pub fallback: Option<Fallback>,
     /// What went wrong, for a numerical failure.
     pub message: Option<String>,
+    /// The multigrid method's coarse levels: `geometric` (the mesh's refinement levels) or
+    /// `algebraic` (aggregation); absent for the other methods.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub hierarchy: Option<crate::solve::multigrid::Kind>,
     /// A random identifier of this run, shared by the files of its result set.
     pub run_id: String,
     /// A hash of the case (XXH3-64 of its canonical JSON), to tell inputs apart.
@@ -248,6 +252,7 @@ impl Summary {
             solver_choice: r.choice,
             fallback: r.fallback.clone(),
             message: r.message.clone(),
+            hierarchy: r.coarsening,
             run_id: String::new(),
             input_hash: String::new(),
             files: BTreeMap::new(),

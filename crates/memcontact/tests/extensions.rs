@@ -6,7 +6,7 @@
 //! admissible set.
 
 use memcontact::run::Discretization;
-use memcontact::solve::{Method, Silent};
+use memcontact::solve::{HierarchyChoice, Method, Silent};
 use memcontact::{Case, Settings};
 
 /// A case from TOML text.
@@ -21,9 +21,20 @@ fn disc(text: &str) -> Discretization {
 
 /// Solves with `method` to `tolerance`; the iterate over all vertices and the report.
 fn solve(d: &Discretization, method: Method, tolerance: f64) -> (Vec<f64>, memcontact::Report) {
+    solve_on(d, method, HierarchyChoice::Auto, tolerance)
+}
+
+/// [`solve`] with the multigrid levels chosen.
+fn solve_on(
+    d: &Discretization,
+    method: Method,
+    hierarchy: HierarchyChoice,
+    tolerance: f64,
+) -> (Vec<f64>, memcontact::Report) {
     let s = Settings {
         method,
         tolerance,
+        hierarchy,
         ..Settings::default()
     };
     let r = d.solve(&s, &mut Silent).unwrap();
@@ -308,12 +319,18 @@ fn agree(name: &str, text: &str) -> (Discretization, memcontact::Report, f64) {
     let (ua, ra) = solve(&d, Method::ActiveSet, 1e-11);
     let scale = ua.iter().fold(0.0f64, |m, x| m.max(x.abs())).max(1e-300);
     let mut worst = 0.0f64;
-    for method in [Method::Qp, Method::Coordinate, Method::Multigrid] {
-        let (u, r) = solve(&d, method, 1e-11);
+    let others = [
+        (Method::Qp, HierarchyChoice::Auto),
+        (Method::Coordinate, HierarchyChoice::Auto),
+        (Method::Multigrid, HierarchyChoice::Auto),
+        (Method::Multigrid, HierarchyChoice::Algebraic),
+    ];
+    for (method, hierarchy) in others {
+        let (u, r) = solve_on(&d, method, hierarchy, 1e-11);
         let c = d.model.certificate(&r.u);
         assert!(
             c.residual_2e <= 1e-9 && c.residual_2f <= 1e-9,
-            "{name} {}: {c:?}",
+            "{name} {} {hierarchy:?}: {c:?}",
             method.name()
         );
         let diff = u
@@ -321,7 +338,11 @@ fn agree(name: &str, text: &str) -> (Discretization, memcontact::Report, f64) {
             .zip(&ua)
             .fold(0.0f64, |m, (x, y)| m.max((x - y).abs()))
             / scale;
-        assert!(diff <= 1e-8, "{name} {}: {diff:e}", method.name());
+        assert!(
+            diff <= 1e-8,
+            "{name} {} {hierarchy:?}: {diff:e}",
+            method.name()
+        );
         assert!(
             (r.energy - ra.energy).abs() <= 1e-9 * ra.energy.abs().max(1e-300),
             "{name} {}",

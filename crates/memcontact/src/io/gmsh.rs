@@ -148,57 +148,55 @@ impl Raw {
                 )));
             }
         }
-        // Tag → file index by sorting (node tags may be sparse and unordered).
-        let mut by_tag: Vec<(u64, u32)> = nodes
-            .iter()
-            .enumerate()
-            .map(|(i, (t, _))| (*t, i as u32))
-            .collect();
-        by_tag.sort_unstable();
-        if let Some(w) = by_tag.windows(2).find(|w| w[0].0 == w[1].0) {
-            return Err(ParseOrMesh::Parse(format!(
-                "$Nodes: node tag {} appears twice",
-                w[0].0
-            )));
-        }
-        let find = |tag: u64| {
-            by_tag
-                .binary_search_by_key(&tag, |e| e.0)
-                .ok()
-                .map(|k| by_tag[k].1)
-        };
+        // Tag → file index: a table when the tags are dense (as Gmsh writes them), else
+        // by sorting (node tags may be sparse and unordered).
+        let lookup = TagLookup::new(&nodes).map_err(ParseOrMesh::Parse)?;
         let mut new_index = vec![u32::MAX; nodes.len()];
+        let resolved: Vec<std::result::Result<[u32; 3], String>> = {
+            use rayon::prelude::*;
+            triangles
+                .par_iter()
+                .with_min_len(8192)
+                .map(|(etag, t, _)| {
+                    let mut out = [0u32; 3];
+                    for (o, &n) in out.iter_mut().zip(t) {
+                        *o = lookup.find(n).ok_or_else(|| {
+                            format!(
+                                "$Elements: triangle {etag} references node {n}, which is not \
+                                 in $Nodes"
+                            )
+                        })?;
+                    }
+                    Ok(out)
+                })
+                .collect()
+        };
         let mut tris = Vec::with_capacity(triangles.len());
-        let mut regions = Vec::with_capacity(triangles.len());
-        for (etag, t, region) in &triangles {
-            let mut out = [0u32; 3];
-            for (o, &n) in out.iter_mut().zip(t) {
-                *o = find(n).ok_or_else(|| {
-                    ParseOrMesh::Parse(format!(
-                        "$Elements: triangle {etag} references node {n}, which is not in $Nodes"
-                    ))
-                })?;
-            }
-            tris.push(out);
-            regions.push(*region);
+        for r in resolved {
+            tris.push(r.map_err(ParseOrMesh::Parse)?);
         }
-        // Keep the used nodes, in file order.
+        let regions: Vec<u32> = triangles.iter().map(|t| t.2).collect();
+        drop(triangles);
+        // Keep the used nodes, in file order (usually all of them: then nothing moves).
         for t in &tris {
             for &v in t {
                 new_index[v as usize] = 0;
             }
         }
-        let mut points = Vec::new();
+        let mut points = Vec::with_capacity(nodes.len());
         for (i, slot) in new_index.iter_mut().enumerate() {
             if *slot == 0 {
                 *slot = points.len() as u32;
                 points.push([nodes[i].1[0], nodes[i].1[1]]);
             }
         }
-        for t in &mut tris {
-            for v in t.iter_mut() {
-                *v = new_index[*v as usize];
-            }
+        if points.len() < nodes.len() {
+            use rayon::prelude::*;
+            tris.par_iter_mut().with_min_len(8192).for_each(|t| {
+                for v in t.iter_mut() {
+                    *v = new_index[*v as usize];
+                }
+            });
         }
         for (&t, &count) in &skipped {
             let name = element_type(t).map_or("unknown type", |e| e.1);
@@ -215,6 +213,60 @@ impl Raw {
         match Mesh::new(points, tris, regions, names) {
             Ok(mesh) => Ok((mesh, warnings)),
             Err(e) => Err(ParseOrMesh::Mesh(e, warnings)),
+        }
+    }
+}
+
+/// Node tag → index in file order.
+enum TagLookup {
+    /// Tags in `[first, first + table.len())`: `table[tag − first]` (`u32::MAX`: none).
+    Dense { first: u64, table: Vec<u32> },
+    /// `(tag, index)` sorted by tag.
+    Sorted(Vec<(u64, u32)>),
+}
+
+impl TagLookup {
+    /// The lookup of `nodes`' tags; a tag given twice is an error.
+    fn new(nodes: &[(u64, [f64; 3])]) -> std::result::Result<TagLookup, String> {
+        let twice = |tag: u64| format!("$Nodes: node tag {tag} appears twice");
+        let (lo, hi) = nodes
+            .iter()
+            .fold((u64::MAX, 0), |(lo, hi), (t, _)| (lo.min(*t), hi.max(*t)));
+        if !nodes.is_empty() && hi - lo < 4 * nodes.len() as u64 {
+            let mut table = vec![u32::MAX; (hi - lo + 1) as usize];
+            for (i, (t, _)) in nodes.iter().enumerate() {
+                let slot = &mut table[(t - lo) as usize];
+                if *slot != u32::MAX {
+                    return Err(twice(*t));
+                }
+                *slot = i as u32;
+            }
+            return Ok(TagLookup::Dense { first: lo, table });
+        }
+        let mut by_tag: Vec<(u64, u32)> = nodes
+            .iter()
+            .enumerate()
+            .map(|(i, (t, _))| (*t, i as u32))
+            .collect();
+        by_tag.sort_unstable();
+        if let Some(w) = by_tag.windows(2).find(|w| w[0].0 == w[1].0) {
+            return Err(twice(w[0].0));
+        }
+        Ok(TagLookup::Sorted(by_tag))
+    }
+
+    /// The file index of node `tag`.
+    fn find(&self, tag: u64) -> Option<u32> {
+        match self {
+            TagLookup::Dense { first, table } => tag
+                .checked_sub(*first)
+                .and_then(|k| table.get(k as usize))
+                .copied()
+                .filter(|&i| i != u32::MAX),
+            TagLookup::Sorted(by_tag) => by_tag
+                .binary_search_by_key(&tag, |e| e.0)
+                .ok()
+                .map(|k| by_tag[k].1),
         }
     }
 }

@@ -220,6 +220,7 @@ fn structured(spec: &RectangleSpec, nx: usize, ny: usize) -> Mesh {
         region_names: BTreeMap::new(),
         curve: None,
         boundary: rectangle_sides(nx, ny),
+        numbering: None,
     }
 }
 

@@ -4,11 +4,12 @@
 pub mod boundary;
 pub mod generate;
 pub mod refine;
+pub mod reorder;
 
 pub use boundary::BoundaryRegions;
 
 use crate::{Error, Result};
-use std::collections::{BTreeMap, HashMap};
+use std::collections::BTreeMap;
 
 /// A point of the plane.
 pub type Point = [f64; 2];
@@ -30,6 +31,10 @@ pub struct Mesh {
     /// Named boundary regions (tagged boundary edges: Gmsh physical curves, generator
     /// sides), for boundary heights and free edges.
     pub boundary: BoundaryRegions,
+    /// For a mesh renumbered for locality before assembly: how it was renumbered from the
+    /// mesh the user gave (whose numbering nodal input data and all outputs use); `None`
+    /// for a mesh in the user's own numbering.
+    pub numbering: Option<std::sync::Arc<reorder::Reordering>>,
 }
 
 /// A circle: the boundary of a disc domain.
@@ -53,9 +58,6 @@ impl Circle {
         [self.center[0] + dx * s, self.center[1] + dy * s]
     }
 }
-
-/// An edge `(a, b)`, `a < b`, with the triangles using it and whether each goes a → b.
-type EdgeUse = (u32, u32, Vec<(usize, bool)>);
 
 /// Geometric quality figures of a mesh (SPEC §2: `l_n`, `s_n`).
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
@@ -124,34 +126,58 @@ impl Mesh {
                 )));
             }
         }
-        // Degenerate and orientation checks.
-        let mut negative = 0usize;
-        for (k, t) in triangles.iter().enumerate() {
-            let a = signed_area(&points, t);
-            let d = diameter(&points, t);
-            if a.abs() <= 1e-12 * d * d {
-                return Err(Error::Mesh(format!(
-                    "triangle {k} (vertices {}, {}, {}) is degenerate: area {a:e}",
-                    t[0], t[1], t[2]
-                )));
-            }
-            if a < 0.0 {
-                negative += 1;
-            }
+        // Degenerate and orientation checks: one parallel pass for the first degenerate
+        // triangle and the number of clockwise ones.
+        use rayon::prelude::*;
+        let (degenerate, negative) = triangles
+            .par_iter()
+            .enumerate()
+            .with_min_len(8192)
+            .fold(
+                || (usize::MAX, 0usize),
+                |(first, neg), (k, t)| {
+                    let a = signed_area(&points, t);
+                    // |2A| ≤ 2e-12 d², d the longest edge (squared lengths, no roots).
+                    let degenerate = a.abs() <= 1e-12 * longest_edge_squared(&points, t);
+                    (
+                        if degenerate { first.min(k) } else { first },
+                        neg + usize::from(a < 0.0),
+                    )
+                },
+            )
+            .reduce(|| (usize::MAX, 0), |x, y| (x.0.min(y.0), x.1 + y.1));
+        if degenerate != usize::MAX {
+            let t = triangles[degenerate];
+            return Err(Error::Mesh(format!(
+                "triangle {degenerate} (vertices {}, {}, {}) is degenerate: area {:e}",
+                t[0],
+                t[1],
+                t[2],
+                signed_area(&points, &t)
+            )));
         }
         if negative == triangles.len() {
-            for t in &mut triangles {
-                t.swap(1, 2);
-            }
+            triangles
+                .par_iter_mut()
+                .with_min_len(8192)
+                .for_each(|t| t.swap(1, 2));
         } else if negative > 0 {
-            let k = triangles
-                .iter()
-                .position(|t| signed_area(&points, t) < 0.0)
-                .unwrap_or(0);
-            let t = triangles[k];
+            // The minority orientation is the inverted one.
+            let inverted_is_negative = 2 * negative <= triangles.len();
+            let (k, t) = triangles
+                .par_iter()
+                .enumerate()
+                .with_min_len(8192)
+                .find_first(|(_, t)| (signed_area(&points, t) < 0.0) == inverted_is_negative)
+                .expect("some triangle has the minority orientation");
+            let count = if inverted_is_negative {
+                negative
+            } else {
+                triangles.len() - negative
+            };
             return Err(Error::Mesh(format!(
                 "triangle {k} (vertices {}, {}, {}) is inverted: its orientation is opposite \
-                 to that of the other triangles ({negative} of {} are inverted)",
+                 to that of the other triangles ({count} of {} are inverted)",
                 t[0],
                 t[1],
                 t[2],
@@ -165,6 +191,7 @@ impl Mesh {
             region_names,
             curve: None,
             boundary: BoundaryRegions::default(),
+            numbering: None,
         };
         mesh.check_vertices()?;
         mesh.check_edges()?;
@@ -173,6 +200,7 @@ impl Mesh {
 
     /// Unused and duplicate vertices are errors.
     fn check_vertices(&self) -> Result<()> {
+        use rayon::prelude::*;
         let mut used = vec![false; self.points.len()];
         for t in &self.triangles {
             for &v in t {
@@ -186,55 +214,98 @@ impl Mesh {
                 self.points[v][0], self.points[v][1]
             )));
         }
-        let mut seen: HashMap<(u64, u64), usize> = HashMap::with_capacity(self.points.len());
-        for (i, p) in self.points.iter().enumerate() {
-            // +0.0 normalises -0.0 so that equal coordinates hash equally.
-            let key = ((p[0] + 0.0).to_bits(), (p[1] + 0.0).to_bits());
-            if let Some(j) = seen.insert(key, i) {
-                return Err(Error::Mesh(format!(
-                    "vertices {j} and {i} are duplicates at ({}, {})",
-                    p[0], p[1]
-                )));
-            }
+        // Duplicates: equal coordinates are neighbours once sorted (+0.0 normalises -0.0).
+        let mut keys: Vec<(u64, u64, u32)> = self
+            .points
+            .par_iter()
+            .enumerate()
+            .with_min_len(8192)
+            .map(|(i, p)| ((p[0] + 0.0).to_bits(), (p[1] + 0.0).to_bits(), i as u32))
+            .collect();
+        keys.par_sort_unstable();
+        let duplicate = keys
+            .par_windows(2)
+            .filter(|w| (w[0].0, w[0].1) == (w[1].0, w[1].1))
+            .map(|w| (w[0].2.min(w[1].2), w[0].2.max(w[1].2)))
+            .min();
+        if let Some((j, i)) = duplicate {
+            let p = self.points[i as usize];
+            return Err(Error::Mesh(format!(
+                "vertices {j} and {i} are duplicates at ({}, {})",
+                p[0], p[1]
+            )));
         }
         Ok(())
     }
 
     /// An edge shared by more than two triangles, or by two triangles that traverse it in
-    /// the same direction (a fold), is an error.
+    /// the same direction (a fold), is an error. With the triangles oriented alike, both
+    /// show as a directed edge `a → b` used twice: the out-edges of every vertex are
+    /// gathered (a counting sort) and checked for repeats, in parallel; the error names the
+    /// smallest offending edge.
     fn check_edges(&self) -> Result<()> {
-        for (a, b, uses) in self.edge_uses() {
-            if uses.len() > 2 {
-                return Err(Error::Mesh(format!(
-                    "edge ({a}, {b}) is non-manifold: shared by triangles {:?}",
-                    uses.iter().map(|u| u.0).collect::<Vec<_>>()
-                )));
-            }
-            if uses.len() == 2 && uses[0].1 == uses[1].1 {
-                return Err(Error::Mesh(format!(
-                    "triangles {} and {} overlap across edge ({a}, {b})",
-                    uses[0].0, uses[1].0
-                )));
+        use rayon::prelude::*;
+        let n = self.points.len();
+        let mut ptr = vec![0u32; n + 1];
+        for t in &self.triangles {
+            for &a in t {
+                ptr[a as usize + 1] += 1;
             }
         }
-        Ok(())
-    }
-
-    /// Every edge `(a, b)` with `a < b` and the triangles using it, each with a flag telling
-    /// whether the triangle traverses it from `a` to `b`.
-    fn edge_uses(&self) -> Vec<EdgeUse> {
-        let mut map: HashMap<(u32, u32), Vec<(usize, bool)>> =
-            HashMap::with_capacity(self.triangles.len() * 2);
+        for i in 0..n {
+            ptr[i + 1] += ptr[i];
+        }
+        // Out-edges a → b of every vertex a, with their triangle: (b, k).
+        let mut fill = ptr.clone();
+        let mut out = vec![(0u32, 0u32); 3 * self.triangles.len()];
         for (k, t) in self.triangles.iter().enumerate() {
             for e in 0..3 {
-                let (a, b) = (t[e], t[(e + 1) % 3]);
-                let key = (a.min(b), a.max(b));
-                map.entry(key).or_default().push((k, a < b));
+                let a = t[e] as usize;
+                out[fill[a] as usize] = (t[(e + 1) % 3], k as u32);
+                fill[a] += 1;
             }
         }
-        let mut v: Vec<_> = map.into_iter().map(|((a, b), u)| (a, b, u)).collect();
-        v.sort_unstable_by_key(|e| (e.0, e.1));
-        v
+        drop(fill);
+        let repeated = (0..n)
+            .into_par_iter()
+            .with_min_len(4096)
+            .filter_map(|a| {
+                let list = &out[ptr[a] as usize..ptr[a + 1] as usize];
+                let mut best: Option<(u32, u32, u32, u32)> = None;
+                for (i, &(b, k)) in list.iter().enumerate() {
+                    if let Some(&(_, k2)) = list[i + 1..].iter().find(|e| e.0 == b) {
+                        let key = (a as u32).min(b);
+                        let cand = (key, (a as u32).max(b), k.min(k2), k.max(k2));
+                        best = Some(best.map_or(cand, |c| c.min(cand)));
+                    }
+                }
+                best
+            })
+            .min();
+        let Some((a, b, k1, k2)) = repeated else {
+            return Ok(());
+        };
+        // All the triangles on the edge: three or more is non-manifold, else a fold.
+        let users: Vec<u32> = [(a, b), (b, a)]
+            .iter()
+            .flat_map(|&(p, q)| {
+                out[ptr[p as usize] as usize..ptr[p as usize + 1] as usize]
+                    .iter()
+                    .filter(move |e| e.0 == q)
+                    .map(|e| e.1)
+            })
+            .collect();
+        if users.len() > 2 {
+            let mut users = users;
+            users.sort_unstable();
+            Err(Error::Mesh(format!(
+                "edge ({a}, {b}) is non-manifold: shared by triangles {users:?}"
+            )))
+        } else {
+            Err(Error::Mesh(format!(
+                "triangles {k1} and {k2} overlap across edge ({a}, {b})"
+            )))
+        }
     }
 
     /// Number of vertices.
@@ -460,9 +531,11 @@ pub fn signed_area(points: &[Point], t: &[u32; 3]) -> f64 {
     0.5 * ((b[0] - a[0]) * (c[1] - a[1]) - (c[0] - a[0]) * (b[1] - a[1]))
 }
 
-fn diameter(points: &[Point], t: &[u32; 3]) -> f64 {
+/// The square of the longest edge of a triangle given by vertex indices.
+fn longest_edge_squared(points: &[Point], t: &[u32; 3]) -> f64 {
     let p = |i: usize| points[t[i] as usize];
-    dist(p(0), p(1)).max(dist(p(1), p(2))).max(dist(p(2), p(0)))
+    let d2 = |a: Point, b: Point| (a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2);
+    d2(p(0), p(1)).max(d2(p(1), p(2))).max(d2(p(2), p(0)))
 }
 
 /// Euclidean distance.

@@ -223,6 +223,7 @@ pub fn refine_uniform(mesh: &Mesh) -> (Mesh, Refinement) {
         region_names: mesh.region_names.clone(),
         curve,
         boundary,
+        numbering: None,
     };
     (fine, Refinement { parents })
 }

@@ -156,5 +156,6 @@ pub fn solve(
         multipliers: None,
         history,
         phases: timer.into_phases(),
+        coarsening: None,
     })
 }

@@ -59,5 +59,6 @@ pub fn solve_from(
         multipliers: None,
         history,
         phases: timer.into_phases(),
+        coarsening: None,
     })
 }

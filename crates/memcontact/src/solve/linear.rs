@@ -29,5 +29,6 @@ pub fn solve(model: &Model, _settings: &Settings) -> Result<Solution> {
         multipliers: None,
         history: vec![],
         phases: timer.into_phases(),
+        coarsening: None,
     })
 }

@@ -97,6 +97,21 @@ pub struct Settings {
     /// Accept a solve whose residual stops at the rounding floor of double precision above
     /// the tolerance (reported as [`Status::RoundingFloor`]); `false` makes it a failure.
     pub accept_rounding_floor: bool,
+    /// The coarse levels of the multigrid method.
+    pub hierarchy: HierarchyChoice,
+}
+
+/// Which coarse levels the multigrid method uses.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum HierarchyChoice {
+    /// The mesh's refinement levels when it has them, an algebraic hierarchy otherwise.
+    #[default]
+    Auto,
+    /// The mesh's refinement levels (an error without them).
+    Geometric,
+    /// An aggregation hierarchy built from the matrices, even when the mesh has levels.
+    Algebraic,
 }
 
 /// Tolerances at or above this certify nothing: a residual of 1 % of the forces.
@@ -137,6 +152,7 @@ impl Default for Settings {
             tolerance: 1e-10,
             max_iterations: None,
             accept_rounding_floor: true,
+            hierarchy: HierarchyChoice::Auto,
         }
     }
 }
@@ -223,6 +239,8 @@ pub struct Solution {
     pub history: Vec<IterationRecord>,
     /// Wall-clock seconds per phase (setup, factorisation, iterations, ...).
     pub phases: Vec<(String, f64)>,
+    /// The kind of hierarchy, for the multigrid method.
+    pub coarsening: Option<multigrid::Kind>,
 }
 
 /// Times phases of a solve.
@@ -307,7 +325,10 @@ pub enum Choice {
     LinearProblem,
     /// `auto`: the mesh has a refinement hierarchy, so geometric multigrid.
     GeometricHierarchy,
-    /// `auto`: no refinement hierarchy, so the active-set method with a direct solver.
+    /// `auto`: no refinement hierarchy, so multigrid on an algebraic hierarchy.
+    AlgebraicHierarchy,
+    /// `auto`: a small problem without a refinement hierarchy, so the active-set method
+    /// with a direct solver.
     NoHierarchy,
 }
 
@@ -318,7 +339,12 @@ impl Choice {
             Choice::Requested => "requested",
             Choice::LinearProblem => "no body can touch the membrane: one linear solve",
             Choice::GeometricHierarchy => "the mesh has a refinement hierarchy: multigrid",
-            Choice::NoHierarchy => "no refinement hierarchy: active-set with a direct solver",
+            Choice::AlgebraicHierarchy => {
+                "no refinement hierarchy: multigrid on an algebraic (aggregation) hierarchy"
+            }
+            Choice::NoHierarchy => {
+                "a small problem without refinement hierarchy: active-set with a direct solver"
+            }
         }
     }
 }
@@ -353,13 +379,21 @@ pub struct Attempt {
     pub message: Option<String>,
 }
 
-/// The one `auto` policy: linear when no body can touch (L = 0), multigrid when the mesh
-/// has a refinement hierarchy, the active-set method otherwise; with the reason.
+/// From this many unknowns on, `auto` solves a mesh without refinement hierarchy by
+/// multigrid on an algebraic hierarchy rather than by the active-set method with its
+/// sparse Cholesky factorisations.
+pub const ALGEBRAIC_FROM: usize = 20_000;
+
+/// The one `auto` policy: linear when no body can touch (L = 0), multigrid on the mesh's
+/// refinement hierarchy when it has one, multigrid on an algebraic hierarchy for a large
+/// mesh without one, the active-set method otherwise; with the reason.
 pub fn auto_choice(model: &Model, hierarchy: Option<&Hierarchy>) -> (Method, Choice) {
     if model.is_linear() {
         (Method::Linear, Choice::LinearProblem)
     } else if hierarchy.is_some_and(|h| h.depth() >= 3) {
         (Method::Multigrid, Choice::GeometricHierarchy)
+    } else if model.n() >= ALGEBRAIC_FROM {
+        (Method::Multigrid, Choice::AlgebraicHierarchy)
     } else {
         (Method::ActiveSet, Choice::NoHierarchy)
     }
@@ -398,14 +432,22 @@ fn run_method(
         Method::Qp => qp::solve(model, settings),
         Method::Coordinate => coordinate::solve_from(model, settings, start, observer),
         Method::Multigrid => {
-            let h = hierarchy.ok_or_else(|| Error::Solver {
-                solver: "multigrid".into(),
-                message: "the mesh has no refinement hierarchy: set mesh.refine > 0, use the \
-                          rectangle generator with nx, ny divisible by a power of two, or \
-                          choose method = \"active-set\""
-                    .into(),
-            })?;
-            multigrid::solve(model, h, settings, start, observer)
+            let coarsening = match (settings.hierarchy, hierarchy) {
+                (HierarchyChoice::Algebraic, _) | (HierarchyChoice::Auto, None) => {
+                    multigrid::Coarsening::Algebraic
+                }
+                (_, Some(h)) => multigrid::Coarsening::Geometric(h),
+                (HierarchyChoice::Geometric, None) => {
+                    return Err(Error::Solver {
+                        solver: "multigrid".into(),
+                        message: "the mesh has no refinement hierarchy: set mesh.refine > 0, \
+                                  use the rectangle generator with nx, ny divisible by a \
+                                  power of two, or choose hierarchy = \"algebraic\""
+                            .into(),
+                    })
+                }
+            };
+            multigrid::solve(model, coarsening, settings, start, observer)
         }
         Method::Auto => unreachable!("resolved by the caller"),
     };
@@ -466,6 +508,7 @@ fn run_method(
                 multipliers: None,
                 history: Vec::new(),
                 phases: Vec::new(),
+                coarsening: None,
             };
             Ok((solution, status, message))
         }

@@ -202,6 +202,7 @@ pub fn solve_with_report(model: &Model, settings: &Settings) -> Result<QpReport>
         multipliers: Some(multipliers),
         history: vec![],
         phases: timer.into_phases(),
+        coarsening: None,
     };
     Ok(QpReport {
         solution,

@@ -22,11 +22,27 @@ use crate::sparse::{Cholesky, Csr, Pattern};
 use crate::{Error, Result};
 use std::sync::Arc;
 
-/// The static structure of a multigrid hierarchy over unknowns: per level its dof map and
-/// operator pattern, and the prolongations. Built once per hierarchy.
+/// Where the coarse levels of a multigrid come from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Kind {
+    /// Nested meshes of uniform refinement (the exact P1 prolongation).
+    Geometric,
+    /// Aggregation of the matrix's unknowns ([`super::aggregation`]).
+    Algebraic,
+}
+
+/// The static structure of a multigrid hierarchy over unknowns: per level its size and
+/// operator pattern (and, for a geometric hierarchy, its dof map), and the prolongations.
+/// Built once per hierarchy.
 #[derive(Debug, Clone)]
 pub struct Levels {
-    /// Unknowns of every level, coarsest first (levels without unknowns are left out).
+    /// Geometric or algebraic.
+    pub kind: Kind,
+    /// Unknowns of every level, coarsest first.
+    pub sizes: Vec<usize>,
+    /// Geometric hierarchies: the unknowns of every level's mesh, coarsest first (levels
+    /// without unknowns are left out). Empty for an algebraic hierarchy.
     pub dofs: Vec<DofMap>,
     /// Operator patterns, coarsest first; the finest is the pattern of S.
     pub patterns: Vec<Arc<Pattern>>,
@@ -80,25 +96,41 @@ impl Levels {
         let dofs: Vec<DofMap> = dofs.into_iter().skip(first).collect();
         let patterns = galerkin_patterns(&transfers, pattern);
         Ok(Levels {
+            kind: Kind::Geometric,
+            sizes: dofs.iter().map(DofMap::len).collect(),
             dofs,
             patterns,
             transfers,
         })
     }
 
+    /// An algebraic hierarchy for the operator `a` (the finest level; its pattern is the
+    /// finest pattern) by double pairwise aggregation, down to about `coarsest` unknowns.
+    pub fn algebraic(a: &Csr, coarsest: usize) -> Levels {
+        let (transfers, sizes) = super::aggregation::hierarchy(a, coarsest);
+        let patterns = galerkin_patterns(&transfers, a.pattern.clone());
+        Levels {
+            kind: Kind::Algebraic,
+            sizes,
+            dofs: Vec::new(),
+            patterns,
+            transfers,
+        }
+    }
+
     /// Number of levels.
     pub fn len(&self) -> usize {
-        self.dofs.len()
+        self.sizes.len()
     }
 
     /// `true` when there is no level (never, after [`Levels::new`]).
     pub fn is_empty(&self) -> bool {
-        self.dofs.is_empty()
+        self.sizes.is_empty()
     }
 
     /// Number of unknowns of level `k`.
     pub fn n(&self, k: usize) -> usize {
-        self.dofs[k].len()
+        self.sizes[k]
     }
 }
 
@@ -197,6 +229,9 @@ pub struct Multigrid<'a> {
     chol: Option<Cholesky>,
     /// Pre- and post-smoothing steps per level.
     pub smoothing: (usize, usize),
+    /// Work vectors of the K-cycle's Krylov steps per level (`[rc, v1, w1, v2]`; empty on
+    /// geometric hierarchies, which use the V-cycle).
+    krylov: Vec<[Vec<f64>; 4]>,
 }
 
 impl<'a> Multigrid<'a> {
@@ -227,6 +262,192 @@ impl<'a> Multigrid<'a> {
             coarsest: Csr::zeros(levels.patterns[0].clone()),
             chol: None,
             smoothing: (1, 1),
+            krylov: (0..top)
+                .map(|k| {
+                    if levels.kind == Kind::Algebraic && k > 0 {
+                        [zeros(k), zeros(k), zeros(k), zeros(k)]
+                    } else {
+                        Default::default()
+                    }
+                })
+                .collect(),
+        }
+    }
+
+    /// Flexible conjugate gradients (FCG(1): each direction A-orthogonal to the previous
+    /// one, so that a preconditioner that varies from step to step is allowed) for
+    /// `A x = b` on the top level from `x = 0`, preconditioned by one [`Multigrid::cycle`]
+    /// per step, until `‖b − A x‖∞ ≤ target` or `max_steps` steps; rows flagged in `held`
+    /// (zero rows of A) stay 0. Returns the steps done. Every step lowers the quadratic
+    /// `½xᵀAx − bᵀx`, so `x` is a descent direction of it from the first step on.
+    #[allow(clippy::too_many_arguments)]
+    pub fn fcg(
+        &mut self,
+        a: &Csr,
+        x: &mut [f64],
+        b: &[f64],
+        target: f64,
+        max_steps: usize,
+        held: &[bool],
+        work: &mut FcgWork,
+    ) -> usize {
+        let n = x.len();
+        work.resize(n);
+        let FcgWork { r, z, w, p, ap } = work;
+        x.iter_mut().for_each(|v| *v = 0.0);
+        r.copy_from_slice(b);
+        let mut pap_prev = 0.0;
+        let mut steps = 0;
+        while steps < max_steps {
+            z.iter_mut().for_each(|v| *v = 0.0);
+            self.cycle(a, z, r);
+            par_rows(z, |i, v| {
+                if held[i] || !v.is_finite() {
+                    *v = 0.0
+                }
+            });
+            a.mul_into(z, w);
+            if steps == 0 {
+                p.copy_from_slice(z);
+                ap.copy_from_slice(w);
+            } else {
+                let beta = -det_dot(z, ap) / pap_prev;
+                par_rows(p, |i, v| *v = z[i] + beta * *v);
+                par_rows(ap, |i, v| *v = w[i] + beta * *v);
+            }
+            let pap = det_dot(p, ap);
+            if !(pap > 0.0 && pap.is_finite()) {
+                break;
+            }
+            let alpha = det_dot(p, r) / pap;
+            par_rows(x, |i, v| *v += alpha * p[i]);
+            par_rows(r, |i, v| *v -= alpha * ap[i]);
+            pap_prev = pap;
+            steps += 1;
+            if crate::sparse::norm_inf(r) <= target {
+                break;
+            }
+        }
+        steps
+    }
+
+    /// One cycle for `A x = b` on the top level: the V-cycle on a geometric hierarchy, the
+    /// K-cycle on an algebraic one (see [`Multigrid::v_cycle`], [`Multigrid::k_cycle`]).
+    pub fn cycle(&mut self, fine: &Csr, x: &mut [f64], b: &[f64]) {
+        match self.levels.kind {
+            Kind::Geometric => self.v_cycle(fine, x, b),
+            Kind::Algebraic => self.k_cycle(fine, x, b),
+        }
+    }
+
+    /// One K-cycle (Y. Notay, P. S. Vassilevski, "Recursive Krylov-based multigrid
+    /// cycles", Numer. Linear Algebra Appl. 15 (2008)) for `A x = b` on the top level,
+    /// improving `x` in place: Gauss-Seidel before and after the coarse correction, as in
+    /// the V-cycle, but the correction on every coarse level but the coarsest is computed
+    /// by two steps of flexible conjugate gradients preconditioned by the cycle on the
+    /// next level (one step when it already reduces the residual by 4). With the
+    /// piecewise-constant prolongation of aggregation, the V-cycle's convergence degrades
+    /// with every level; the K-cycle's does not. Zero rows of A leave their x unchanged.
+    pub fn k_cycle(&mut self, fine: &Csr, x: &mut [f64], b: &[f64]) {
+        let top = self.top;
+        if top == 0 {
+            return self.v_cycle(fine, x, b);
+        }
+        let (nu1, nu2) = self.smoothing;
+        for _ in 0..nu1 {
+            gauss_seidel(fine, &self.inv_diag[top], x, b, &mut self.snap[top], false);
+        }
+        residual(fine, x, b, &mut self.r[top]);
+        self.levels.transfers[top - 1].restrict(&self.r[top], &mut self.b[top - 1]);
+        self.krylov_correction(top - 1);
+        self.levels.transfers[top - 1].prolongate_add(&self.x[top - 1], x);
+        for _ in 0..nu2 {
+            gauss_seidel(fine, &self.inv_diag[top], x, b, &mut self.snap[top], true);
+        }
+    }
+
+    /// `x[k] ≈ A_k⁻¹ b[k]` for a coarse level `k < top`: the direct solve on level 0, else
+    /// two flexible CG steps preconditioned by [`Multigrid::coarse_k_cycle`].
+    fn krylov_correction(&mut self, k: usize) {
+        if k == 0 {
+            self.solve_coarsest_in_place(Some(0));
+            return;
+        }
+        /// Accept one step when it reduces the residual's norm by this factor.
+        const ONE_STEP: f64 = 0.25;
+        self.krylov[k][0].copy_from_slice(&self.b[k]);
+        self.coarse_k_cycle(k);
+        let a = &self.coarse[k];
+        let [rc, v1, w1, _] = &mut self.krylov[k];
+        v1.copy_from_slice(&self.x[k]);
+        a.mul_into(v1, w1);
+        let rho1 = det_dot(v1, w1);
+        let alpha1 = det_dot(v1, rc);
+        if !(rho1 > 0.0 && rho1.is_finite()) {
+            self.x[k].iter_mut().for_each(|v| *v = 0.0);
+            return;
+        }
+        // r̃ = rc − (α₁/ρ₁) w₁, into b[k] (the right-hand side of the second cycle).
+        let c1 = alpha1 / rho1;
+        for ((bk, r), w) in self.b[k].iter_mut().zip(rc.iter()).zip(w1.iter()) {
+            *bk = r - c1 * w;
+        }
+        let norm_rc = det_dot(rc, rc).sqrt();
+        let norm_rt = det_dot(&self.b[k], &self.b[k]).sqrt();
+        if norm_rt <= ONE_STEP * norm_rc {
+            for (x, v) in self.x[k].iter_mut().zip(v1.iter()) {
+                *x = c1 * v;
+            }
+            return;
+        }
+        self.coarse_k_cycle(k);
+        let a = &self.coarse[k];
+        let [_, v1, w1, v2] = &mut self.krylov[k];
+        v2.copy_from_slice(&self.x[k]);
+        let w2 = &mut self.r[k];
+        a.mul_into(v2, w2);
+        let gamma = det_dot(v2, w1);
+        let beta = det_dot(v2, w2);
+        let alpha2 = det_dot(v2, &self.b[k]);
+        let rho2 = beta - gamma * gamma / rho1;
+        let (ca, cb) = if rho2 > 0.0 && rho2.is_finite() {
+            (c1 - gamma * alpha2 / (rho1 * rho2), alpha2 / rho2)
+        } else {
+            (c1, 0.0)
+        };
+        for ((x, p), q) in self.x[k].iter_mut().zip(v1.iter()).zip(v2.iter()) {
+            *x = ca * p + cb * q;
+        }
+    }
+
+    /// One K-cycle on coarse level `k ≥ 1` for `A_k x[k] = b[k]`, from `x[k] = 0`.
+    fn coarse_k_cycle(&mut self, k: usize) {
+        let (nu1, nu2) = self.smoothing;
+        {
+            let (a, inv) = (&self.coarse[k], &self.inv_diag[k]);
+            let (xk, bk) = (&mut self.x[k], &self.b[k]);
+            xk.iter_mut().for_each(|v| *v = 0.0);
+            for _ in 0..nu1 {
+                gauss_seidel(a, inv, xk, bk, &mut self.snap[k], false);
+            }
+            residual(a, xk, bk, &mut self.r[k]);
+        }
+        {
+            let (bl, _) = self.b.split_at_mut(k);
+            self.levels.transfers[k - 1].restrict(&self.r[k], &mut bl[k - 1]);
+        }
+        self.krylov_correction(k - 1);
+        let (xl, xu) = self.x.split_at_mut(k);
+        self.levels.transfers[k - 1].prolongate_add(&xl[k - 1], &mut xu[0]);
+        for _ in 0..nu2 {
+            gauss_seidel(
+                &self.coarse[k],
+                &self.inv_diag[k],
+                &mut xu[0],
+                &self.b[k],
+                &mut self.snap[k],
+                true,
+            );
         }
     }
 
@@ -381,6 +602,47 @@ impl<'a> Multigrid<'a> {
                 *t = 0.0;
             }
         }
+    }
+}
+
+/// The work vectors of [`Multigrid::fcg`] (allocated once per solve).
+#[derive(Debug, Default)]
+pub struct FcgWork {
+    r: Vec<f64>,
+    z: Vec<f64>,
+    w: Vec<f64>,
+    p: Vec<f64>,
+    ap: Vec<f64>,
+}
+
+impl FcgWork {
+    fn resize(&mut self, n: usize) {
+        for v in [
+            &mut self.r,
+            &mut self.z,
+            &mut self.w,
+            &mut self.p,
+            &mut self.ap,
+        ] {
+            v.resize(n, 0.0);
+        }
+    }
+}
+
+/// `aᵀb`, summed in fixed blocks (the same result for any number of threads).
+fn det_dot(a: &[f64], b: &[f64]) -> f64 {
+    use rayon::prelude::*;
+    const BLOCK: usize = 4096;
+    let block = |(x, y): (&[f64], &[f64])| -> f64 { x.iter().zip(y).map(|(p, q)| p * q).sum() };
+    if a.len() >= super::transfer::PAR_ROWS {
+        let parts: Vec<f64> = a
+            .par_chunks(BLOCK)
+            .zip(b.par_chunks(BLOCK))
+            .map(block)
+            .collect();
+        parts.iter().sum()
+    } else {
+        a.chunks(BLOCK).zip(b.chunks(BLOCK)).map(block).sum()
     }
 }
 

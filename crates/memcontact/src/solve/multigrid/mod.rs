@@ -26,13 +26,16 @@
 //! `D_c = PᵀD`: exactly the coarse discretisation for nested meshes; φ injected at the
 //! coarse vertices), and each solution prolongated as the start of the next level.
 
+pub mod aggregation;
 pub mod cycle;
 pub mod transfer;
 
 #[cfg(test)]
+mod algebraic_tests;
+#[cfg(test)]
 pub(crate) mod tests;
 
-pub use cycle::{linear_solve, poisson_solve, Levels, LinearSolve, Multigrid};
+pub use cycle::{linear_solve, poisson_solve, Kind, Levels, LinearSolve, Multigrid};
 pub use transfer::Transfer;
 
 use super::active_set::start_from;
@@ -57,8 +60,15 @@ const STALL_LIMIT: usize = 3;
 pub struct Options {
     /// ν₁: nonsmooth Gauss-Seidel sweeps before each Newton correction.
     pub presmoothing: usize,
-    /// Linear V-cycles per Newton correction.
+    /// Multigrid cycles per Newton correction while the vertex states change (flexible CG
+    /// steps preconditioned by the cycle when `krylov_steps > 0`).
     pub cycles: usize,
+    /// Once the vertex states (nearly) repeat from one iteration to the next, up to this
+    /// many flexible CG steps preconditioned by the cycle per Newton correction. The
+    /// correction is inexact Newton: its linear residual is driven below the square of the
+    /// current scaled KKT residual (a quarter of the tolerance at the end). 0: `cycles`
+    /// plain cycles, always.
+    pub krylov_steps: usize,
     /// (pre, post) Gauss-Seidel steps per level inside a V-cycle.
     pub smoothing: (usize, usize),
     /// Solve the coarser levels first and start from the prolongated solution.
@@ -66,17 +76,30 @@ pub struct Options {
     /// Scaled KKT residual to which the coarser levels are solved in nested iteration
     /// (never below `settings.tolerance`).
     pub nested_tolerance: f64,
+    /// Algebraic hierarchies: coarsen down to about this many unknowns (the coarsest level
+    /// is factorised).
+    pub coarsest: usize,
 }
 
 impl Default for Options {
     fn default() -> Self {
         Options {
             presmoothing: 1,
-            cycles: 1,
+            cycles: 2,
+            krylov_steps: 30,
             smoothing: (1, 1),
             nested: true,
             nested_tolerance: 1e-6,
+            coarsest: aggregation::COARSEST,
         }
+    }
+}
+
+impl Options {
+    /// These options with algebraic hierarchies coarsened down to about `coarsest`
+    /// unknowns.
+    pub fn with_coarsest(self, coarsest: usize) -> Options {
+        Options { coarsest, ..self }
     }
 }
 
@@ -101,20 +124,39 @@ pub struct Report {
     pub levels: Vec<LevelReport>,
 }
 
-/// Solves Problem 2b by TNNMG with the default [`Options`]. `hierarchy` must end with the
-/// mesh the model was assembled on; anything else is an error. With a `start` (a warm
-/// start, e.g. the answer of a neighbouring load step) the iteration begins there on the
-/// finest level, without nested iteration.
+/// The coarse levels TNNMG runs on.
+#[derive(Debug, Clone, Copy)]
+pub enum Coarsening<'a> {
+    /// Nested meshes of uniform refinement; the last must be the mesh the model was
+    /// assembled on (anything else is an error).
+    Geometric(&'a Hierarchy),
+    /// An aggregation hierarchy built from the model's matrices ([`aggregation`]).
+    Algebraic,
+}
+
+impl Coarsening<'_> {
+    /// Geometric or algebraic.
+    pub fn kind(&self) -> Kind {
+        match self {
+            Coarsening::Geometric(_) => Kind::Geometric,
+            Coarsening::Algebraic => Kind::Algebraic,
+        }
+    }
+}
+
+/// Solves Problem 2b by TNNMG with the default [`Options`] on the given coarse levels.
+/// With a `start` (a warm start, e.g. the answer of a neighbouring load step) the
+/// iteration begins there on the finest level, without nested iteration.
 pub fn solve(
     model: &Model,
-    hierarchy: &Hierarchy,
+    coarsening: Coarsening,
     settings: &Settings,
     start: Option<&[f64]>,
     observer: &mut dyn Observer,
 ) -> Result<Solution> {
     solve_with(
         model,
-        hierarchy,
+        coarsening,
         settings,
         &Options::default(),
         start,
@@ -123,18 +165,35 @@ pub fn solve(
     .map(|r| r.0)
 }
 
-/// [`solve`] with explicit options, also returning the per-level report.
+/// The matrix an algebraic hierarchy is built from: S plus the diagonals of the bodies'
+/// foundations (where the membrane penetrates a body, the Newton matrices add its L to S).
+fn setup_matrix(model: &Model) -> Csr {
+    let mut a = model.s.clone();
+    for (i, k) in a.pattern.diagonal_positions().into_iter().enumerate() {
+        if model.can_touch[i] {
+            a.val[k] += model.l.diag(i);
+        }
+        if let Some(low) = model.lower.as_ref().filter(|low| low.can_touch[i]) {
+            a.val[k] += low.l.diag(i);
+        }
+    }
+    a
+}
+
+/// [`solve`] with explicit options, also returning the per-level report. Nested iteration
+/// runs on geometric hierarchies only (aggregates are no meshes to restrict φ to).
 pub fn solve_with(
     model: &Model,
-    hierarchy: &Hierarchy,
+    coarsening: Coarsening,
     settings: &Settings,
     options: &Options,
     start: Option<&[f64]>,
     observer: &mut dyn Observer,
 ) -> Result<(Solution, Report)> {
     let mut timer = PhaseTimer::default();
-    let levels = timer.time("setup", || {
-        Levels::new(hierarchy, &model.dofs, model.s.pattern.clone())
+    let levels = timer.time("setup", || match coarsening {
+        Coarsening::Geometric(h) => Levels::new(h, &model.dofs, model.s.pattern.clone()),
+        Coarsening::Algebraic => Ok(Levels::algebraic(&setup_matrix(model), options.coarsest)),
     })?;
     let top = levels.len() - 1;
     let max = settings.max_iterations.unwrap_or(MAX_ITERATIONS);
@@ -142,7 +201,7 @@ pub fn solve_with(
     let mut history = Vec::new();
 
     // Nested iteration: the Galerkin models of the coarser levels, coarsest first.
-    let first = if options.nested && start.is_none() {
+    let first = if options.nested && start.is_none() && levels.kind == Kind::Geometric {
         0
     } else {
         top
@@ -229,6 +288,7 @@ pub fn solve_with(
             multipliers: None,
             history,
             phases: timer.into_phases(),
+            coarsening: Some(levels.kind),
         },
         report,
     ))
@@ -352,8 +412,11 @@ fn level_solve(ls: LevelSolve) -> Result<(usize, f64, Option<Certificate>)> {
     let mut kkt;
     let mut certificate = None;
     let mut watch = crate::certificate::FloorWatch::default();
+    let mut fcg = cycle::FcgWork::default();
+    let mut scale;
     loop {
         let ev = timer.time("certificate", || crate::certificate::evaluate(model, v));
+        scale = ev.certificate.force_scale;
         kkt = ev.certificate.kkt();
         if iterations > 0 {
             let record = IterationRecord::new(iterations, &ev);
@@ -381,10 +444,13 @@ fn level_solve(ls: LevelSolve) -> Result<(usize, f64, Option<Certificate>)> {
         });
         // The truncated Newton system at the smoothed iterate.
         let st = NewtonStates::of(model, v);
-        let rows = prev
+        let dirty_rows = prev
             .as_ref()
             .map(|p| mark_dirty(&pattern, p, &st, &mut changed, &mut dirty));
-        let rows = rows.map(|_| dirty.as_slice());
+        // The states are (nearly) those of the last iteration: the piece of J is likely the
+        // solution's, and the Newton step on it is worth computing accurately.
+        let settled = dirty_rows.is_some_and(|d| d <= n / 1000);
+        let rows = dirty_rows.map(|_| dirty.as_slice());
         timer.time("newton system", || {
             newton_system(model, v, &st, &mut a, rows, &mut g, &mut r)
         });
@@ -394,8 +460,31 @@ fn level_solve(ls: LevelSolve) -> Result<(usize, f64, Option<Certificate>)> {
                 *x = -*x;
             }
             delta.iter_mut().for_each(|d| *d = 0.0);
-            for _ in 0..options.cycles {
-                mg.v_cycle(&a, &mut delta, &g);
+            if options.krylov_steps > 0 {
+                // Inexact Newton: the linear residual is driven below a forcing term, the
+                // square of the current scaled KKT residual (a quarter of the tolerance at
+                // the end); until the states repeat, a few steps only.
+                let (eta, steps) = if settled {
+                    (
+                        kkt.min(0.5).powi(2).max(0.25 * tolerance),
+                        options.krylov_steps,
+                    )
+                } else {
+                    (0.0, options.cycles)
+                };
+                mg.fcg(
+                    &a,
+                    &mut delta,
+                    &g,
+                    eta * scale,
+                    steps,
+                    &st.truncated,
+                    &mut fcg,
+                );
+            } else {
+                for _ in 0..options.cycles {
+                    mg.cycle(&a, &mut delta, &g);
+                }
             }
             let extended = model.is_extended();
             for (i, d) in delta.iter_mut().enumerate() {

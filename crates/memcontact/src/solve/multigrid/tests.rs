@@ -214,8 +214,15 @@ fn tnnmg_without_nested_iteration_converges_from_zero() {
             nested: false,
             ..Options::default()
         };
-        let (sol, rep) =
-            solve_with(&model, &hier, &settings(1e-10), &opts, None, &mut Silent).unwrap();
+        let (sol, rep) = solve_with(
+            &model,
+            Coarsening::Geometric(&hier),
+            &settings(1e-10),
+            &opts,
+            None,
+            &mut Silent,
+        )
+        .unwrap();
         assert!(sol.certificate.kkt() <= 1e-10, "{f:?} {h:?}");
         assert_eq!(rep.levels.len(), 1);
         assert!(sol.iterations < 40, "{f:?} {h:?}: {}", sol.iterations);
@@ -237,7 +244,14 @@ fn iteration_counts_do_not_grow_under_refinement() {
             // 16 × 16 ... 128 × 128 from a 2 × 2 coarse grid.
             let hier = square_hierarchy(2, levels);
             let model = bench_model(hier.finest(), h, f);
-            let sol = solve(&model, &hier, &settings(1e-10), None, &mut Silent).unwrap();
+            let sol = solve(
+                &model,
+                Coarsening::Geometric(&hier),
+                &settings(1e-10),
+                None,
+                &mut Silent,
+            )
+            .unwrap();
             counts.push(sol.iterations);
         }
         // The certificate is relative to the forces of the iterate (O(h²) per vertex), so
@@ -253,27 +267,62 @@ fn a_hierarchy_of_another_mesh_is_an_error() {
     let hier = square_hierarchy(4, 3);
     let other = square_hierarchy(3, 3);
     let model = bench_model(hier.finest(), Some(1000.0), Foundation::Lumped);
-    let e = solve(&model, &other, &settings(1e-10), None, &mut Silent).unwrap_err();
+    let e = solve(
+        &model,
+        Coarsening::Geometric(&other),
+        &settings(1e-10),
+        None,
+        &mut Silent,
+    )
+    .unwrap_err();
     assert!(e.to_string().contains("finest level"), "{e}");
     // A hierarchy with a broken refinement relation.
     let mut broken = hier.clone();
     broken.refinements[1].parents.pop();
-    let e = solve(&model, &broken, &settings(1e-10), None, &mut Silent).unwrap_err();
+    let e = solve(
+        &model,
+        Coarsening::Geometric(&broken),
+        &settings(1e-10),
+        None,
+        &mut Silent,
+    )
+    .unwrap_err();
     assert!(e.to_string().contains("refinement"), "{e}");
     let mut broken = hier.clone();
     broken.refinements[0].parents[3] = [10_000, 0];
-    let e = solve(&model, &broken, &settings(1e-10), None, &mut Silent).unwrap_err();
+    let e = solve(
+        &model,
+        Coarsening::Geometric(&broken),
+        &settings(1e-10),
+        None,
+        &mut Silent,
+    )
+    .unwrap_err();
     assert!(e.to_string().contains("parent"), "{e}");
     let mut broken = hier;
     broken.refinements.pop();
-    assert!(solve(&model, &broken, &settings(1e-10), None, &mut Silent).is_err());
+    assert!(solve(
+        &model,
+        Coarsening::Geometric(&broken),
+        &settings(1e-10),
+        None,
+        &mut Silent
+    )
+    .is_err());
 }
 
 #[test]
 fn one_level_is_a_direct_truncated_newton() {
     let hier = square_hierarchy(16, 1);
     let model = bench_model(hier.finest(), Some(1000.0), Foundation::Consistent);
-    let sol = solve(&model, &hier, &settings(1e-11), None, &mut Silent).unwrap();
+    let sol = solve(
+        &model,
+        Coarsening::Geometric(&hier),
+        &settings(1e-11),
+        None,
+        &mut Silent,
+    )
+    .unwrap();
     let reference = active_set::solve(&model, &settings(1e-11), None, &mut Silent).unwrap();
     assert!(rel_diff(&sol.u, &reference.u) < 1e-8);
 }

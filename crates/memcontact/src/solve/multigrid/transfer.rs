@@ -87,8 +87,29 @@ impl Transfer {
         } else {
             fine.vertex.iter().map(map).unzip()
         };
-        // Columns: counting sort by parent (children stay in increasing fine order).
-        let n_coarse = coarse.len();
+        Ok(Transfer::from_rows(parents, weights, coarse.len()))
+    }
+
+    /// The piecewise-constant prolongation of an aggregation: fine unknown `v` belongs to
+    /// aggregate `aggregate[v] < n_coarse` (`P[v, aggregate[v]] = 1`), or to none
+    /// (`aggregate[v] = u32::MAX`: a zero row of P).
+    pub fn aggregation(aggregate: &[u32], n_coarse: usize) -> Transfer {
+        let (parents, weights): (Vec<[u32; 2]>, Vec<[f64; 2]>) = aggregate
+            .iter()
+            .map(|&a| {
+                if (a as usize) < n_coarse {
+                    ([a, a], [1.0, 0.0])
+                } else {
+                    ([0, 0], [0.0, 0.0])
+                }
+            })
+            .unzip();
+        Transfer::from_rows(parents, weights, n_coarse)
+    }
+
+    /// P from its rows (up to two parents per fine unknown; weight 0 for a missing one),
+    /// with the columns built by a counting sort (children in increasing fine order).
+    fn from_rows(parents: Vec<[u32; 2]>, weights: Vec<[f64; 2]>, n_coarse: usize) -> Transfer {
         let mut child_ptr = vec![0usize; n_coarse + 1];
         for (p, w) in parents.iter().zip(&weights) {
             for s in 0..2 {
@@ -113,14 +134,14 @@ impl Transfer {
                 }
             }
         }
-        Ok(Transfer {
+        Transfer {
             n_coarse,
             parents,
             weights,
             child_ptr,
             children,
             child_weights,
-        })
+        }
     }
 
     /// Number of fine unknowns (rows of P).

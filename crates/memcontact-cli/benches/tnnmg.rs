@@ -1,0 +1,150 @@
+//! `cargo bench -p memcontact-cli --bench tnnmg [-- N1 N2 ...] [-- --lumped|--consistent]`:
+//! the standard benchmark table of `memcontact bench` (see `memcontact::bench`). Sizes default to
+//! 128 … 2048 cells per side. Environment: `MEMCONTACT_PHASES=1` prints the phases,
+//! `MEMCONTACT_NESTED_TOL`, `MEMCONTACT_CYCLES`, `MEMCONTACT_SMOOTHING`,
+//! `MEMCONTACT_NO_NESTED` override the TNNMG options.
+
+use memcontact::bench::{run_bench, BenchRow};
+use memcontact::model::Foundation;
+use memcontact::solve::multigrid::Options;
+
+/// `-- --micro N`: times the kernels of one TNNMG iteration on the N × N benchmark mesh.
+fn micro(n: usize) {
+    let h = memcontact::bench::mesh(n).unwrap();
+    for f in [Foundation::Lumped, Foundation::Consistent] {
+        let m = memcontact::bench::model(h.finest(), f).unwrap();
+        let t = memcontact::solve::multigrid::kernel_timings(&m, &h, 10).unwrap();
+        println!("{}:                      wall ms   cpu ms", f.name());
+        for (name, ms, cpu) in t {
+            println!("  {name:<24} {ms:8.2} {cpu:8.2}");
+        }
+    }
+}
+
+/// `-- --assembly N`: times the passes of assembly on the N × N benchmark mesh (and, with
+/// `--mesh FILE` instead of N, on a Gmsh mesh renumbered as a solve would).
+fn assembly(args: &[String]) {
+    use memcontact::fem::{assemble_stiffness_and_mass, assemble_vector, unknowns_pattern};
+    use memcontact::mesh::{DofMap, VertexTriangles};
+    let mesh = match args.iter().position(|a| a == "--mesh") {
+        Some(k) => {
+            let path = std::path::Path::new(&args[k + 1]);
+            let user = memcontact::io::gmsh::read_msh(path).unwrap().0;
+            let (h, _) = memcontact::mesh::refine::Hierarchy::single(user).reordered();
+            h.finest().clone()
+        }
+        None => {
+            let n = args
+                .iter()
+                .find_map(|a| a.parse().ok())
+                .unwrap_or(1024usize);
+            memcontact::bench::mesh(n).unwrap().finest().clone()
+        }
+    };
+    let reps = 5;
+    let time = |name: &str, f: &mut dyn FnMut()| {
+        let c0 = memcontact::bench::cpu_seconds().unwrap_or(f64::NAN);
+        let t0 = std::time::Instant::now();
+        for _ in 0..reps {
+            f();
+        }
+        let wall = t0.elapsed().as_secs_f64() * 1e3 / reps as f64;
+        let cpu = (memcontact::bench::cpu_seconds().unwrap_or(f64::NAN) - c0) * 1e3 / reps as f64;
+        println!("  {name:<28} {wall:8.1} {cpu:8.1}");
+    };
+    println!(
+        "{} vertices (edge span {:.2}):   wall ms   cpu ms",
+        mesh.n_vertices(),
+        memcontact::mesh::reorder::edge_span(&mesh)
+    );
+    let adj = VertexTriangles::new(&mesh);
+    time("vertex triangles", &mut || {
+        std::hint::black_box(VertexTriangles::new(&mesh));
+    });
+    let dofs = DofMap::with_adjacency(&mesh, &adj);
+    time("dof map (boundary)", &mut || {
+        std::hint::black_box(DofMap::with_adjacency(&mesh, &adj));
+    });
+    let pattern = std::sync::Arc::new(unknowns_pattern(&mesh, &dofs, &adj));
+    time("pattern", &mut || {
+        std::hint::black_box(unknowns_pattern(&mesh, &dofs, &adj));
+    });
+    time("S and consistent L", &mut || {
+        std::hint::black_box(assemble_stiffness_and_mass(
+            &mesh,
+            &dofs,
+            &adj,
+            &pattern,
+            1.0,
+            Some(&1000.0),
+        ));
+    });
+    time("S", &mut || {
+        std::hint::black_box(assemble_stiffness_and_mass(
+            &mesh, &dofs, &adj, &pattern, 1.0, None,
+        ));
+    });
+    time("load vector", &mut || {
+        std::hint::black_box(assemble_vector(&mesh, &dofs, &adj, &|e, r, a| {
+            e.weighted_load(&20.0, r, a)
+        }));
+    });
+    for f in [Foundation::Lumped, Foundation::Consistent] {
+        time(&format!("model ({})", f.name()), &mut || {
+            std::hint::black_box(memcontact::bench::model(&mesh, f).unwrap());
+        });
+    }
+}
+
+fn main() {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    if args.iter().any(|a| a == "--assembly") {
+        assembly(&args);
+        return;
+    }
+    if let Some(k) = args.iter().position(|a| a == "--micro") {
+        let n = args.get(k + 1).and_then(|a| a.parse().ok()).unwrap_or(1024);
+        micro(n);
+        return;
+    }
+    let mut sizes: Vec<usize> = args.iter().filter_map(|a| a.parse().ok()).collect();
+    if sizes.is_empty() {
+        sizes = vec![128, 256, 512, 1024, 2048];
+    }
+    let foundations: Vec<Foundation> = if args.iter().any(|a| a == "--lumped") {
+        vec![Foundation::Lumped]
+    } else if args.iter().any(|a| a == "--consistent") {
+        vec![Foundation::Consistent]
+    } else {
+        vec![Foundation::Lumped, Foundation::Consistent]
+    };
+    println!("{}", memcontact_cli::bench::square_header());
+    let phases = std::env::var_os("MEMCONTACT_PHASES").is_some();
+    let mut print = |r: &BenchRow| println!("{}", memcontact_cli::bench::square_row(r, phases));
+    let mut options = Options::default();
+    if let Some(t) = std::env::var("MEMCONTACT_NESTED_TOL")
+        .ok()
+        .and_then(|t| t.parse().ok())
+    {
+        options.nested_tolerance = t;
+    }
+    if let Some(c) = std::env::var("MEMCONTACT_CYCLES")
+        .ok()
+        .and_then(|t| t.parse().ok())
+    {
+        options.cycles = c;
+    }
+    if let Some(c) = std::env::var("MEMCONTACT_SMOOTHING")
+        .ok()
+        .and_then(|t| t.parse().ok())
+    {
+        options.smoothing = (c, c);
+    }
+    if std::env::var_os("MEMCONTACT_NO_NESTED").is_some() {
+        options.nested = false;
+    }
+    if let Err(e) = run_bench(&sizes, &foundations, &options, &mut print) {
+        eprintln!("benchmark failed: {e}");
+        std::process::exit(1);
+    }
+}

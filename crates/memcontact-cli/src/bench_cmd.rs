@@ -1,0 +1,31 @@
+//! `memcontact bench`: the standard benchmark table (Ω = (0,1)², t = 1, f = 20,
+//! h = 1000, φ = 0.5 + 0.1 sin(2πx) cos(2πy), N × N "right" mesh, nodal φ, tolerance
+//! 1e-10), solved by TNNMG, with one linear Poisson multigrid solve as the yardstick.
+
+use anyhow::{bail, Result};
+use memcontact::bench::{run_bench, BenchRow};
+use memcontact::model::Foundation;
+use memcontact::solve::multigrid::Options;
+use memcontact_cli::bench::{square_header, square_row};
+
+/// Runs the benchmark for `sizes` (cells per side) and the chosen foundations, printing
+/// one row per (size, foundation) as soon as it is measured.
+pub fn run(sizes: &[usize], foundation: &str, phases: bool) -> Result<()> {
+    let foundations: Vec<Foundation> = match foundation {
+        "both" => vec![Foundation::Lumped, Foundation::Consistent],
+        "lumped" => vec![Foundation::Lumped],
+        "consistent" => vec![Foundation::Consistent],
+        f => bail!("--foundation must be lumped, consistent or both, not \"{f}\""),
+    };
+    if sizes.is_empty() || sizes.iter().any(|&n| n < 2) {
+        bail!("--sizes needs cells per side ≥ 2, e.g. --sizes 128,256,512,1024");
+    }
+    println!(
+        "threads: {} (rayon); times in seconds, memory = peak resident set (VmHWM)",
+        rayon::current_num_threads()
+    );
+    println!("{}", square_header());
+    let mut print = |r: &BenchRow| println!("{}", square_row(r, phases));
+    run_bench(sizes, &foundations, &Options::default(), &mut print)?;
+    Ok(())
+}

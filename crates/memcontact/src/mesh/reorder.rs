@@ -1,0 +1,415 @@
+//! Vertex and triangle orders for memory locality. Every pass of the solver (assembly,
+//! smoothing, residuals, transfers) walks the unknowns in order and reads their
+//! neighbours: when neighbours are near in memory the pass runs from cache, when the order
+//! is scattered (a mesh generator's or another tool's numbering, the midpoints of a
+//! refinement) each neighbour is a miss. Meshes whose order is scattered are renumbered
+//! along a Hilbert curve through their vertices (triangles along the same curve through
+//! their centroids) before assembly; the outputs are mapped back to the user's order.
+
+use super::refine::Hierarchy;
+use super::{Mesh, Point};
+use rayon::prelude::*;
+
+/// A permutation of `0..n`: `old_of_new[i]` is the old index of new entry `i`.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Permutation {
+    /// The old index of every new position.
+    pub old_of_new: Vec<u32>,
+    /// The new position of every old index.
+    pub new_of_old: Vec<u32>,
+}
+
+impl Permutation {
+    /// The permutation that puts old entry `old_of_new[i]` at position `i`.
+    pub fn from_order(old_of_new: Vec<u32>) -> Permutation {
+        let mut new_of_old = vec![0u32; old_of_new.len()];
+        for (new, &old) in old_of_new.iter().enumerate() {
+            new_of_old[old as usize] = new as u32;
+        }
+        Permutation {
+            old_of_new,
+            new_of_old,
+        }
+    }
+
+    /// The identity on `0..n`.
+    pub fn identity(n: usize) -> Permutation {
+        let id: Vec<u32> = (0..n as u32).collect();
+        Permutation {
+            old_of_new: id.clone(),
+            new_of_old: id,
+        }
+    }
+
+    /// Length.
+    pub fn len(&self) -> usize {
+        self.old_of_new.len()
+    }
+
+    /// `true` for the permutation of nothing.
+    pub fn is_empty(&self) -> bool {
+        self.old_of_new.is_empty()
+    }
+
+    /// `true` when nothing moves.
+    pub fn is_identity(&self) -> bool {
+        self.old_of_new
+            .iter()
+            .enumerate()
+            .all(|(i, &o)| o as usize == i)
+    }
+
+    /// Values in the new order from values in the old order.
+    pub fn to_new<T: Copy + Send + Sync>(&self, old: &[T]) -> Vec<T> {
+        self.old_of_new
+            .par_iter()
+            .with_min_len(8192)
+            .map(|&o| old[o as usize])
+            .collect()
+    }
+
+    /// Values in the old order from values in the new order.
+    pub fn to_old<T: Copy + Send + Sync>(&self, new: &[T]) -> Vec<T> {
+        self.new_of_old
+            .par_iter()
+            .with_min_len(8192)
+            .map(|&n| new[n as usize])
+            .collect()
+    }
+}
+
+/// How a mesh was renumbered: its vertices and its triangles.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Reordering {
+    /// Old = the user's vertex numbering, new = the internal one.
+    pub vertices: Permutation,
+    /// Old = the user's triangle numbering, new = the internal one.
+    pub triangles: Permutation,
+}
+
+impl Reordering {
+    /// No renumbering of a mesh of `n_vertices` and `n_triangles`.
+    pub fn identity(n_vertices: usize, n_triangles: usize) -> Reordering {
+        Reordering {
+            vertices: Permutation::identity(n_vertices),
+            triangles: Permutation::identity(n_triangles),
+        }
+    }
+
+    /// `true` when nothing moves.
+    pub fn is_identity(&self) -> bool {
+        self.vertices.is_identity() && self.triangles.is_identity()
+    }
+
+    /// `mesh` (in the user's numbering) renumbered; the result records the renumbering in
+    /// [`Mesh::numbering`].
+    pub fn apply(&self, mesh: &Mesh) -> Mesh {
+        let mut m = self.map(mesh, &self.vertices.new_of_old, &self.triangles.old_of_new);
+        m.numbering = Some(std::sync::Arc::new(self.clone()));
+        m
+    }
+
+    /// The inverse of [`Reordering::apply`]: the mesh in the user's numbering from the
+    /// renumbered one.
+    pub fn undo(&self, internal: &Mesh) -> Mesh {
+        self.map(
+            internal,
+            &self.vertices.old_of_new,
+            &self.triangles.new_of_old,
+        )
+    }
+
+    /// `mesh` with vertex `v` moved to `vertex_to[v]` and the triangle now at position `k`
+    /// taken from position `triangle_from[k]`.
+    fn map(&self, mesh: &Mesh, vertex_to: &[u32], triangle_from: &[u32]) -> Mesh {
+        let mut points: Vec<Point> = vec![[0.0; 2]; mesh.points.len()];
+        for (v, p) in mesh.points.iter().enumerate() {
+            points[vertex_to[v] as usize] = *p;
+        }
+        let triangles: Vec<[u32; 3]> = triangle_from
+            .par_iter()
+            .with_min_len(8192)
+            .map(|&k| mesh.triangles[k as usize].map(|v| vertex_to[v as usize]))
+            .collect();
+        let regions: Vec<u32> = triangle_from
+            .par_iter()
+            .with_min_len(8192)
+            .map(|&k| mesh.regions[k as usize])
+            .collect();
+        Mesh {
+            points,
+            triangles,
+            regions,
+            region_names: mesh.region_names.clone(),
+            curve: mesh.curve,
+            boundary: super::BoundaryRegions {
+                edges: mesh
+                    .boundary
+                    .edges
+                    .iter()
+                    .map(|e| e.map(|v| vertex_to[v as usize]))
+                    .collect(),
+                tags: mesh.boundary.tags.clone(),
+                names: mesh.boundary.names.clone(),
+            },
+            numbering: None,
+        }
+    }
+}
+
+impl Mesh {
+    /// The mesh in the user's numbering: itself, or the renumbering undone.
+    pub fn in_user_numbering(&self) -> std::borrow::Cow<'_, Mesh> {
+        match &self.numbering {
+            Some(r) => std::borrow::Cow::Owned(r.undo(self)),
+            None => std::borrow::Cow::Borrowed(self),
+        }
+    }
+
+    /// Values at this mesh's vertices in the user's vertex numbering.
+    pub fn vertex_values_to_user<T: Copy + Send + Sync>(&self, values: &[T]) -> Vec<T> {
+        match &self.numbering {
+            Some(r) => r.vertices.to_old(values),
+            None => values.to_vec(),
+        }
+    }
+
+    /// Values given at the user's vertices, in this mesh's numbering.
+    pub fn vertex_values_from_user<T: Copy + Send + Sync>(&self, values: &[T]) -> Vec<T> {
+        match &self.numbering {
+            Some(r) => r.vertices.to_new(values),
+            None => values.to_vec(),
+        }
+    }
+}
+
+/// Bits per coordinate of the Hilbert curve (a 65 536 × 65 536 grid over the mesh's
+/// bounding square).
+const BITS: u32 = 16;
+
+/// The index of cell `(x, y)` along the Hilbert curve of the `2^BITS × 2^BITS` grid.
+pub fn hilbert_index(mut x: u32, mut y: u32) -> u32 {
+    let n: u32 = 1 << BITS;
+    let mut d: u64 = 0;
+    let mut s = n / 2;
+    while s > 0 {
+        let rx = u32::from(x & s > 0);
+        let ry = u32::from(y & s > 0);
+        d += u64::from(s) * u64::from(s) * u64::from((3 * rx) ^ ry);
+        // Rotate the quadrant so that the curve inside it has the standard orientation.
+        if ry == 0 {
+            if rx == 1 {
+                x = n - 1 - x;
+                y = n - 1 - y;
+            }
+            std::mem::swap(&mut x, &mut y);
+        }
+        s /= 2;
+    }
+    d as u32
+}
+
+/// The order of `points` along the Hilbert curve of their bounding square (ties by
+/// index: deterministic).
+fn curve_order(points: &[Point]) -> Vec<u32> {
+    let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+    for p in points {
+        for d in 0..2 {
+            lo[d] = lo[d].min(p[d]);
+            hi[d] = hi[d].max(p[d]);
+        }
+    }
+    let extent = (hi[0] - lo[0]).max(hi[1] - lo[1]);
+    let scale = if extent > 0.0 && extent.is_finite() {
+        ((1u32 << BITS) - 1) as f64 / extent
+    } else {
+        0.0
+    };
+    let mut keys: Vec<u64> = points
+        .par_iter()
+        .enumerate()
+        .with_min_len(8192)
+        .map(|(i, p)| {
+            let q = |d: usize| ((p[d] - lo[d]) * scale).clamp(0.0, ((1u32 << BITS) - 1) as f64);
+            let h = hilbert_index(q(0) as u32, q(1) as u32);
+            (u64::from(h) << 32) | i as u64
+        })
+        .collect();
+    keys.par_sort_unstable();
+    keys.into_iter().map(|k| k as u32).collect()
+}
+
+/// The mean distance `|i − j|` between the numbers of the two ends of an edge, in units of
+/// `√n`: about 0.7 for a structured grid numbered row by row, of order `√n` for a
+/// scattered numbering.
+pub fn edge_span(mesh: &Mesh) -> f64 {
+    let n = mesh.n_vertices().max(1) as f64;
+    let total: f64 = mesh
+        .triangles
+        .par_iter()
+        .with_min_len(8192)
+        .map(|t| {
+            let s = |a: u32, b: u32| (a as f64 - b as f64).abs();
+            s(t[0], t[1]) + s(t[1], t[2]) + s(t[2], t[0])
+        })
+        .sum();
+    total / (3.0 * mesh.n_triangles().max(1) as f64) / n.sqrt()
+}
+
+/// Meshes whose [`edge_span`] is at most this are kept in their order (a row-by-row
+/// structured grid, or a mesh already renumbered for locality).
+pub const LOCAL_SPAN: f64 = 4.0;
+
+/// The renumbering of `mesh` for locality: vertices along the Hilbert curve, triangles
+/// along it too (by centroid); the identity when the mesh's own order is already local
+/// ([`LOCAL_SPAN`]).
+pub fn locality_order(mesh: &Mesh) -> Reordering {
+    if edge_span(mesh) <= LOCAL_SPAN {
+        return Reordering::identity(mesh.n_vertices(), mesh.n_triangles());
+    }
+    let vertices = Permutation::from_order(curve_order(&mesh.points));
+    let centroids: Vec<Point> = mesh
+        .triangles
+        .par_iter()
+        .with_min_len(8192)
+        .map(|t| {
+            let c = |d: usize| {
+                (mesh.points[t[0] as usize][d]
+                    + mesh.points[t[1] as usize][d]
+                    + mesh.points[t[2] as usize][d])
+                    / 3.0
+            };
+            [c(0), c(1)]
+        })
+        .collect();
+    let triangles = Permutation::from_order(curve_order(&centroids));
+    Reordering {
+        vertices,
+        triangles,
+    }
+}
+
+impl Hierarchy {
+    /// Every level renumbered for locality ([`locality_order`]), with the refinement
+    /// relations renumbered to match; returns the reorderings, coarsest level first.
+    pub fn reordered(self) -> (Hierarchy, Vec<Reordering>) {
+        let orders: Vec<Reordering> = self.levels.iter().map(locality_order).collect();
+        if orders.iter().all(Reordering::is_identity) {
+            return (self, orders);
+        }
+        let levels: Vec<Mesh> = self
+            .levels
+            .iter()
+            .zip(&orders)
+            .map(|(m, r)| {
+                if r.is_identity() {
+                    m.clone()
+                } else {
+                    r.apply(m)
+                }
+            })
+            .collect();
+        let refinements = self
+            .refinements
+            .iter()
+            .enumerate()
+            .map(|(k, rf)| {
+                let (coarse, fine) = (&orders[k], &orders[k + 1]);
+                let parents = fine
+                    .vertices
+                    .old_of_new
+                    .par_iter()
+                    .with_min_len(8192)
+                    .map(|&v| {
+                        rf.parents[v as usize].map(|c| coarse.vertices.new_of_old[c as usize])
+                    })
+                    .collect();
+                super::refine::Refinement { parents }
+            })
+            .collect();
+        (
+            Hierarchy {
+                levels,
+                refinements,
+            },
+            orders,
+        )
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mesh::generate::disk;
+
+    #[test]
+    fn hilbert_curve_visits_neighbouring_cells_in_turn() {
+        // On a 2^BITS grid, consecutive indices are adjacent cells: check a 64 × 64 corner.
+        let mut cells: Vec<(u32, u32, u32)> = (0..64u32)
+            .flat_map(|x| (0..64u32).map(move |y| (hilbert_index(x, y), x, y)))
+            .collect();
+        cells.sort_unstable();
+        // The first 4096 indices fill the 64 × 64 corner exactly.
+        assert_eq!(cells.last().unwrap().0, 4095);
+        for w in cells.windows(2) {
+            assert_eq!(w[1].0, w[0].0 + 1);
+            let d = w[0].1.abs_diff(w[1].1) + w[0].2.abs_diff(w[1].2);
+            assert_eq!(d, 1, "{w:?}");
+        }
+    }
+
+    #[test]
+    fn renumbering_is_local_and_undone_exactly() {
+        // A disc, then scrambled: a scattered numbering.
+        let m = disk([0.0, 0.0], 1.0, 0.03).unwrap();
+        let n = m.n_vertices();
+        let scramble = Permutation::from_order(
+            (0..n as u32)
+                .map(|i| ((i as u64 * 7919) % n as u64) as u32)
+                .collect(),
+        );
+        assert!(
+            !n.is_multiple_of(7919),
+            "7919 is a prime: the scramble is a bijection"
+        );
+        let user = Reordering {
+            vertices: scramble,
+            triangles: Permutation::identity(m.n_triangles()),
+        }
+        .apply(&m);
+        assert!(edge_span(&user) > 10.0, "{}", edge_span(&user));
+        let r = locality_order(&user);
+        let internal = r.apply(&user);
+        assert!(edge_span(&internal) < 3.0, "{}", edge_span(&internal));
+        // The same triangles (as point sets) with the same regions, and undone exactly.
+        let back = r.undo(&internal);
+        assert_eq!(back.points, user.points);
+        assert_eq!(back.triangles, user.triangles);
+        assert_eq!(back.regions, user.regions);
+        let (a, b) = (internal.quality(), user.quality());
+        assert!((a.area - b.area).abs() < 1e-14 * b.area);
+        assert_eq!((a.l_n, a.s_n, a.unknowns), (b.l_n, b.s_n, b.unknowns));
+        // A structured order is kept.
+        let grid = crate::solve::tests::square(32);
+        assert!(locality_order(&grid).is_identity());
+    }
+
+    #[test]
+    fn renumbered_hierarchy_keeps_its_refinement_relations() {
+        let h = Hierarchy::refined(disk([0.0, 0.0], 1.0, 0.2).unwrap(), 2);
+        let (r, orders) = h.clone().reordered();
+        assert_eq!(orders.len(), 3);
+        for k in 0..2 {
+            // Fine vertex = midpoint of its parents, in the renumbered meshes too (up to the
+            // projection of new boundary vertices onto the circle).
+            let (c, f) = (&r.levels[k], &r.levels[k + 1]);
+            for (v, [a, b]) in r.refinements[k].parents.iter().enumerate() {
+                let (pa, pb) = (c.points[*a as usize], c.points[*b as usize]);
+                let mid = [(pa[0] + pb[0]) / 2.0, (pa[1] + pb[1]) / 2.0];
+                let p = f.points[v];
+                let on_circle = (p[0].hypot(p[1]) - 1.0).abs() < 1e-12;
+                assert!(on_circle || (p[0] - mid[0]).abs() + (p[1] - mid[1]).abs() < 1e-14);
+            }
+        }
+    }
+}

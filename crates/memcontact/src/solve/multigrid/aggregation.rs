@@ -1,0 +1,254 @@
+//! An algebraic multigrid hierarchy by **double pairwise aggregation** (Y. Notay, "An
+//! aggregation-based algebraic multigrid method", ETNA 37 (2010); the aggregation of
+//! AGMG), for meshes that carry no refinement hierarchy.
+//!
+//! One coarsening step matches every unknown with its most strongly negatively coupled
+//! unmatched neighbour (a pair, or a singleton when none is left), forms the Galerkin
+//! matrix of those pairs, and matches again: aggregates of up to four unknowns, a
+//! coarsening ratio close to 4 in two dimensions. The prolongation is the piecewise-constant
+//! one (`P[v, aggregate(v)] = 1`), which fits [`Transfer`] with one parent of weight 1, so
+//! that the Galerkin coarse operators `PᵀAP` and their refresh in changed rows are those of
+//! the geometric hierarchy. Unknowns whose row is dominated by its diagonal (a stiff
+//! foundation) need no coarse correction: they are left out of every aggregate and handled
+//! by the smoother alone.
+//!
+//! Unsmoothed aggregation needs a cycle that keeps its convergence as levels are added:
+//! the K-cycle of [`super::cycle::Multigrid::k_cycle`]. The aggregation is built once per
+//! solve from `S` plus the foundation's diagonal and reused by every Newton correction.
+
+use super::transfer::{galerkin_patterns, Transfer};
+use crate::sparse::{Csr, Pattern};
+use std::sync::Arc;
+
+/// An unknown not in any aggregate.
+pub const NONE: u32 = u32::MAX;
+
+/// Coupling threshold: `j` is a strong neighbour of `i` when
+/// `a_ij < −β max_k |a_ik|` over the negative off-diagonal entries of row `i`.
+const BETA: f64 = 0.25;
+
+/// A row with `a_ii ≥ DOMINANT Σ_{j≠i} |a_ij|` is left to the smoother.
+const DOMINANT: f64 = 5.0;
+
+/// Stop coarsening at this many unknowns by default (the coarsest level is factorised).
+pub const COARSEST: usize = 2_000;
+
+/// Stop coarsening when a step keeps more than this fraction of the unknowns.
+const STAGNATION: f64 = 0.7;
+
+/// At most this many levels.
+const MAX_LEVELS: usize = 40;
+
+/// The strong neighbours of every row: negative couplings above [`BETA`] times the
+/// strongest of the row, among the rows taking part in the matching.
+struct Strong<'a> {
+    a: &'a Csr,
+    free: Vec<bool>,
+    threshold: Vec<f64>,
+}
+
+impl Strong<'_> {
+    /// `(j, a_ij)` for the strong neighbours `j` of row `i`.
+    fn of(&self, i: usize) -> impl Iterator<Item = (usize, f64)> + '_ {
+        let (cols, vals) = self.a.row(i);
+        let t = self.threshold[i];
+        cols.iter()
+            .zip(vals)
+            .map(|(&j, &v)| (j as usize, v))
+            .filter(move |&(j, v)| j != i && self.free[j] && -v > t)
+    }
+}
+
+/// One pairwise matching of the rows of `a`: the pair (or singleton) of every row, `NONE`
+/// for rows left to the smoother (zero or dominant diagonal); returns the aggregate index
+/// of every row and the number of aggregates. Rows are taken in order of fewest unmatched
+/// strong neighbours (Notay's rule, which leaves few rows unpaired), each paired with its
+/// strongest unmatched neighbour. Deterministic.
+fn pairwise(a: &Csr) -> (Vec<u32>, usize) {
+    let n = a.n();
+    let mut free = vec![true; n];
+    let mut threshold = vec![0.0; n];
+    for i in 0..n {
+        let (cols, vals) = a.row(i);
+        let (mut diag, mut off, mut strongest) = (0.0, 0.0, 0.0f64);
+        for (&j, &v) in cols.iter().zip(vals) {
+            if j as usize == i {
+                diag = v;
+            } else {
+                off += v.abs();
+                strongest = strongest.max(-v);
+            }
+        }
+        free[i] = diag > 0.0 && diag < DOMINANT * off;
+        threshold[i] = BETA * strongest;
+    }
+    let strong = Strong { a, free, threshold };
+    let mut agg = vec![NONE; n];
+    // A bucket queue by the number of unmatched strong neighbours, with lazy deletion.
+    let mut degree: Vec<u32> = (0..n)
+        .map(|i| {
+            if strong.free[i] {
+                strong.of(i).count() as u32
+            } else {
+                0
+            }
+        })
+        .collect();
+    let top = degree.iter().copied().max().unwrap_or(0) as usize;
+    let mut buckets: Vec<Vec<u32>> = vec![Vec::new(); top + 1];
+    for i in (0..n).rev() {
+        if strong.free[i] {
+            buckets[degree[i] as usize].push(i as u32);
+        }
+    }
+    let mut lowest = 0usize;
+    let mut count = 0u32;
+    loop {
+        while lowest < buckets.len() && buckets[lowest].is_empty() {
+            lowest += 1;
+        }
+        let Some(i) = buckets.get_mut(lowest).and_then(Vec::pop) else {
+            break;
+        };
+        let i = i as usize;
+        if agg[i] != NONE || degree[i] as usize != lowest {
+            continue; // matched, or queued again with a smaller degree
+        }
+        let mut best: Option<(usize, f64)> = None;
+        for (j, v) in strong.of(i) {
+            if agg[j] == NONE && best.is_none_or(|(_, b)| v < b) {
+                best = Some((j, v));
+            }
+        }
+        for m in std::iter::once(i).chain(best.map(|b| b.0)) {
+            agg[m] = count;
+            for (k, _) in strong.of(m) {
+                if agg[k] == NONE && degree[k] > 0 {
+                    degree[k] -= 1;
+                    buckets[degree[k] as usize].push(k as u32);
+                    lowest = lowest.min(degree[k] as usize);
+                }
+            }
+        }
+        count += 1;
+    }
+    (agg, count as usize)
+}
+
+/// The transfers of an aggregation hierarchy for the operator `a` (finest level), coarsest
+/// level first, with the level sizes, coarsest first. Coarsening stops at `coarsest`
+/// unknowns (see [`COARSEST`]), when a step no longer reduces the size enough, or at
+/// [`MAX_LEVELS`].
+pub fn hierarchy(a: &Csr, coarsest: usize) -> (Vec<Transfer>, Vec<usize>) {
+    let mut transfers: Vec<Transfer> = Vec::new();
+    let mut sizes = vec![a.n()];
+    let mut current: Option<Csr> = None;
+    while sizes.len() < MAX_LEVELS {
+        let fine = current.as_ref().unwrap_or(a);
+        let n = fine.n();
+        if n <= coarsest {
+            break;
+        }
+        // Two pairwise matchings, composed.
+        let (first, n1) = pairwise(fine);
+        let t1 = Transfer::aggregation(&first, n1);
+        let a1 = galerkin(fine, &t1);
+        let (second, n2) = pairwise(&a1);
+        let agg: Vec<u32> = first
+            .iter()
+            .map(|&p| if p == NONE { NONE } else { second[p as usize] })
+            .collect();
+        if n2 == 0 || n2 as f64 > STAGNATION * n as f64 {
+            break;
+        }
+        let t = Transfer::aggregation(&agg, n2);
+        let coarse = galerkin(fine, &t);
+        transfers.push(t);
+        sizes.push(n2);
+        current = Some(coarse);
+    }
+    transfers.reverse();
+    sizes.reverse();
+    (transfers, sizes)
+}
+
+/// `PᵀAP` on its own pattern.
+fn galerkin(a: &Csr, t: &Transfer) -> Csr {
+    let pattern: Pattern = t.galerkin_pattern(&a.pattern);
+    let mut c = Csr::zeros(Arc::new(pattern));
+    t.galerkin_values(a, &mut c, None);
+    c
+}
+
+/// The Galerkin patterns of an aggregation hierarchy (see [`galerkin_patterns`]).
+pub fn patterns(transfers: &[Transfer], finest: Arc<Pattern>) -> Vec<Arc<Pattern>> {
+    galerkin_patterns(transfers, finest)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The 5-point Laplacian on an m × m grid.
+    fn lap2d(m: usize) -> Csr {
+        let id = |i: usize, j: usize| i * m + j;
+        let mut t = Vec::new();
+        for i in 0..m {
+            for j in 0..m {
+                t.push((id(i, j), id(i, j), 4.0));
+                if i > 0 {
+                    t.push((id(i, j), id(i - 1, j), -1.0));
+                }
+                if i + 1 < m {
+                    t.push((id(i, j), id(i + 1, j), -1.0));
+                }
+                if j > 0 {
+                    t.push((id(i, j), id(i, j - 1), -1.0));
+                }
+                if j + 1 < m {
+                    t.push((id(i, j), id(i, j + 1), -1.0));
+                }
+            }
+        }
+        Csr::from_triplets(m * m, &t)
+    }
+
+    #[test]
+    fn aggregates_are_small_connected_and_cover_the_coupled_rows() {
+        let a = lap2d(100);
+        let (transfers, sizes) = hierarchy(&a, COARSEST);
+        assert!(sizes.len() >= 3, "{sizes:?}");
+        assert_eq!(*sizes.last().unwrap(), 10_000);
+        assert!(sizes[0] <= COARSEST, "{sizes:?}");
+        // Coarsening ratio close to 4 per level.
+        for w in sizes.windows(2) {
+            let ratio = w[1] as f64 / w[0] as f64;
+            assert!(ratio > 3.0 && ratio <= 4.0 + 1e-12, "{sizes:?}");
+        }
+        let t = transfers.last().unwrap();
+        let mut members = vec![Vec::new(); t.n_coarse];
+        for (v, (p, w)) in t.parents.iter().zip(&t.weights).enumerate() {
+            // Every row of the Laplacian is coupled: every row is in an aggregate.
+            assert_eq!(*w, [1.0, 0.0]);
+            members[p[0] as usize].push(v);
+        }
+        for m in &members {
+            assert!(!m.is_empty() && m.len() <= 4, "{m:?}");
+            // Connected: every member has a neighbour in the aggregate (or is alone).
+            for &v in m {
+                assert!(m.len() == 1 || m.iter().any(|&u| u != v && a.get(u, v) != 0.0));
+            }
+        }
+    }
+
+    #[test]
+    fn dominant_rows_are_left_to_the_smoother() {
+        let mut a = lap2d(10);
+        // Row 0 gets a huge diagonal (a stiff foundation).
+        let k = a.pattern.find(0, 0).unwrap();
+        a.val[k] = 1e6;
+        let (agg, n) = pairwise(&a);
+        assert_eq!(agg[0], NONE);
+        assert!(agg[1..].iter().all(|&g| (g as usize) < n));
+    }
+}

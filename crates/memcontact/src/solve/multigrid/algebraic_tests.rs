@@ -1,0 +1,226 @@
+//! TNNMG on algebraic (aggregation) hierarchies, on unstructured meshes without refinement
+//! levels: a Gmsh mesh with two regions and a hole, the disc and polygon generators.
+//! Checked against the active-set method (an independent formulation, Problem 2f with
+//! sparse Cholesky), with monotone energy, bounded iteration counts under refinement and
+//! results independent of the number of threads.
+
+use super::*;
+use crate::fem::Coefficient;
+use crate::mesh::generate::{disk, polygon, PolygonSpec};
+use crate::mesh::{Mesh, Point};
+use crate::model::{Foundation, ProblemData, Sampling, Stiffness};
+use crate::solve::{active_set, Silent};
+use crate::sparse::norm_inf;
+
+/// A coefficient given per region and point.
+struct ByRegion<F: Fn(Point, u32) -> f64 + Sync>(F);
+
+impl<F: Fn(Point, u32) -> f64 + Sync> Coefficient for ByRegion<F> {
+    fn at(&self, p: Point, region: u32) -> f64 {
+        (self.0)(p, region)
+    }
+    fn on_region(&self, _: u32) -> Option<f64> {
+        None
+    }
+}
+
+/// The Gmsh fixture: a 2 × 1 site with a hole, regions "foam" (tag 1) and "soil" (tag 2).
+fn site() -> Mesh {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/site.msh");
+    crate::io::gmsh::read_msh(&path).unwrap().0
+}
+
+/// The data of the tests: f = 20, φ = 0.3 + 0.05 sin 2πx cos 2πy, h by region (foam 100,
+/// soil 1000) or constant, or rigid (`h = None`).
+fn model(mesh: &Mesh, h: Option<&dyn Coefficient>, foundation: Foundation) -> Model {
+    use std::f64::consts::PI;
+    let phi =
+        ByRegion(|p: Point, _| 0.3 + 0.05 * (2.0 * PI * p[0]).sin() * (2.0 * PI * p[1]).cos());
+    Model::assemble(
+        mesh,
+        &ProblemData {
+            tension: 1.0,
+            load: &20.0,
+            shape: &phi,
+            stiffness: match h {
+                Some(h) => Stiffness::Elastic(h),
+                None => Stiffness::Rigid,
+            },
+            foundation,
+            sampling: Sampling::Nodal,
+        },
+    )
+    .unwrap()
+}
+
+fn settings() -> Settings {
+    Settings {
+        method: Method::Multigrid,
+        tolerance: 1e-11,
+        ..Settings::default()
+    }
+}
+
+/// Options that coarsen small test meshes over several levels.
+fn options() -> Options {
+    Options {
+        coarsest: 40,
+        ..Options::default()
+    }
+}
+
+fn rel_diff(a: &[f64], b: &[f64]) -> f64 {
+    let num = a
+        .iter()
+        .zip(b)
+        .fold(0.0f64, |m, (x, y)| m.max((x - y).abs()));
+    num / norm_inf(b).max(1e-300)
+}
+
+/// Algebraic TNNMG against the active-set method, with its energy history monotone.
+fn agrees_with_active_set(model: &Model, what: &str) -> usize {
+    let (sol, rep) = solve_with(
+        model,
+        Coarsening::Algebraic,
+        &settings(),
+        &options(),
+        None,
+        &mut Silent,
+    )
+    .unwrap();
+    assert_eq!(sol.coarsening, Some(Kind::Algebraic));
+    assert!(
+        sol.certificate.kkt() <= 1e-11,
+        "{what}: {:?}",
+        sol.certificate
+    );
+    let reference = active_set::solve(model, &settings(), None, &mut Silent).unwrap();
+    let d = rel_diff(&sol.u, &reference.u);
+    assert!(d < 1e-8, "{what}: differs from active set by {d:e}");
+    for w in sol.history.windows(2) {
+        assert!(
+            w[1].energy <= w[0].energy + 1e-13 * w[0].energy.abs(),
+            "{what}: J rises {} -> {}",
+            w[0].energy,
+            w[1].energy
+        );
+    }
+    assert_eq!(rep.levels.len(), 1, "no nested iteration on aggregates");
+    sol.iterations
+}
+
+#[test]
+fn hierarchy_of_the_gmsh_site_has_several_levels() {
+    let mesh = site();
+    let m = model(&mesh, Some(&1000.0), Foundation::Consistent);
+    let levels = Levels::algebraic(&setup_matrix(&m), options().coarsest);
+    assert_eq!(levels.kind, Kind::Algebraic);
+    assert!(levels.len() >= 3, "{:?}", levels.sizes);
+    assert_eq!(levels.n(levels.len() - 1), m.n());
+    assert!(levels.sizes.windows(2).all(|w| w[0] < w[1]));
+}
+
+#[test]
+fn algebraic_tnnmg_agrees_with_the_active_set_method() {
+    let mesh = site();
+    // h by region: foam (1) soft, soil (2) stiff.
+    let regions = ByRegion(|_, r| if r == 1 { 100.0 } else { 1000.0 });
+    let varying = ByRegion(|p: Point, _| 200.0 + 300.0 * p[0]);
+    for foundation in [Foundation::Consistent, Foundation::Lumped] {
+        for (h, name) in [
+            (&1000.0 as &dyn Coefficient, "constant"),
+            (&regions as &dyn Coefficient, "region table"),
+            (&varying as &dyn Coefficient, "expression"),
+        ] {
+            let m = model(&mesh, Some(h), foundation);
+            agrees_with_active_set(&m, &format!("site, {name}, {foundation:?}"));
+        }
+    }
+    let rigid = model(&mesh, None, Foundation::Consistent);
+    agrees_with_active_set(&rigid, "site, rigid");
+    // The generators without refinement: the disc and a polygon with a hole and regions.
+    let d = disk([0.0, 0.0], 1.0, 0.08).unwrap();
+    agrees_with_active_set(&model(&d, Some(&300.0), Foundation::Consistent), "disc");
+    agrees_with_active_set(&model(&d, None, Foundation::Lumped), "disc, rigid");
+    let p = polygon(&l_shape(0.08)).unwrap();
+    let m = model(&p, Some(&regions), Foundation::Lumped);
+    agrees_with_active_set(&m, "polygon");
+}
+
+/// An L-shaped polygon with a square hole and a region "foam" (tag 1).
+fn l_shape(size: f64) -> PolygonSpec {
+    PolygonSpec {
+        outer: vec![
+            [0.0, 0.0],
+            [2.0, 0.0],
+            [2.0, 1.0],
+            [1.0, 1.0],
+            [1.0, 2.0],
+            [0.0, 2.0],
+        ],
+        holes: vec![vec![[0.3, 0.3], [0.6, 0.3], [0.6, 0.6], [0.3, 0.6]]],
+        regions: vec![(
+            "foam".into(),
+            vec![[1.0, 0.0], [2.0, 0.0], [2.0, 1.0], [1.0, 1.0]],
+        )],
+        size,
+        min_angle: 25.0,
+    }
+}
+
+#[test]
+fn iteration_counts_stay_bounded_under_refinement() {
+    // Four unstructured meshes of the same polygon, each meshed anew (no hierarchy).
+    let regions = ByRegion(|_, r| if r == 1 { 100.0 } else { 1000.0 });
+    for foundation in [Foundation::Consistent, Foundation::Lumped] {
+        let counts: Vec<usize> = [0.1, 0.05, 0.025, 0.0125]
+            .iter()
+            .map(|&size| {
+                let mesh = polygon(&l_shape(size)).unwrap();
+                let m = model(&mesh, Some(&regions), foundation);
+                let (sol, _) = solve_with(
+                    &m,
+                    Coarsening::Algebraic,
+                    &settings(),
+                    &Options::default().with_coarsest(200),
+                    None,
+                    &mut Silent,
+                )
+                .unwrap();
+                assert!(sol.certificate.kkt() <= 1e-11);
+                sol.iterations
+            })
+            .collect();
+        let (lo, hi) = (counts[0], *counts.iter().max().unwrap());
+        assert!(hi <= lo + 3, "{foundation:?}: {counts:?}");
+    }
+}
+
+#[test]
+fn results_do_not_depend_on_the_thread_count() {
+    // Large enough for the parallel paths (blocks of the smoother, reductions).
+    let mesh = disk([0.0, 0.0], 1.0, 0.008).unwrap();
+    let m = model(&mesh, Some(&1000.0), Foundation::Consistent);
+    assert!(m.n() > 2 * super::cycle::GS_BLOCK, "{}", m.n());
+    let run = |threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        pool.install(|| {
+            solve_with(
+                &m,
+                Coarsening::Algebraic,
+                &settings(),
+                &Options::default(),
+                None,
+                &mut Silent,
+            )
+            .unwrap()
+            .0
+        })
+    };
+    let (one, two) = (run(1), run(2));
+    assert_eq!(one.u, two.u);
+    assert_eq!(one.iterations, two.iterations);
+}
