@@ -208,6 +208,8 @@ fn problem(c: &Case) -> Problem {
             sampling: SamplingKind::Nodal,
             epsilon: None,
         },
+        boundary: Default::default(),
+        lower: None,
     }
 }
 
