@@ -373,7 +373,7 @@ impl Discretization {
         // The fields and totals of the answer (pressures, forces, areas) must be finite
         // too: refused here, before any caller reports or writes them.
         let (fields, totals) = derive_from(self.mesh(), &self.model, &a.solution.u);
-        crate::checks::check_results(&self.mesh(), &fields, &totals)?;
+        crate::checks::check_results(self.mesh(), &fields, &totals)?;
         let seconds = t0.elapsed().as_secs_f64();
         observer.phase_finished("solve", seconds);
         let mut phases = self.phases.clone();

@@ -288,8 +288,9 @@ impl Summary {
 
     /// The boundary counts, when the case has boundary heights or free edges.
     fn with_boundary(mut self, outcome: &Outcome) -> Summary {
+        // The model's unknowns are numbered on the solved (possibly renumbered) mesh.
         let m = &outcome.discretization.model;
-        let mesh = outcome.mesh();
+        let mesh = outcome.discretization.mesh();
         let on_boundary = mesh.boundary_vertices();
         let free = on_boundary
             .iter()
