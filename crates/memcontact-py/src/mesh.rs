@@ -558,7 +558,9 @@ pub fn rectangle(
 }
 
 /// An unstructured mesh of the disc of `center` and `radius` with elements of about
-/// `size` (default radius/8); boundary vertices lie on the circle.
+/// `size` (default radius/8); boundary vertices lie on the circle. A mesh of more than
+/// about 150 000 triangles is a coarser Delaunay mesh refined uniformly, with its levels
+/// (for multigrid).
 #[pyfunction]
 #[pyo3(signature = (center=(0.0, 0.0), radius=1.0, size=None))]
 pub fn disk(
@@ -568,10 +570,10 @@ pub fn disk(
     size: Option<f64>,
 ) -> PyResult<PyMesh> {
     let size = size.unwrap_or(radius / 8.0);
-    let mesh = py
-        .detach(|| generate::disk([center.0, center.1], radius, size))
+    let h = py
+        .detach(|| generate::disk_levels([center.0, center.1], radius, size))
         .map_err(py_err)?;
-    Ok(PyMesh::new_from(Hierarchy::single(mesh)))
+    Ok(PyMesh::new_from(h))
 }
 
 /// A named region polygon, as Python gives it.
@@ -580,6 +582,8 @@ type NamedPolygon = (String, Vec<(f64, f64)>);
 /// A constrained Delaunay mesh of the polygon `outer` minus `holes`, with named
 /// sub-polygons `regions` (a dict name -> polygon; triangles outside all of them are the
 /// region "default"), elements of about `size` and angles of at least `min_angle` degrees.
+/// A mesh of more than about 150 000 triangles is a coarser Delaunay mesh refined
+/// uniformly, with its levels (for multigrid).
 #[pyfunction]
 #[pyo3(signature = (outer, size, holes=None, regions=None, min_angle=25.0))]
 pub fn polygon(
@@ -611,8 +615,10 @@ pub fn polygon(
         size,
         min_angle,
     };
-    let mesh = py.detach(|| generate::polygon(&spec)).map_err(py_err)?;
-    Ok(PyMesh::new_from(Hierarchy::single(mesh)))
+    let h = py
+        .detach(|| generate::polygon_levels(&spec))
+        .map_err(py_err)?;
+    Ok(PyMesh::new_from(h))
 }
 
 /// Reads a Gmsh mesh (MSH 2.2 or 4.1, ASCII or binary): the mesh and the reader's warnings.

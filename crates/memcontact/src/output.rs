@@ -95,15 +95,31 @@ pub fn input_hash(case: &Case) -> String {
     format!("{:016x}", h.digest())
 }
 
-/// The size and hash of a written file.
+/// The size and hash of a written file (read in blocks: a result file of hundreds of MB
+/// is never held in memory twice).
 pub fn file_record(path: &Path) -> Result<FileRecord> {
-    let bytes = std::fs::read(path).map_err(|source| Error::Io {
+    use std::io::Read;
+    let io = |source| Error::Io {
         path: path.to_path_buf(),
         source,
-    })?;
+    };
+    let mut file = std::fs::File::open(path).map_err(io)?;
+    let mut hasher = xxhash_rust::xxh3::Xxh3::new();
+    let mut buf = vec![0u8; 1 << 20];
+    let mut bytes = 0u64;
+    loop {
+        let n = match file.read(&mut buf) {
+            Ok(0) => break,
+            Ok(n) => n,
+            Err(e) if e.kind() == std::io::ErrorKind::Interrupted => continue,
+            Err(e) => return Err(io(e)),
+        };
+        hasher.update(&buf[..n]);
+        bytes += n as u64;
+    }
     Ok(FileRecord {
-        bytes: bytes.len() as u64,
-        xxh3: format!("{:016x}", xxhash_rust::xxh3::xxh3_64(&bytes)),
+        bytes,
+        xxh3: format!("{:016x}", hasher.digest()),
     })
 }
 

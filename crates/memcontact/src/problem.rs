@@ -640,14 +640,14 @@ impl MeshSpec {
                 center,
                 radius,
                 size,
-            } => Hierarchy::single(generate::disk(center, radius, size)?),
+            } => generate::disk_levels(center, radius, size)?,
             MeshSource::Polygon {
                 outer,
                 holes,
                 regions,
                 size,
                 min_angle,
-            } => Hierarchy::single(generate::polygon(&PolygonSpec {
+            } => generate::polygon_levels(&PolygonSpec {
                 outer: outer.clone(),
                 holes: holes.clone(),
                 regions: regions
@@ -656,7 +656,7 @@ impl MeshSpec {
                     .collect(),
                 size: *size,
                 min_angle: *min_angle,
-            })?),
+            })?,
         };
         if self.refine > 0 {
             let base = MeshSize::of(hierarchy.finest());

@@ -164,7 +164,9 @@ def disk(
     center: Point = (0.0, 0.0), radius: float = 1.0, size: Optional[float] = None
 ) -> Mesh:
     """An unstructured mesh of a disc with elements of about ``size`` (default radius/8);
-    the boundary vertices lie on the circle, and refining keeps them there."""
+    the boundary vertices lie on the circle, and refining keeps them there. A mesh of more
+    than about 150 000 triangles is a coarser Delaunay mesh refined uniformly, and carries
+    its levels for multigrid."""
     return _native.disk((float(center[0]), float(center[1])), float(radius), size)
 
 
@@ -179,7 +181,9 @@ def polygon(
     elements of about ``size``, angles of at least ``min_angle`` degrees (≤ 30).
     ``regions`` names sub-polygons (a dict name → points, or a list of ``(name, points)``
     or of the case file's ``{"name": ..., "polygon": ...}``): their triangles get a tag named
-    after them (usable as keys of region tables); the rest is the region ``"default"``."""
+    after them (usable as keys of region tables); the rest is the region ``"default"``.
+    A mesh of more than about 150 000 triangles is a coarser Delaunay mesh refined
+    uniformly, and carries its levels for multigrid."""
     hole_list = [_points(h, "holes") for h in (holes or [])]
     if regions is None:
         region_list: List[Tuple[str, List[Point]]] = []

@@ -20,6 +20,24 @@ pub const MAX_TRIANGLES: f64 = 1e7;
 /// levels together take about 40 bytes per finest triangle).
 pub const MAX_STRUCTURED_TRIANGLES: f64 = 1.5e8;
 
+/// The unstructured generators make at most about this many triangles by Delaunay
+/// refinement: a finer mesh is made coarse and refined uniformly ([`disk_levels`],
+/// [`polygon_levels`]), which is many times faster than Delaunay refinement, keeps every
+/// angle of the coarse mesh and gives multigrid its levels.
+pub const DELAUNAY_TRIANGLES: f64 = 1.5e5;
+
+/// How many uniform refinements (each quarters the element area) bring a mesh of about
+/// `estimate` triangles down to at most [`DELAUNAY_TRIANGLES`] on its coarsest level.
+fn uniform_levels(estimate: f64) -> u32 {
+    let mut k = 0;
+    let mut e = estimate;
+    while e > DELAUNAY_TRIANGLES {
+        e /= 4.0;
+        k += 1;
+    }
+    k
+}
+
 /// How each cell of a structured rectangle mesh is cut into triangles.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 #[serde(rename_all = "lowercase")]
@@ -312,29 +330,7 @@ fn structured_parents(cx: usize, cy: usize, diagonal: Diagonal) -> Refinement {
 /// vertices the refinement adds on chords are projected onto the circle, so every boundary
 /// vertex lies on it; `mesh.curve` records the circle for later refinement.
 pub fn disk(center: Point, radius: f64, size: f64) -> Result<Mesh> {
-    if !center[0].is_finite() || !center[1].is_finite() {
-        return Err(Error::Mesh(format!(
-            "disk: centre ({}, {}) is not finite",
-            center[0], center[1]
-        )));
-    }
-    if !radius.is_finite() || radius <= 0.0 {
-        return Err(Error::Mesh(format!(
-            "disk: radius must be positive and finite, got {radius}"
-        )));
-    }
-    if !size.is_finite() || size <= 0.0 {
-        return Err(Error::Mesh(format!(
-            "disk: element size must be positive and finite, got {size}"
-        )));
-    }
-    let estimate = estimated_triangles(PI * radius * radius, size);
-    if estimate > MAX_TRIANGLES {
-        return Err(Error::Mesh(format!(
-            "disk: size {size} is too small for radius {radius}: about {estimate:.2e} \
-             triangles, more than the limit {MAX_TRIANGLES:.0e}"
-        )));
-    }
+    let estimate = disk_estimate(center, radius, size)?;
     let n = ((2.0 * PI * radius / size).ceil() as usize).max(6);
     let on_circle: Vec<Point> = (0..n)
         .map(|k| {
@@ -373,6 +369,107 @@ pub fn disk(center: Point, radius: f64, size: f64) -> Result<Mesh> {
     let mut mesh = Mesh::new(points, triangles, vec![], BTreeMap::new())?;
     mesh.curve = Some(circle);
     tag_boundary(mesh, |_| 1, BTreeMap::from([(1, "outer".to_string())]))
+}
+
+/// Checks the disc's data and returns the triangle count its mesh will have, refused
+/// above [`MAX_TRIANGLES`].
+fn disk_estimate(center: Point, radius: f64, size: f64) -> Result<f64> {
+    if !center[0].is_finite() || !center[1].is_finite() {
+        return Err(Error::Mesh(format!(
+            "disk: centre ({}, {}) is not finite",
+            center[0], center[1]
+        )));
+    }
+    if !radius.is_finite() || radius <= 0.0 {
+        return Err(Error::Mesh(format!(
+            "disk: radius must be positive and finite, got {radius}"
+        )));
+    }
+    if !size.is_finite() || size <= 0.0 {
+        return Err(Error::Mesh(format!(
+            "disk: element size must be positive and finite, got {size}"
+        )));
+    }
+    let estimate = estimated_triangles(PI * radius * radius, size);
+    if estimate > MAX_TRIANGLES {
+        return Err(Error::Mesh(format!(
+            "disk: size {size} is too small for radius {radius}: about {estimate:.2e} \
+             triangles, more than the limit {MAX_TRIANGLES:.0e}"
+        )));
+    }
+    Ok(estimate)
+}
+
+/// The disc of [`disk`] as a hierarchy: with more than [`DELAUNAY_TRIANGLES`] triangles
+/// expected, the disc meshed at `size · 2ᵏ` and refined uniformly `k` times (new boundary
+/// vertices on the circle), so that the finest level has element size about `size` and the
+/// coarse mesh's angles; otherwise the single mesh of [`disk`].
+pub fn disk_levels(center: Point, radius: f64, size: f64) -> Result<Hierarchy> {
+    let k = uniform_levels(disk_estimate(center, radius, size)?);
+    let coarse = disk(center, radius, size * f64::from(1u32 << k))?;
+    Ok(Hierarchy::refined(coarse, k as usize))
+}
+
+/// The polygon of [`polygon`] as a hierarchy: with more than [`DELAUNAY_TRIANGLES`]
+/// triangles expected, meshed at `size · 2ᵏ` and refined uniformly `k` times (regions and
+/// boundary regions inherited), so that the finest level has element size about `size` and
+/// the coarse mesh's angles (at least `min_angle`); otherwise the single mesh of
+/// [`polygon`].
+pub fn polygon_levels(spec: &PolygonSpec) -> Result<Hierarchy> {
+    let estimate = polygon_estimate(spec);
+    if !(estimate.is_finite() && estimate <= MAX_TRIANGLES) {
+        // Bad data or too many triangles: the direct generator names the problem.
+        return polygon(spec).map(Hierarchy::single);
+    }
+    let k = uniform_levels(estimate);
+    let coarse = polygon(&PolygonSpec {
+        size: spec.size * f64::from(1u32 << k),
+        ..spec.clone()
+    })?;
+    Ok(Hierarchy::refined(coarse, k as usize))
+}
+
+/// The box that pads a polygon's triangulation, whether faces outside the constraints are
+/// excluded during refinement, and the area refinement fills.
+fn padded_domain(spec: &PolygonSpec) -> ([Point; 4], bool, f64) {
+    // The triangulation is padded by a box around the polygon: its boundary points then
+    // never form the triangulation's convex hull, where three nearly collinear points of a
+    // subdivided edge (one rounded a hair outside the others' line) would be forced into a
+    // flat triangle. The padding lies outside the polygon and is dropped.
+    let (lo, hi) = spec.outer.iter().fold(
+        ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]),
+        |(lo, hi), p| {
+            (
+                [lo[0].min(p[0]), lo[1].min(p[1])],
+                [hi[0].max(p[0]), hi[1].max(p[1])],
+            )
+        },
+    );
+    let margin = spec.size.max(0.05 * (hi[0] - lo[0]).max(hi[1] - lo[1]));
+    let padding = [
+        [lo[0] - margin, lo[1] - margin],
+        [hi[0] + margin, lo[1] - margin],
+        [hi[0] + margin, hi[1] + margin],
+        [lo[0] - margin, hi[1] + margin],
+    ];
+    // With regions the parity rule that excludes outer faces would also exclude regions:
+    // refine the whole padded box then, and drop the outside afterwards.
+    let exclude_outer = spec.regions.is_empty();
+    let refined_area = if exclude_outer {
+        ring_area(&spec.outer).abs() - spec.holes.iter().map(|h| ring_area(h).abs()).sum::<f64>()
+    } else {
+        ring_area(&padding).abs()
+    };
+    (padding, exclude_outer, refined_area)
+}
+
+/// The triangle count [`polygon`] will make for `spec` (not checked: `NaN` or huge for bad
+/// data).
+fn polygon_estimate(spec: &PolygonSpec) -> f64 {
+    if spec.outer.len() < 3 {
+        return f64::NAN;
+    }
+    estimated_triangles(padded_domain(spec).2, spec.size)
 }
 
 /// The triangle count that Delaunay refinement with area bound `size²·√3/4` typically
@@ -480,7 +577,6 @@ pub fn polygon(spec: &PolygonSpec) -> Result<Mesh> {
         )));
     }
     check_ring(&spec.outer, "outer polygon")?;
-    let outer_area = ring_area(&spec.outer).abs();
     for (h, hole) in spec.holes.iter().enumerate() {
         let what = format!("hole {h}");
         check_ring(hole, &what)?;
@@ -517,34 +613,7 @@ pub fn polygon(spec: &PolygonSpec) -> Result<Mesh> {
             }
         }
     }
-    // The triangulation is padded by a box around the polygon: its boundary points then
-    // never form the triangulation's convex hull, where three nearly collinear points of a
-    // subdivided edge (one rounded a hair outside the others' line) would be forced into a
-    // flat triangle. The padding lies outside the polygon and is dropped.
-    let (lo, hi) = spec.outer.iter().fold(
-        ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]),
-        |(lo, hi), p| {
-            (
-                [lo[0].min(p[0]), lo[1].min(p[1])],
-                [hi[0].max(p[0]), hi[1].max(p[1])],
-            )
-        },
-    );
-    let margin = size.max(0.05 * (hi[0] - lo[0]).max(hi[1] - lo[1]));
-    let padding = [
-        [lo[0] - margin, lo[1] - margin],
-        [hi[0] + margin, lo[1] - margin],
-        [hi[0] + margin, hi[1] + margin],
-        [lo[0] - margin, hi[1] + margin],
-    ];
-    // With regions the parity rule that excludes outer faces would also exclude regions:
-    // refine the whole padded box then, and drop the outside afterwards.
-    let exclude_outer = spec.regions.is_empty();
-    let refined_area = if exclude_outer {
-        outer_area - spec.holes.iter().map(|h| ring_area(h).abs()).sum::<f64>()
-    } else {
-        ring_area(&padding).abs()
-    };
+    let (padding, exclude_outer, refined_area) = padded_domain(spec);
     let estimate = estimated_triangles(refined_area, size);
     if estimate > MAX_TRIANGLES {
         return Err(Error::Mesh(format!(
@@ -1156,6 +1225,72 @@ mod tests {
         // Refining keeps the boundary on the circle and the area converges.
         let (f, _) = refine_uniform(&m);
         assert!(PI * r * r - f.total_area() < err / 3.0);
+    }
+
+    #[test]
+    fn fine_disks_and_polygons_are_coarse_meshes_refined_with_their_guarantees() {
+        // Small: one Delaunay mesh, as `disk` makes it.
+        let small = disk_levels([0.0, 0.0], 1.0, 0.1).unwrap();
+        assert_eq!(small.levels.len(), 1);
+        assert_eq!(
+            triangle_set(small.finest()),
+            triangle_set(&disk([0.0, 0.0], 1.0, 0.1).unwrap())
+        );
+        // Fine: about 4× more triangles than the limit of Delaunay refinement.
+        let (c, r, h) = ([0.3, -0.2], 1.0, 0.005);
+        let levels = disk_levels(c, r, h).unwrap();
+        assert!(levels.levels.len() >= 2, "uniform refinements");
+        let m = levels.finest();
+        let q = revalidate(m).quality();
+        let expected = estimated_triangles(PI * r * r, h);
+        assert!(
+            (0.6 * expected..1.4 * expected).contains(&(q.triangles as f64)),
+            "{} triangles for {expected:.0} expected",
+            q.triangles
+        );
+        // The size and angle guarantees of `disk` (snapping to the circle costs a little
+        // of the 30° at the boundary), every boundary vertex on the circle.
+        assert!(q.min_angle_deg > 25.0, "{q:?}");
+        assert!(q.l_n < 2.0 * h, "{q:?}");
+        let boundary = m.boundary_vertices();
+        for (v, p) in m.points.iter().enumerate() {
+            if boundary[v] {
+                let d = crate::mesh::dist(*p, c);
+                assert!((d - r).abs() < 1e-12, "boundary vertex {v} at {d}");
+            }
+        }
+        assert_eq!(m.boundary.names.get(&1).map(String::as_str), Some("outer"));
+
+        // A polygon with a hole and a region: areas exact, regions and boundary regions
+        // carried to the finest level, angles at least the coarse mesh's.
+        let spec = PolygonSpec {
+            outer: square(0.0, 2.0),
+            holes: vec![square(0.2, 0.6)],
+            regions: vec![(
+                "clay".into(),
+                vec![[1.0, 1.0], [2.0, 1.0], [2.0, 2.0], [1.0, 2.0]],
+            )],
+            size: 0.006,
+            min_angle: 28.0,
+        };
+        let levels = polygon_levels(&spec).unwrap();
+        assert!(levels.levels.len() >= 2);
+        let m = levels.finest();
+        let q = revalidate(m).quality();
+        assert!((q.area - (4.0 - 0.16)).abs() < 1e-9, "{}", q.area);
+        assert!(q.min_angle_deg > 27.9, "{q:?}");
+        assert!(q.l_n < 2.0 * spec.size, "{q:?}");
+        let clay: f64 = (0..m.triangles.len())
+            .filter(|&k| m.regions[k] == 1)
+            .map(|k| m.area(k))
+            .sum();
+        assert!((clay - 1.0).abs() < 1e-9, "{clay}");
+        assert_eq!(m.region_name(1), "clay");
+        let names: Vec<&str> = m.boundary.names.values().map(String::as_str).collect();
+        assert_eq!(names, ["outer", "hole1"]);
+        // Too fine is refused as by `polygon`.
+        let e = polygon_levels(&PolygonSpec { size: 1e-5, ..spec }).unwrap_err();
+        assert!(e.to_string().contains("limit"), "{e}");
     }
 
     #[test]
