@@ -11,7 +11,8 @@
 # fuzz/seeds/; crashes land in fuzz/artifacts/TARGET. Installs cargo-fuzz when missing.
 # RUSTC_BOOTSTRAP=1 lets the stable compiler take the sanitizer flags cargo-fuzz passes.
 set -euo pipefail
-cd "$(dirname "$0")"
+self="$(cd "$(dirname "$0")" && pwd)/$(basename "$0")"
+cd "$(dirname "$self")"
 target="${1:?usage: fuzz/run.sh TARGET|all [SECONDS] [libFuzzer flags]}"
 seconds="${2:-60}"
 shift $(( $# >= 2 ? 2 : 1 ))
@@ -21,7 +22,7 @@ if ! cargo fuzz --version >/dev/null 2>&1; then
 fi
 TARGETS=(case expr gmsh gmsh_flavours mesh)
 if [ "$target" = all ]; then
-    for t in "${TARGETS[@]}"; do "$0" "$t" "$seconds" "$@"; done
+    for t in "${TARGETS[@]}"; do "$self" "$t" "$seconds" "$@"; done
     exit 0
 fi
 
