@@ -420,22 +420,24 @@ impl<'a> Multigrid<'a> {
         }
     }
 
+    /// On coarse level `k ≥ 1`: `x[k] = 0`, `ν₁` Gauss-Seidel sweeps on `A_k x[k] = b[k]`,
+    /// and the residual restricted into `b[k − 1]`.
+    fn presmooth_and_restrict(&mut self, k: usize) {
+        let (a, inv) = (&self.coarse[k], &self.inv_diag[k]);
+        let (xk, bk) = (&mut self.x[k], &self.b[k]);
+        xk.iter_mut().for_each(|v| *v = 0.0);
+        for _ in 0..self.smoothing.0 {
+            gauss_seidel(a, inv, xk, bk, &mut self.snap[k], false);
+        }
+        residual(a, xk, bk, &mut self.r[k]);
+        let (bl, _) = self.b.split_at_mut(k);
+        self.levels.transfers[k - 1].restrict(&self.r[k], &mut bl[k - 1]);
+    }
+
     /// One K-cycle on coarse level `k ≥ 1` for `A_k x[k] = b[k]`, from `x[k] = 0`.
     fn coarse_k_cycle(&mut self, k: usize) {
-        let (nu1, nu2) = self.smoothing;
-        {
-            let (a, inv) = (&self.coarse[k], &self.inv_diag[k]);
-            let (xk, bk) = (&mut self.x[k], &self.b[k]);
-            xk.iter_mut().for_each(|v| *v = 0.0);
-            for _ in 0..nu1 {
-                gauss_seidel(a, inv, xk, bk, &mut self.snap[k], false);
-            }
-            residual(a, xk, bk, &mut self.r[k]);
-        }
-        {
-            let (bl, _) = self.b.split_at_mut(k);
-            self.levels.transfers[k - 1].restrict(&self.r[k], &mut bl[k - 1]);
-        }
+        let (_, nu2) = self.smoothing;
+        self.presmooth_and_restrict(k);
         self.krylov_correction(k - 1);
         let (xl, xu) = self.x.split_at_mut(k);
         self.levels.transfers[k - 1].prolongate_add(&xl[k - 1], &mut xu[0]);
@@ -545,15 +547,7 @@ impl<'a> Multigrid<'a> {
         residual(fine, x, b, &mut self.r[top]);
         self.levels.transfers[top - 1].restrict(&self.r[top], &mut self.b[top - 1]);
         for k in (1..top).rev() {
-            let (a, inv) = (&self.coarse[k], &self.inv_diag[k]);
-            let (xk, bk) = (&mut self.x[k], &self.b[k]);
-            xk.iter_mut().for_each(|v| *v = 0.0);
-            for _ in 0..nu1 {
-                gauss_seidel(a, inv, xk, bk, &mut self.snap[k], false);
-            }
-            residual(a, xk, bk, &mut self.r[k]);
-            let (bl, _) = self.b.split_at_mut(k);
-            self.levels.transfers[k - 1].restrict(&self.r[k], &mut bl[k - 1]);
+            self.presmooth_and_restrict(k);
         }
         // Bottom: the direct solve.
         self.solve_coarsest_in_place(Some(0));
