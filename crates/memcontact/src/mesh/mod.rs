@@ -137,8 +137,10 @@ impl Mesh {
                 || (usize::MAX, 0usize),
                 |(first, neg), (k, t)| {
                     let a = signed_area(&points, t);
-                    // |2A| ≤ 2e-12 d², d the longest edge (squared lengths, no roots).
-                    let degenerate = a.abs() <= 1e-12 * longest_edge_squared(&points, t);
+                    let d2 = longest_edge_squared(&points, t);
+                    // |2A| ≤ 2e-12 d², d the longest edge (squared lengths, no roots); an
+                    // area or edge that overflows is refused with the degenerate ones.
+                    let degenerate = !(a.is_finite() && d2.is_finite()) || a.abs() <= 1e-12 * d2;
                     (
                         if degenerate { first.min(k) } else { first },
                         neg + usize::from(a < 0.0),
@@ -148,6 +150,18 @@ impl Mesh {
             .reduce(|| (usize::MAX, 0), |x, y| (x.0.min(y.0), x.1 + y.1));
         if degenerate != usize::MAX {
             let t = triangles[degenerate];
+            let (a, d2) = (signed_area(&points, &t), longest_edge_squared(&points, &t));
+            if !(a.is_finite() && d2.is_finite()) {
+                let far = t
+                    .iter()
+                    .map(|&v| points[v as usize])
+                    .fold(0.0f64, |m, p| m.max(p[0].abs()).max(p[1].abs()));
+                return Err(Error::Mesh(format!(
+                    "triangle {degenerate} (vertices {}, {}, {}) has coordinates up to {far:e}: \
+                     its area overflows double precision; rescale the mesh (units)",
+                    t[0], t[1], t[2]
+                )));
+            }
             return Err(Error::Mesh(format!(
                 "triangle {degenerate} (vertices {}, {}, {}) is degenerate: area {:e}",
                 t[0],
@@ -586,6 +600,16 @@ mod tests {
         )
         .unwrap_err();
         assert!(e.to_string().contains("degenerate"), "{e}");
+        // Found by fuzzing: one vertex at 4.4e252 made the area overflow (NaN) and the
+        // mesh was accepted with a total area of NaN.
+        let e = Mesh::new(
+            vec![[4.44e252, 4.82e228], [0.415, -0.910], [0.305, -0.819]],
+            vec![[0, 1, 2]],
+            vec![],
+            BTreeMap::new(),
+        )
+        .unwrap_err();
+        assert!(e.to_string().contains("overflows"), "{e}");
         let e = Mesh::new(
             p.clone(),
             vec![[0, 1, 2], [1, 2, 3]],
