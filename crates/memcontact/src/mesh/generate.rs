@@ -27,7 +27,8 @@ pub const MAX_STRUCTURED_TRIANGLES: f64 = 1.5e8;
 pub const DELAUNAY_TRIANGLES: f64 = 1.5e5;
 
 /// How many uniform refinements (each quarters the element area) bring a mesh of about
-/// `estimate` triangles down to at most [`DELAUNAY_TRIANGLES`] on its coarsest level.
+/// `estimate` triangles down to at most [`DELAUNAY_TRIANGLES`] on its coarsest level; at
+/// least two when any, so that the levels make a multigrid hierarchy `auto` takes.
 fn uniform_levels(estimate: f64) -> u32 {
     let mut k = 0;
     let mut e = estimate;
@@ -35,7 +36,11 @@ fn uniform_levels(estimate: f64) -> u32 {
         e /= 4.0;
         k += 1;
     }
-    k
+    if k > 0 {
+        k.max(2)
+    } else {
+        0
+    }
 }
 
 /// How each cell of a structured rectangle mesh is cut into triangles.
@@ -1239,7 +1244,7 @@ mod tests {
         // Fine: about 4× more triangles than the limit of Delaunay refinement.
         let (c, r, h) = ([0.3, -0.2], 1.0, 0.005);
         let levels = disk_levels(c, r, h).unwrap();
-        assert!(levels.levels.len() >= 2, "uniform refinements");
+        assert!(levels.levels.len() >= 3, "at least two uniform refinements");
         let m = levels.finest();
         let q = revalidate(m).quality();
         let expected = estimated_triangles(PI * r * r, h);
@@ -1274,7 +1279,7 @@ mod tests {
             min_angle: 28.0,
         };
         let levels = polygon_levels(&spec).unwrap();
-        assert!(levels.levels.len() >= 2);
+        assert!(levels.levels.len() >= 3);
         let m = levels.finest();
         let q = revalidate(m).quality();
         assert!((q.area - (4.0 - 0.16)).abs() < 1e-9, "{}", q.area);
