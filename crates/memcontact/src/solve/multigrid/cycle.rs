@@ -434,14 +434,12 @@ impl<'a> Multigrid<'a> {
         self.levels.transfers[k - 1].restrict(&self.r[k], &mut bl[k - 1]);
     }
 
-    /// One K-cycle on coarse level `k ≥ 1` for `A_k x[k] = b[k]`, from `x[k] = 0`.
-    fn coarse_k_cycle(&mut self, k: usize) {
-        let (_, nu2) = self.smoothing;
-        self.presmooth_and_restrict(k);
-        self.krylov_correction(k - 1);
+    /// On coarse level `k ≥ 1`: the correction of level `k − 1` prolongated into `x[k]`,
+    /// then `ν₂` Gauss-Seidel sweeps (in reverse order) on `A_k x[k] = b[k]`.
+    fn prolongate_and_postsmooth(&mut self, k: usize) {
         let (xl, xu) = self.x.split_at_mut(k);
         self.levels.transfers[k - 1].prolongate_add(&xl[k - 1], &mut xu[0]);
-        for _ in 0..nu2 {
+        for _ in 0..self.smoothing.1 {
             gauss_seidel(
                 &self.coarse[k],
                 &self.inv_diag[k],
@@ -451,6 +449,13 @@ impl<'a> Multigrid<'a> {
                 true,
             );
         }
+    }
+
+    /// One K-cycle on coarse level `k ≥ 1` for `A_k x[k] = b[k]`, from `x[k] = 0`.
+    fn coarse_k_cycle(&mut self, k: usize) {
+        self.presmooth_and_restrict(k);
+        self.krylov_correction(k - 1);
+        self.prolongate_and_postsmooth(k);
     }
 
     /// Number of levels used.
@@ -553,18 +558,7 @@ impl<'a> Multigrid<'a> {
         self.solve_coarsest_in_place(Some(0));
         // Up: prolongate the correction, smooth.
         for k in 1..top {
-            let (xl, xu) = self.x.split_at_mut(k);
-            self.levels.transfers[k - 1].prolongate_add(&xl[k - 1], &mut xu[0]);
-            for _ in 0..nu2 {
-                gauss_seidel(
-                    &self.coarse[k],
-                    &self.inv_diag[k],
-                    &mut xu[0],
-                    &self.b[k],
-                    &mut self.snap[k],
-                    true,
-                );
-            }
+            self.prolongate_and_postsmooth(k);
         }
         self.levels.transfers[top - 1].prolongate_add(&self.x[top - 1], x);
         for _ in 0..nu2 {
