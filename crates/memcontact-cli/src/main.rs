@@ -14,6 +14,11 @@ use clap::{Parser, Subcommand};
 use std::path::PathBuf;
 use std::process::ExitCode;
 
+/// mimalloc keeps freed memory for reuse: the solver's large work vectors are not handed
+/// back to the kernel and faulted in again page by page on every allocation.
+#[global_allocator]
+static ALLOCATOR: mimalloc::MiMalloc = mimalloc::MiMalloc;
+
 /// Contact between a stretched membrane and an elastic (Winkler) obstacle: the discrete
 /// model of Maceri & Maceri (1986), solved exactly and certified.
 ///
