@@ -184,7 +184,7 @@ impl Canvas {
     /// Writes the canvas as a PNG file, atomically.
     pub fn write_png(&self, path: &Path) -> Result<()> {
         let png = self.encode_png()?;
-        memcontact::io::write_atomic(path, |w| w.write_all(&png))
+        memcontact::io::write_atomic(path, |w| w.write_all(&png)).map(|_| ())
     }
 }
 

@@ -124,14 +124,14 @@ pub fn file_record(path: &Path) -> Result<FileRecord> {
 }
 
 /// Writes `solution.vtu` (with `run_id` in its field data) and `nodes.csv` of `fields` on
-/// the outcome's mesh into `dir`.
+/// the outcome's mesh into `dir`; returns their names and records, hashed as written.
 pub fn write_fields(
     dir: &Path,
     outcome: &Outcome,
     fields: &NodalFields,
     vtu: VtuFormat,
     run_id: &str,
-) -> Result<()> {
+) -> Result<Vec<(String, FileRecord)>> {
     let mesh = outcome.mesh();
     let region: Vec<i32> = mesh.regions.iter().map(|&r| r as i32).collect();
     let state: Vec<i32> = fields.state.iter().map(|&s| s as i32).collect();
@@ -190,8 +190,10 @@ pub fn write_fields(
         },
         || write_columns_csv(&dir.join("nodes.csv"), &columns),
     );
-    vtu_written?;
-    csv_written
+    Ok(vec![
+        ("solution.vtu".to_string(), vtu_written?.into()),
+        ("nodes.csv".to_string(), csv_written?.into()),
+    ])
 }
 
 /// Writes the files of `outcome` into the directory `dir` (which must exist and is not
@@ -214,16 +216,16 @@ pub fn write_files(
         outcome.discretization.model.is_rigid(),
     )?;
     let run_id = options.run_id.clone().unwrap_or_else(new_run_id);
-    write_fields(dir, outcome, &fields, options.vtu, &run_id)?;
-    let mut names = vec!["solution.vtu".to_string(), "nodes.csv".to_string()];
-    names.extend(extra(dir, &fields)?);
+    let written = write_fields(dir, outcome, &fields, options.vtu, &run_id)?;
+    let names = extra(dir, &fields)?;
     // Order-independent: the mesh in the solver's numbering will do.
     let quality = outcome.discretization.mesh().quality();
     let mut summary = Summary::new(&options.label, outcome, &quality, &totals);
     summary.run_id = run_id;
     summary.input_hash = input_hash(case);
     summary.plot_options = options.plot_options.clone();
-    // The files are hashed side by side.
+    // The fields' files were hashed as they were written; the extra files (pictures) are
+    // read back, side by side.
     let records: Vec<FileRecord> = {
         use rayon::prelude::*;
         names
@@ -231,6 +233,7 @@ pub fn write_files(
             .map(|name| file_record(&dir.join(name)))
             .collect::<Result<_>>()?
     };
+    summary.files.extend(written);
     summary.files.extend(names.into_iter().zip(records));
     summary.time_write_s = t0.elapsed().as_secs_f64();
     summary.time_total_s = options.started.elapsed().as_secs_f64();
@@ -369,7 +372,7 @@ pub fn write_sweep_csv(path: &Path, rows: &[StepRow]) -> Result<()> {
         text.push_str(&cells.join(","));
         text.push('\n');
     }
-    crate::io::write_atomic(path, |w| w.write_all(text.as_bytes()))
+    crate::io::write_atomic(path, |w| w.write_all(text.as_bytes())).map(|_| ())
 }
 
 /// `manifest.json` of a sweep or a convergence study: the run id, the input's hash, and

@@ -18,6 +18,15 @@ pub struct FileRecord {
     pub xxh3: String,
 }
 
+impl From<crate::io::Written> for FileRecord {
+    fn from(w: crate::io::Written) -> FileRecord {
+        FileRecord {
+            bytes: w.bytes,
+            xxh3: w.hex(),
+        }
+    }
+}
+
 /// Everything `summary.json` holds.
 #[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct Summary {
@@ -283,20 +292,15 @@ impl Summary {
             max_pressure_low: totals.lower.map(|t| t.max_pressure_low),
             liftoff_area_low: totals.lower.map(|t| t.liftoff_area_low),
         }
-        .with_boundary(outcome)
+        .with_boundary(outcome, quality)
     }
 
     /// The boundary counts, when the case has boundary heights or free edges.
-    fn with_boundary(mut self, outcome: &Outcome) -> Summary {
-        // The model's unknowns are numbered on the solved (possibly renumbered) mesh.
+    fn with_boundary(mut self, outcome: &Outcome, quality: &MeshQuality) -> Summary {
         let m = &outcome.discretization.model;
-        let mesh = outcome.discretization.mesh();
-        let on_boundary = mesh.boundary_vertices();
-        let free = on_boundary
-            .iter()
-            .enumerate()
-            .filter(|(v, &b)| b && m.dofs.dof[*v].is_some())
-            .count();
+        // Every vertex off the boundary is an unknown: the other unknowns are the free
+        // boundary vertices.
+        let free = m.n().saturating_sub(quality.unknowns);
         let heights = m.boundary_values.iter().any(|&g| g != 0.0);
         if free > 0 || heights {
             self.fixed_vertices = Some(m.dofs.dof.iter().filter(|d| d.is_none()).count());

@@ -1,16 +1,54 @@
 //! Atomic file writes: write to a temporary file beside the target, then rename, so that a
-//! failed run never leaves a half-written output behind.
+//! failed run never leaves a half-written output behind. The bytes are counted and hashed
+//! as they are written ([`Written`]), so a result set's manifest never reads its files back.
 
 use crate::{Error, Result};
 use std::io::Write;
 use std::path::Path;
 
+/// The size and XXH3-64 digest of a file's bytes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Written {
+    /// Bytes written.
+    pub bytes: u64,
+    /// XXH3-64 of the bytes.
+    pub xxh3: u64,
+}
+
+impl Written {
+    /// The digest as 16 hex digits (how `summary.json` and `manifest.json` record it).
+    pub fn hex(&self) -> String {
+        format!("{:016x}", self.xxh3)
+    }
+}
+
+/// A writer that counts and hashes the bytes it passes on.
+struct Hashing<W: Write> {
+    inner: W,
+    hasher: xxhash_rust::xxh3::Xxh3,
+    bytes: u64,
+}
+
+impl<W: Write> Write for Hashing<W> {
+    fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
+        let n = self.inner.write(buf)?;
+        self.hasher.update(&buf[..n]);
+        self.bytes += n as u64;
+        Ok(n)
+    }
+
+    fn flush(&mut self) -> std::io::Result<()> {
+        self.inner.flush()
+    }
+}
+
 /// Writes `path` atomically: `fill` writes into a buffered temporary file in the same
-/// directory, which is renamed over `path` only if `fill` and the flush succeed.
+/// directory, which is renamed over `path` only if `fill` and the flush succeed. Returns
+/// the size and digest of what was written.
 pub fn write_atomic(
     path: &Path,
     fill: impl FnOnce(&mut dyn Write) -> std::io::Result<()>,
-) -> Result<()> {
+) -> Result<Written> {
     let io_err = |source| Error::Io {
         path: path.to_path_buf(),
         source,
@@ -26,17 +64,25 @@ pub fn write_atomic(
     let tmp = dir.join(format!(".{name}.tmp{}", std::process::id()));
     let result = (|| {
         let file = std::fs::File::create(&tmp)?;
-        let mut w = std::io::BufWriter::with_capacity(1 << 20, file);
+        let mut w = Hashing {
+            inner: std::io::BufWriter::with_capacity(1 << 20, file),
+            hasher: xxhash_rust::xxh3::Xxh3::new(),
+            bytes: 0,
+        };
         fill(&mut w)?;
         w.flush()?;
-        w.into_inner().map_err(|e| e.into_error())?.sync_all()?;
-        std::fs::rename(&tmp, path)
+        let written = Written {
+            bytes: w.bytes,
+            xxh3: w.hasher.digest(),
+        };
+        w.inner.into_inner().map_err(|e| e.into_error())?.sync_all()?;
+        std::fs::rename(&tmp, path)?;
+        Ok(written)
     })();
-    if let Err(e) = result {
+    result.map_err(|e| {
         let _ = std::fs::remove_file(&tmp);
-        return Err(io_err(e));
-    }
-    Ok(())
+        io_err(e)
+    })
 }
 
 #[cfg(test)]
@@ -48,8 +94,11 @@ mod tests {
         let tmp = tempfile::tempdir().unwrap();
         let dir = tmp.path();
         let p = dir.join("a.txt");
-        write_atomic(&p, |w| w.write_all(b"hello")).unwrap();
+        let written = write_atomic(&p, |w| w.write_all(b"hello")).unwrap();
         assert_eq!(std::fs::read_to_string(&p).unwrap(), "hello");
+        // The digest is that of the bytes on disk, computed independently.
+        assert_eq!(written.bytes, 5);
+        assert_eq!(written.xxh3, xxhash_rust::xxh3::xxh3_64(b"hello"));
         let q = dir.join("b.txt");
         let r = write_atomic(&q, |w| {
             w.write_all(b"half")?;

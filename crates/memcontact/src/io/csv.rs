@@ -21,7 +21,10 @@ use std::path::Path;
 /// Writes `columns` side by side: a header row with the names, then row `i` holding value
 /// `i` of every column. All columns must have the same length ([`Error::Data`] naming the
 /// first column that differs otherwise); at least one column is required.
-pub fn write_columns_csv(path: &Path, columns: &[(&str, DataArray)]) -> Result<()> {
+pub fn write_columns_csv(
+    path: &Path,
+    columns: &[(&str, DataArray)],
+) -> Result<crate::io::Written> {
     let Some((first, first_data)) = columns.first() else {
         return Err(Error::Data(format!(
             "CSV {}: no column to write",
@@ -40,20 +43,31 @@ pub fn write_columns_csv(path: &Path, columns: &[(&str, DataArray)]) -> Result<(
         let mut head = Vec::new();
         push_header(&mut head, &names);
         w.write_all(&head)?;
-        // Blocks of rows are formatted in parallel, a batch at a time, and written in order.
+        // Blocks of rows are formatted in parallel, a batch at a time, and written in order;
+        // a batch is written while the next one is formatted.
         let blocks = rows.div_ceil(ROWS_PER_BLOCK);
         let batch = 4 * rayon::current_num_threads().max(1);
-        for first in (0..blocks).step_by(batch) {
-            let texts: Vec<Vec<u8>> = (first..(first + batch).min(blocks))
+        let format_batch = |first: usize| -> Vec<Vec<u8>> {
+            (first..(first + batch).min(blocks))
                 .into_par_iter()
                 .map(|b| {
                     let range = b * ROWS_PER_BLOCK..((b + 1) * ROWS_PER_BLOCK).min(rows);
                     format_rows(columns, range)
                 })
-                .collect();
-            for text in &texts {
-                w.write_all(text)?;
-            }
+                .collect()
+        };
+        let mut texts = format_batch(0);
+        let mut next = batch;
+        while !texts.is_empty() {
+            let mut following = Vec::new();
+            rayon::in_place_scope(|s| {
+                if next < blocks {
+                    s.spawn(|_| following = format_batch(next));
+                }
+                texts.iter().try_for_each(|t| w.write_all(t))
+            })?;
+            texts = following;
+            next += batch;
         }
         Ok(())
     })
@@ -114,6 +128,7 @@ pub fn write_table_csv(path: &Path, header: &[&str], rows: &[Vec<f64>]) -> Resul
         }
         w.write_all(&buf)
     })
+    .map(|_| ())
 }
 
 /// Size of the staging buffer, in bytes.
@@ -138,13 +153,33 @@ fn push_header(buf: &mut Vec<u8>, names: &[&str]) {
 /// Appends `x` in its shortest round-trip form; NaN as nothing (an empty field).
 fn push_f64(buf: &mut Vec<u8>, x: f64) {
     if x.is_finite() {
-        buf.extend_from_slice(ryu::Buffer::new().format_finite(x).as_bytes());
+        push_shortest(buf, x);
     } else if x.is_nan() {
         // empty field
     } else if x > 0.0 {
         buf.extend_from_slice(b"inf");
     } else {
         buf.extend_from_slice(b"-inf");
+    }
+}
+
+/// Appends the finite `x` in the shortest form that reads back to the same `f64`, with
+/// exponents written without a plus sign (`1e16`, `2.5e-7`), the form of every text file
+/// memcontact writes.
+pub(crate) fn push_shortest(buf: &mut Vec<u8>, x: f64) {
+    let mut b = zmij::Buffer::new();
+    let text = b.format_finite(x).as_bytes();
+    // Only numbers of magnitude 1e16 and more are written with a positive exponent.
+    if x.abs() < 1e15 {
+        buf.extend_from_slice(text);
+        return;
+    }
+    match text.iter().position(|&c| c == b'+') {
+        Some(k) => {
+            buf.extend_from_slice(&text[..k]);
+            buf.extend_from_slice(&text[k + 1..]);
+        }
+        None => buf.extend_from_slice(text),
     }
 }
 
@@ -211,6 +246,46 @@ pub(crate) mod tests {
         assert_eq!(rows[5][0], "-inf");
         assert!(text.ends_with('\n'));
         std::fs::remove_file(&path).unwrap();
+    }
+
+    /// The shortest round-trip form: parses back to the same bits, has as many significant
+    /// digits as the standard library's own shortest form (`{:e}`), and no `+` in exponents.
+    #[test]
+    fn shortest_form_round_trips_with_the_fewest_digits() {
+        let mut state = 0x2545_f491_4f6c_dd1d_u64;
+        let mut values = vec![0.1, 1e16, 1e-7, 1e22, 5e-324, f64::MAX, -0.0, 123456789.0];
+        for k in 0..200_000 {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            let x = match k % 3 {
+                0 => f64::from_bits(state),
+                1 => (state >> 11) as f64 * 2f64.powi(-53),
+                _ => (state % 100_000) as f64 * 10f64.powi((state % 60) as i32 - 30),
+            };
+            if x.is_finite() {
+                values.push(x);
+            }
+        }
+        let digits = |s: &str| {
+            let mantissa = s.split(['e', 'E']).next().unwrap();
+            let d: String = mantissa.chars().filter(|c| c.is_ascii_digit()).collect();
+            d.trim_start_matches('0').trim_end_matches('0').len().max(1)
+        };
+        let mut buf = Vec::new();
+        for &x in &values {
+            buf.clear();
+            push_shortest(&mut buf, x);
+            let text = std::str::from_utf8(&buf).unwrap();
+            assert!(same(text.parse().unwrap(), x), "{x:e} written {text}");
+            assert!(!text.contains('+'), "{text}");
+            assert_eq!(digits(text), digits(&format!("{x:e}")), "{x:e} written {text}");
+        }
+        for (x, text) in [(0.1, "0.1"), (1e16, "1e16"), (1e-7, "1e-7"), (-0.0, "-0.0")] {
+            buf.clear();
+            push_shortest(&mut buf, x);
+            assert_eq!(std::str::from_utf8(&buf).unwrap(), text);
+        }
     }
 
     #[test]

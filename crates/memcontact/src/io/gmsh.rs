@@ -957,6 +957,7 @@ pub fn write_msh(path: &Path, mesh: &Mesh, version: MshVersion) -> Result<()> {
         MshVersion::V41Ascii => write_v41(w, mesh, false),
         MshVersion::V41Binary => write_v41(w, mesh, true),
     })
+    .map(|_| ())
 }
 
 fn write_header(

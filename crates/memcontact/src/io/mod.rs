@@ -6,7 +6,7 @@ pub mod gmsh;
 pub mod json;
 pub mod result_set;
 pub mod vtu;
-pub use atomic::write_atomic;
+pub use atomic::{write_atomic, Written};
 
 /// A path in a fresh temporary directory that is removed with it (tests of the writers).
 #[cfg(test)]

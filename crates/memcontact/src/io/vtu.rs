@@ -17,6 +17,7 @@
 //!
 //! The file is written atomically ([`crate::io::write_atomic`]).
 
+use crate::io::Written;
 use crate::mesh::Mesh;
 use crate::{Error, Result};
 use std::io::Write;
@@ -70,7 +71,7 @@ pub fn write_vtu(
     point_data: &[(&str, DataArray)],
     cell_data: &[(&str, DataArray)],
     encoding: VtuEncoding,
-) -> Result<()> {
+) -> Result<Written> {
     write_vtu_impl(path, mesh, None, point_data, cell_data, encoding, &[])
 }
 
@@ -84,7 +85,7 @@ pub fn write_vtu_with_field_data(
     cell_data: &[(&str, DataArray)],
     encoding: VtuEncoding,
     field_data: &[(&str, &str)],
-) -> Result<()> {
+) -> Result<Written> {
     write_vtu_impl(
         path, mesh, None, point_data, cell_data, encoding, field_data,
     )
@@ -99,7 +100,7 @@ pub fn write_vtu_warped(
     point_data: &[(&str, DataArray)],
     cell_data: &[(&str, DataArray)],
     encoding: VtuEncoding,
-) -> Result<()> {
+) -> Result<Written> {
     write_vtu_impl(path, mesh, Some(z), point_data, cell_data, encoding, &[])
 }
 
@@ -292,7 +293,7 @@ fn write_le<T: Copy, const N: usize>(
 /// Appends `x` in its shortest round-trip form (`nan`, `inf`, `-inf` when not finite).
 fn push_f64(buf: &mut Vec<u8>, x: f64) {
     if x.is_finite() {
-        buf.extend_from_slice(ryu::Buffer::new().format_finite(x).as_bytes());
+        super::csv::push_shortest(buf, x);
     } else if x.is_nan() {
         buf.extend_from_slice(b"nan");
     } else if x > 0.0 {
@@ -367,7 +368,7 @@ fn write_vtu_impl(
     cell_data: &[(&str, DataArray)],
     encoding: VtuEncoding,
     field_data: &[(&str, &str)],
-) -> Result<()> {
+) -> Result<Written> {
     let n_points = mesh.points.len();
     let n_cells = mesh.triangles.len();
     check_arrays(point_data, n_points, "point data")?;
