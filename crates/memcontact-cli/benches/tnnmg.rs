@@ -5,6 +5,10 @@
 //! `MEMCONTACT_NO_NESTED` override the TNNMG options.
 
 use memcontact::bench::{run_bench, BenchRow};
+
+/// The allocator of the `memcontact` binary, so that the kernels are timed as it runs them.
+#[global_allocator]
+static ALLOCATOR: mimalloc::MiMalloc = mimalloc::MiMalloc;
 use memcontact::model::Foundation;
 use memcontact::solve::multigrid::Options;
 

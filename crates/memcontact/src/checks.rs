@@ -18,8 +18,10 @@ use crate::{Error, Result};
 /// ([`Model::assemble_with`]) between the checks of the boundary data
 /// ([`check_boundary_data`]) and of overflow ([`check_model`]).
 pub fn assemble(mesh: &Mesh, data: &ProblemData, ext: &Extensions) -> Result<Model> {
-    check_boundary_data(mesh, data, ext)?;
-    let model = Model::assemble_with(mesh, data, ext)?;
+    let adj = VertexTriangles::new(mesh);
+    let boundary = mesh.boundary_vertices_with(&adj);
+    check_boundary_data_on(mesh, &adj, &boundary, data, ext)?;
+    let model = Model::assemble_on(mesh, &adj, &boundary, data, ext)?;
     check_model(mesh, &model)?;
     Ok(model)
 }
@@ -29,9 +31,20 @@ pub fn assemble(mesh: &Mesh, data: &ProblemData, ext: &Extensions) -> Result<Mod
 /// next to the fixed boundary, that it leaves room for the prescribed height g there
 /// (`φ ≥ g` above, `φ_low ≤ g` below: otherwise no continuous solution exists).
 pub fn check_boundary_data(mesh: &Mesh, data: &ProblemData, ext: &Extensions) -> Result<()> {
-    let boundary = mesh.boundary_vertices();
     let adj = VertexTriangles::new(mesh);
-    let (fixed, heights) = crate::model::fixed_heights(mesh, &adj, ext)?;
+    let boundary = mesh.boundary_vertices_with(&adj);
+    check_boundary_data_on(mesh, &adj, &boundary, data, ext)
+}
+
+/// [`check_boundary_data`] given the mesh's adjacency and boundary vertices.
+fn check_boundary_data_on(
+    mesh: &Mesh,
+    adj: &VertexTriangles,
+    boundary: &[bool],
+    data: &ProblemData,
+    ext: &Extensions,
+) -> Result<()> {
+    let (fixed, heights) = crate::model::fixed_heights_on(mesh, adj, boundary, ext)?;
     let rigid_upper = |region: u32| {
         matches!(data.stiffness, Stiffness::Rigid) || ext.rigid_regions.contains(&region)
     };

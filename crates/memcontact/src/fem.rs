@@ -128,64 +128,79 @@ fn row_columns(mesh: &Mesh, dofs: &DofMap, adj: &VertexTriangles, v: usize, buf:
     buf.dedup();
 }
 
-/// Splits `val` into the rows of `pattern`, so that rows can be written in parallel.
-fn split_rows<'a, T>(pattern: &Pattern, mut val: &'a mut [T]) -> Vec<&'a mut [T]> {
-    let mut rows = Vec::with_capacity(pattern.n());
-    for i in 0..pattern.n() {
-        let (head, tail) = val.split_at_mut(pattern.row_ptr[i + 1] - pattern.row_ptr[i]);
-        rows.push(head);
+/// Rows per parallel task of assembly (fixed, so results do not depend on the thread count).
+const ROW_BLOCK: usize = 2048;
+
+/// The rows `first..first + ROW_BLOCK` (fewer in the last block) of every block.
+fn block_rows(n: usize, block: usize) -> std::ops::Range<usize> {
+    block * ROW_BLOCK..((block + 1) * ROW_BLOCK).min(n)
+}
+
+/// Splits `val` (values on `pattern`) into the blocks of [`ROW_BLOCK`] rows, so that blocks
+/// are filled in parallel.
+fn split_blocks<'a, T>(pattern: &Pattern, mut val: &'a mut [T]) -> Vec<&'a mut [T]> {
+    let n = pattern.n();
+    let mut blocks = Vec::with_capacity(n.div_ceil(ROW_BLOCK));
+    for b in 0..n.div_ceil(ROW_BLOCK) {
+        let rows = block_rows(n, b);
+        let len = pattern.row_ptr[rows.end] - pattern.row_ptr[rows.start];
+        let (head, tail) = std::mem::take(&mut val).split_at_mut(len);
+        blocks.push(head);
         val = tail;
     }
-    rows
+    blocks
 }
 
 /// The sparsity pattern over unknowns: `(i, j)` is stored when vertices `a_i`, `a_j` share
-/// a triangle. S and the consistent L live on it. Two parallel passes (lengths, then
-/// columns) with one scratch buffer per task: no allocation per row.
+/// a triangle. S and the consistent L live on it. One parallel pass over blocks of rows,
+/// whose columns are then concatenated.
 pub fn unknowns_pattern(mesh: &Mesh, dofs: &DofMap, adj: &VertexTriangles) -> Pattern {
-    let lengths: Vec<usize> = dofs
-        .vertex
-        .par_iter()
-        .with_min_len(4096)
-        .map_init(
-            || Vec::with_capacity(32),
-            |buf, &v| {
-                row_columns(mesh, dofs, adj, v as usize, buf);
-                buf.len()
-            },
-        )
+    let n = dofs.len();
+    let blocks: Vec<(Vec<u32>, Vec<u32>)> = (0..n.div_ceil(ROW_BLOCK))
+        .into_par_iter()
+        .map(|b| {
+            let rows = block_rows(n, b);
+            let mut lengths = Vec::with_capacity(rows.len());
+            let mut cols = Vec::with_capacity(rows.len() * 8);
+            let mut buf = Vec::with_capacity(32);
+            for i in rows {
+                row_columns(mesh, dofs, adj, dofs.vertex[i] as usize, &mut buf);
+                lengths.push(buf.len() as u32);
+                cols.extend_from_slice(&buf);
+            }
+            (lengths, cols)
+        })
         .collect();
-    let mut row_ptr = Vec::with_capacity(lengths.len() + 1);
+    let mut row_ptr = Vec::with_capacity(n + 1);
     row_ptr.push(0);
     let mut total = 0;
-    for l in &lengths {
-        total += l;
-        row_ptr.push(total);
+    for (lengths, _) in &blocks {
+        for &l in lengths {
+            total += l as usize;
+            row_ptr.push(total);
+        }
     }
-    let mut pattern = Pattern {
-        row_ptr,
-        col: vec![0; total],
-    };
-    let mut col = std::mem::take(&mut pattern.col);
-    split_rows(&pattern, &mut col)
-        .into_par_iter()
-        .enumerate()
-        .with_min_len(4096)
-        .for_each_init(
-            || Vec::with_capacity(32),
-            |buf, (i, row)| {
-                row_columns(mesh, dofs, adj, dofs.vertex[i] as usize, buf);
-                row.copy_from_slice(buf);
-            },
-        );
-    pattern.col = col;
-    pattern
+    let mut col = Vec::with_capacity(total);
+    for (_, cols) in &blocks {
+        col.extend_from_slice(cols);
+    }
+    Pattern { row_ptr, col }
+}
+
+/// The position of column `j` in the sorted columns `cols` of a row (a short linear scan:
+/// rows hold about seven entries).
+#[inline]
+fn position(cols: &[u32], j: u32) -> usize {
+    cols.iter()
+        .position(|&c| c == j)
+        .expect("the pattern covers the patch")
 }
 
 /// Assembles the stiffness matrix `S_ij = t ∫ ∇g_i·∇g_j` and, when `h` is given, the
 /// consistent foundation matrix `L_ij = ∫ h g_i g_j` on `pattern`, in one pass over the rows
-/// (SPEC §2). Entry `(i, j)` sums the element integrals of the triangles around `a_i`; rows
-/// are assembled in parallel and element geometry is computed once per (row, triangle).
+/// (SPEC §2). Entry `(i, j)` sums the element integrals of the triangles around `a_i`
+/// (`∫_T ∇λ_a·∇λ_b` from the edges opposite corners a and b, one division per triangle).
+/// Blocks of rows are assembled in parallel; the result does not depend on the thread count.
 pub fn assemble_stiffness_and_mass(
     mesh: &Mesh,
     dofs: &DofMap,
@@ -194,49 +209,118 @@ pub fn assemble_stiffness_and_mass(
     t: f64,
     h: Option<&dyn Coefficient>,
 ) -> (Csr, Option<Csr>) {
+    let n = pattern.n();
     let mut s = Csr::zeros(pattern.clone());
     let mut l = h.map(|_| Csr::zeros(pattern.clone()));
-    let s_rows = split_rows(pattern, &mut s.val);
-    let l_rows: Vec<Option<&mut [f64]>> = match &mut l {
-        Some(l) => split_rows(pattern, &mut l.val)
+    let s_blocks = split_blocks(pattern, &mut s.val);
+    let l_blocks: Vec<Option<&mut [f64]>> = match &mut l {
+        Some(l) => split_blocks(pattern, &mut l.val)
             .into_iter()
             .map(Some)
             .collect(),
-        None => (0..pattern.n()).map(|_| None).collect(),
+        None => (0..s_blocks.len()).map(|_| None).collect(),
     };
-    s_rows
+    s_blocks
         .into_par_iter()
-        .zip(l_rows)
+        .zip(l_blocks)
         .enumerate()
-        .with_min_len(1024)
-        .for_each(|(i, (srow, mut lrow))| {
-            let v = dofs.vertex[i] as usize;
-            let cols = &pattern.col[pattern.row_ptr[i]..pattern.row_ptr[i + 1]];
-            for &k in adj.of(v) {
-                let tri = mesh.triangles[k as usize];
-                let e = Element::of(mesh, k as usize);
-                let region = mesh.regions[k as usize];
-                let a = tri
-                    .iter()
-                    .position(|&w| w as usize == v)
-                    .expect("v in triangle");
-                let h_const = h.and_then(|h| h.on_region(region));
-                for (b, &w) in tri.iter().enumerate() {
-                    let Some(j) = dofs.dof[w as usize] else {
-                        continue;
+        .for_each(|(b, (s_block, mut l_block))| {
+            let rows = block_rows(n, b);
+            let base = pattern.row_ptr[rows.start];
+            for i in rows {
+                let range = pattern.row_ptr[i] - base..pattern.row_ptr[i + 1] - base;
+                let cols = &pattern.col[pattern.row_ptr[i]..pattern.row_ptr[i + 1]];
+                let v = dofs.vertex[i];
+                for &k in adj.of(v as usize) {
+                    let tri = mesh.triangles[k as usize];
+                    let a = if tri[0] == v {
+                        0
+                    } else if tri[1] == v {
+                        1
+                    } else {
+                        2
                     };
-                    let pos = cols.binary_search(&j).expect("pattern covers the patch");
-                    srow[pos] += t * e.stiffness(a, b);
-                    if let (Some(lrow), Some(h)) = (lrow.as_deref_mut(), h) {
-                        lrow[pos] += match h_const {
-                            Some(c) => c * e.area * if a == b { 1.0 / 6.0 } else { 1.0 / 12.0 },
-                            None => e.weighted_mass(h, region, a, b),
+                    let c = tri.map(|w| mesh.points[w as usize]);
+                    let e = [0, 1, 2].map(|q| {
+                        let (p, r) = (c[(q + 1) % 3], c[(q + 2) % 3]);
+                        [r[0] - p[0], r[1] - p[1]]
+                    });
+                    // Twice the area; ∇λ_k is e_k turned a quarter and divided by it, and
+                    // ∫_T ∇λ_a·∇λ_b = |T| (e_a·e_b) / (2|T|)² (the gradients are formed
+                    // first, so that an S that overflows shows as infinite).
+                    let two_area = e[2][0] * (-e[1][1]) + e[2][1] * e[1][0];
+                    let inv = 1.0 / two_area;
+                    let e = e.map(|q| [q[0] * inv, q[1] * inv]);
+                    let scale = t * 0.5 * two_area;
+                    let region = mesh.regions[k as usize];
+                    let h_const = h.and_then(|h| h.on_region(region));
+                    for (b, &w) in tri.iter().enumerate() {
+                        let Some(j) = dofs.dof[w as usize] else {
+                            continue;
                         };
+                        let pos = position(cols, j);
+                        s_block[range.start + pos] +=
+                            scale * (e[a][0] * e[b][0] + e[a][1] * e[b][1]);
+                        if let (Some(lb), Some(h)) = (l_block.as_deref_mut(), h) {
+                            lb[range.start + pos] += match h_const {
+                                Some(hc) => {
+                                    hc * 0.5
+                                        * two_area
+                                        * if a == b { 1.0 / 6.0 } else { 1.0 / 12.0 }
+                                }
+                                None => Element::new(c).weighted_mass(h, region, a, b),
+                            };
+                        }
                     }
                 }
             }
         });
     (s, l)
+}
+
+/// `∫_T c λ_a` for every corner a of triangle `k`, with `c` constant on the triangle's region
+/// (`|T| c / 3`, no element geometry beyond the area) or by quadrature.
+#[inline]
+fn element_load(mesh: &Mesh, k: usize, c: &dyn Coefficient, a: usize) -> f64 {
+    let region = mesh.regions[k];
+    match c.on_region(region) {
+        Some(v) => v * mesh.area(k) / 3.0,
+        None => Element::of(mesh, k).weighted_load(c, region, a),
+    }
+}
+
+/// The load-type vector `∫ c g_i` over unknowns (the paper's D for c = f, the lumped
+/// foundation diagonal for c = h): element areas only where c is constant on a region.
+pub fn assemble_load(
+    mesh: &Mesh,
+    dofs: &DofMap,
+    adj: &VertexTriangles,
+    c: &dyn Coefficient,
+) -> Vec<f64> {
+    dofs.vertex
+        .par_iter()
+        .with_min_len(1024)
+        .map(|&v| {
+            adj.of(v as usize)
+                .iter()
+                .map(|&k| {
+                    let t = mesh.triangles[k as usize];
+                    let a = t.iter().position(|&w| w == v).expect("v in triangle");
+                    element_load(mesh, k as usize, c, a)
+                })
+                .sum()
+        })
+        .collect()
+}
+
+/// `∫_Ω c` over the whole mesh (the total load for c = f), by the same element integrals
+/// as [`assemble_load`].
+pub fn integrate(mesh: &Mesh, c: &dyn Coefficient) -> f64 {
+    (0..mesh.n_triangles())
+        .into_par_iter()
+        .with_min_len(4096)
+        .map(|k| (0..3).map(|a| element_load(mesh, k, c, a)).sum::<f64>())
+        .sum()
 }
 
 /// Fills a vector over unknowns: entry `i` sums `local(element, region, a)` over the

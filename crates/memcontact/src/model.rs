@@ -6,7 +6,7 @@
 pub use crate::certificate::Certificate;
 use crate::fem::assemble_lift;
 use crate::fem::{
-    assemble_stiffness_and_mass, assemble_vector, unknowns_pattern, Coefficient, Element,
+    assemble_load, assemble_stiffness_and_mass, integrate, unknowns_pattern, Coefficient,
     VertexTriangles,
 };
 use crate::mesh::boundary::FixedBoundary;
@@ -272,20 +272,33 @@ impl Model {
     /// that is not finite, a membrane that nothing holds (no fixed boundary and no body
     /// that can stop it), both bodies rigid with φ_low > φ at some unknown.
     pub fn assemble_with(mesh: &Mesh, data: &ProblemData, ext: &Extensions) -> Result<Model> {
+        let adj = VertexTriangles::new(mesh);
+        let boundary = mesh.boundary_vertices_with(&adj);
+        Model::assemble_on(mesh, &adj, &boundary, data, ext)
+    }
+
+    /// [`Model::assemble_with`] given the mesh's vertex → triangles adjacency and its
+    /// boundary vertices (computed once per run and shared with the checks).
+    pub fn assemble_on(
+        mesh: &Mesh,
+        adj: &VertexTriangles,
+        boundary: &[bool],
+        data: &ProblemData,
+        ext: &Extensions,
+    ) -> Result<Model> {
         let t = data.tension;
         if !t.is_finite() || t <= 0.0 {
             return Err(Error::Data(format!(
                 "membrane.tension must be a finite number > 0, got {t}"
             )));
         }
-        let adj = VertexTriangles::new(mesh);
         let fixed = match &ext.boundary {
-            Some(b) => Some(FixedBoundary::new(mesh, &adj, b.free)?),
+            Some(b) => Some(FixedBoundary::new(mesh, adj, b.free)?),
             None => None,
         };
         let dofs = match &fixed {
             Some(f) => DofMap::from_fixed(&f.fixed),
-            None => DofMap::with_adjacency(mesh, &adj),
+            None => DofMap::from_fixed(boundary),
         };
         if dofs.is_empty() {
             return Err(Error::Mesh(
@@ -302,7 +315,7 @@ impl Model {
             foundation: data.foundation,
             sampling: data.sampling,
         };
-        let pattern = Arc::new(unknowns_pattern(mesh, &dofs, &adj));
+        let pattern = Arc::new(unknowns_pattern(mesh, &dofs, adj));
         // S and the upper body's consistent L share one pass over the rows.
         let masked = Masked::new(upper);
         let consistent_h = match (masked.elastic(), data.foundation) {
@@ -310,10 +323,10 @@ impl Model {
             _ => None,
         };
         let (s, l_consistent) =
-            assemble_stiffness_and_mass(mesh, &dofs, &adj, &pattern, t, consistent_h);
-        let body = assemble_body(mesh, &adj, &dofs, &upper, l_consistent, NAMES_UPPER)?;
+            assemble_stiffness_and_mass(mesh, &dofs, adj, &pattern, t, consistent_h);
+        let body = assemble_body(mesh, adj, &dofs, &upper, l_consistent, NAMES_UPPER)?;
         let load = data.load;
-        let mut d = assemble_vector(mesh, &dofs, &adj, &|e, r, a| e.weighted_load(load, r, a));
+        let mut d = assemble_load(mesh, &dofs, adj, load);
         if let Some(i) = d.iter().position(|v| !v.is_finite()) {
             let p = mesh.points[dofs.vertex[i] as usize];
             return Err(Error::Data(format!(
@@ -321,21 +334,13 @@ impl Model {
                 p[0], p[1]
             )));
         }
-        let total_load: f64 = (0..mesh.n_triangles())
-            .into_par_iter()
-            .with_min_len(4096)
-            .map(|k| {
-                let e = Element::of(mesh, k);
-                let r = mesh.regions[k];
-                (0..3).map(|a| e.weighted_load(load, r, a)).sum::<f64>()
-            })
-            .sum();
+        let total_load = integrate(mesh, load);
         // Boundary heights and the lifting S_fix G.
         let (boundary_values, lift) = match (&ext.boundary, &fixed) {
             (Some(b), Some(f)) => {
                 let g = boundary_heights(mesh, f, b.height)?;
                 if g.iter().any(|&x| x != 0.0) {
-                    let lift = assemble_lift(mesh, &dofs, &adj, t, &g);
+                    let lift = assemble_lift(mesh, &dofs, adj, t, &g);
                     (g, lift)
                 } else {
                     (Vec::new(), Vec::new())
@@ -351,13 +356,13 @@ impl Model {
                 let masked = Masked::new(*low);
                 let l_consistent = match (masked.elastic(), low.foundation) {
                     (Some(h), Foundation::Consistent) => {
-                        Some(assemble_mass(mesh, &dofs, &adj, &pattern, h))
+                        Some(assemble_mass(mesh, &dofs, adj, &pattern, h))
                     }
                     _ => None,
                 };
                 Some(assemble_body(
                     mesh,
-                    &adj,
+                    adj,
                     &dofs,
                     low,
                     l_consistent,
@@ -758,11 +763,7 @@ fn assemble_body(
     let l = match (masked.elastic(), l_consistent) {
         _ if wholly_rigid => FoundationMatrix::Rigid,
         (_, Some(l)) => FoundationMatrix::Consistent(l),
-        (Some(h), None) => {
-            FoundationMatrix::Lumped(assemble_vector(mesh, dofs, adj, &|e, r, a| {
-                e.weighted_load(h, r, a)
-            }))
-        }
+        (Some(h), None) => FoundationMatrix::Lumped(assemble_load(mesh, dofs, adj, h)),
         (None, None) => FoundationMatrix::Rigid,
     };
     let rigid: Option<Vec<bool>> = match (&rigid_vertex, wholly_rigid) {
@@ -825,16 +826,23 @@ pub fn fixed_heights(
     adj: &VertexTriangles,
     ext: &Extensions,
 ) -> Result<(Vec<bool>, Vec<f64>)> {
+    fixed_heights_on(mesh, adj, &mesh.boundary_vertices_with(adj), ext)
+}
+
+/// [`fixed_heights`] given the boundary vertices of the mesh.
+pub fn fixed_heights_on(
+    mesh: &Mesh,
+    adj: &VertexTriangles,
+    boundary: &[bool],
+    ext: &Extensions,
+) -> Result<(Vec<bool>, Vec<f64>)> {
     match &ext.boundary {
         Some(b) => {
             let fixed = FixedBoundary::new(mesh, adj, b.free)?;
             let g = boundary_heights(mesh, &fixed, b.height)?;
             Ok((fixed.fixed, g))
         }
-        None => Ok((
-            mesh.boundary_vertices_with(adj),
-            vec![0.0; mesh.n_vertices()],
-        )),
+        None => Ok((boundary.to_vec(), vec![0.0; mesh.n_vertices()])),
     }
 }
 

@@ -75,7 +75,10 @@ pub fn write_atomic(
             bytes: w.bytes,
             xxh3: w.hasher.digest(),
         };
-        w.inner.into_inner().map_err(|e| e.into_error())?.sync_all()?;
+        w.inner
+            .into_inner()
+            .map_err(|e| e.into_error())?
+            .sync_all()?;
         std::fs::rename(&tmp, path)?;
         Ok(written)
     })();

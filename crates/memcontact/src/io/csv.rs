@@ -21,10 +21,7 @@ use std::path::Path;
 /// Writes `columns` side by side: a header row with the names, then row `i` holding value
 /// `i` of every column. All columns must have the same length ([`Error::Data`] naming the
 /// first column that differs otherwise); at least one column is required.
-pub fn write_columns_csv(
-    path: &Path,
-    columns: &[(&str, DataArray)],
-) -> Result<crate::io::Written> {
+pub fn write_columns_csv(path: &Path, columns: &[(&str, DataArray)]) -> Result<crate::io::Written> {
     let Some((first, first_data)) = columns.first() else {
         return Err(Error::Data(format!(
             "CSV {}: no column to write",
@@ -279,7 +276,11 @@ pub(crate) mod tests {
             let text = std::str::from_utf8(&buf).unwrap();
             assert!(same(text.parse().unwrap(), x), "{x:e} written {text}");
             assert!(!text.contains('+'), "{text}");
-            assert_eq!(digits(text), digits(&format!("{x:e}")), "{x:e} written {text}");
+            assert_eq!(
+                digits(text),
+                digits(&format!("{x:e}")),
+                "{x:e} written {text}"
+            );
         }
         for (x, text) in [(0.1, "0.1"), (1e16, "1e16"), (1e-7, "1e-7"), (-0.0, "-0.0")] {
             buf.clear();
