@@ -136,12 +136,13 @@ fn pairwise(a: &Csr) -> (Vec<u32>, usize) {
 }
 
 /// The transfers of an aggregation hierarchy for the operator `a` (finest level), coarsest
-/// level first, with the level sizes, coarsest first. Coarsening stops at `coarsest`
-/// unknowns (see [`COARSEST`]), when a step no longer reduces the size enough, or at
-/// [`MAX_LEVELS`].
-pub fn hierarchy(a: &Csr, coarsest: usize) -> (Vec<Transfer>, Vec<usize>) {
+/// level first, with the level sizes and the Galerkin operator patterns (the finest is
+/// `a`'s), coarsest first. Coarsening stops at `coarsest` unknowns (see [`COARSEST`]), when
+/// a step no longer reduces the size enough, or at [`MAX_LEVELS`].
+pub fn hierarchy(a: &Csr, coarsest: usize) -> (Vec<Transfer>, Vec<usize>, Vec<Arc<Pattern>>) {
     let mut transfers: Vec<Transfer> = Vec::new();
     let mut sizes = vec![a.n()];
+    let mut patterns = vec![a.pattern.clone()];
     let mut current: Option<Csr> = None;
     while sizes.len() < MAX_LEVELS {
         let fine = current.as_ref().unwrap_or(a);
@@ -162,14 +163,18 @@ pub fn hierarchy(a: &Csr, coarsest: usize) -> (Vec<Transfer>, Vec<usize>) {
             break;
         }
         let t = Transfer::aggregation(&agg, n2);
-        let coarse = galerkin(fine, &t);
+        // P = P₁P₂, so PᵀAP = P₂ᵀ(P₁ᵀAP₁)P₂: the product from the half-size matrix, on
+        // the same pattern as PᵀAP (aggregation keeps every diagonal).
+        let coarse = galerkin(&a1, &Transfer::aggregation(&second, n2));
         transfers.push(t);
         sizes.push(n2);
+        patterns.push(coarse.pattern.clone());
         current = Some(coarse);
     }
     transfers.reverse();
     sizes.reverse();
-    (transfers, sizes)
+    patterns.reverse();
+    (transfers, sizes, patterns)
 }
 
 /// `PᵀAP` on its own pattern.
@@ -216,7 +221,15 @@ mod tests {
     #[test]
     fn aggregates_are_small_connected_and_cover_the_coupled_rows() {
         let a = lap2d(100);
-        let (transfers, sizes) = hierarchy(&a, COARSEST);
+        let (transfers, sizes, patterns) = hierarchy(&a, COARSEST);
+        // The patterns built from the half-size products are those of PᵀAP for the
+        // composed transfers, computed directly from the finest pattern.
+        let direct = galerkin_patterns(&transfers, a.pattern.clone());
+        assert_eq!(patterns.len(), direct.len());
+        for (p, q) in patterns.iter().zip(&direct) {
+            assert_eq!(p.row_ptr, q.row_ptr);
+            assert_eq!(p.col, q.col);
+        }
         assert!(sizes.len() >= 3, "{sizes:?}");
         assert_eq!(*sizes.last().unwrap(), 10_000);
         assert!(sizes[0] <= COARSEST, "{sizes:?}");

@@ -118,6 +118,12 @@ fn hierarchy_of_the_gmsh_site_has_several_levels() {
     assert!(levels.len() >= 3, "{:?}", levels.sizes);
     assert_eq!(levels.n(levels.len() - 1), m.n());
     assert!(levels.sizes.windows(2).all(|w| w[0] < w[1]));
+    // The operator patterns are those of PᵀAP for the composed aggregations, as the
+    // symbolic product from the finest pattern gives them.
+    let direct = super::transfer::galerkin_patterns(&levels.transfers, m.s.pattern.clone());
+    for (p, q) in levels.patterns.iter().zip(&direct) {
+        assert_eq!((&p.row_ptr, &p.col), (&q.row_ptr, &q.col));
+    }
 }
 
 #[test]

@@ -107,8 +107,7 @@ impl Levels {
     /// An algebraic hierarchy for the operator `a` (the finest level; its pattern is the
     /// finest pattern) by double pairwise aggregation, down to about `coarsest` unknowns.
     pub fn algebraic(a: &Csr, coarsest: usize) -> Levels {
-        let (transfers, sizes) = super::aggregation::hierarchy(a, coarsest);
-        let patterns = galerkin_patterns(&transfers, a.pattern.clone());
+        let (transfers, sizes, patterns) = super::aggregation::hierarchy(a, coarsest);
         Levels {
             kind: Kind::Algebraic,
             sizes,

@@ -587,6 +587,23 @@ pub fn kernel_timings(
     let mut delta = vec![0.0; n];
     let rhs: Vec<f64> = g.iter().map(|x| -x).collect();
     time("v-cycle", &mut || mg.v_cycle(&a, &mut delta, &rhs));
+    let inv: Vec<f64> = (0..n)
+        .map(|i| {
+            let d = a.get(i, i);
+            if d > 0.0 {
+                1.0 / d
+            } else {
+                0.0
+            }
+        })
+        .collect();
+    let mut snap = vec![0.0; n];
+    time("gauss-seidel sweep", &mut || {
+        cycle::gauss_seidel(&a, &inv, &mut delta, &rhs, &mut snap, false)
+    });
+    let mut res = vec![0.0; n];
+    time("residual", &mut || cycle::residual(&a, &delta, &rhs, &mut res));
+    time("matrix-vector product", &mut || a.mul_into(&delta, &mut res));
     for (i, d) in delta.iter_mut().enumerate() {
         if st.truncated[i] {
             *d = 0.0;
