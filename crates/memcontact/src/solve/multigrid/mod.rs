@@ -602,8 +602,12 @@ pub fn kernel_timings(
         cycle::gauss_seidel(&a, &inv, &mut delta, &rhs, &mut snap, false)
     });
     let mut res = vec![0.0; n];
-    time("residual", &mut || cycle::residual(&a, &delta, &rhs, &mut res));
-    time("matrix-vector product", &mut || a.mul_into(&delta, &mut res));
+    time("residual", &mut || {
+        cycle::residual(&a, &delta, &rhs, &mut res)
+    });
+    time("matrix-vector product", &mut || {
+        a.mul_into(&delta, &mut res)
+    });
     for (i, d) in delta.iter_mut().enumerate() {
         if st.truncated[i] {
             *d = 0.0;
