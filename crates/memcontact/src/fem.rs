@@ -8,7 +8,7 @@
 pub use crate::mesh::VertexTriangles;
 use crate::mesh::{DofMap, Mesh, Point};
 use crate::quadrature::{map, DEGREE5};
-use crate::sparse::{Csr, Pattern};
+use crate::sparse::{row_chunks, Csr, Pattern};
 use rayon::prelude::*;
 use std::sync::Arc;
 
@@ -136,21 +136,6 @@ fn block_rows(n: usize, block: usize) -> std::ops::Range<usize> {
     block * ROW_BLOCK..((block + 1) * ROW_BLOCK).min(n)
 }
 
-/// Splits `val` (values on `pattern`) into the blocks of [`ROW_BLOCK`] rows, so that blocks
-/// are filled in parallel.
-fn split_blocks<'a, T>(pattern: &Pattern, mut val: &'a mut [T]) -> Vec<&'a mut [T]> {
-    let n = pattern.n();
-    let mut blocks = Vec::with_capacity(n.div_ceil(ROW_BLOCK));
-    for b in 0..n.div_ceil(ROW_BLOCK) {
-        let rows = block_rows(n, b);
-        let len = pattern.row_ptr[rows.end] - pattern.row_ptr[rows.start];
-        let (head, tail) = std::mem::take(&mut val).split_at_mut(len);
-        blocks.push(head);
-        val = tail;
-    }
-    blocks
-}
-
 /// The sparsity pattern over unknowns: `(i, j)` is stored when vertices `a_i`, `a_j` share
 /// a triangle. S and the consistent L live on it. One parallel pass over blocks of rows,
 /// whose columns are then concatenated.
@@ -212,20 +197,19 @@ pub fn assemble_stiffness_and_mass(
     let n = pattern.n();
     let mut s = Csr::zeros(pattern.clone());
     let mut l = h.map(|_| Csr::zeros(pattern.clone()));
-    let s_blocks = split_blocks(pattern, &mut s.val);
+    let s_blocks = row_chunks(pattern, &mut s.val, ROW_BLOCK);
     let l_blocks: Vec<Option<&mut [f64]>> = match &mut l {
-        Some(l) => split_blocks(pattern, &mut l.val)
+        Some(l) => row_chunks(pattern, &mut l.val, ROW_BLOCK)
             .into_iter()
-            .map(Some)
+            .map(|(_, block)| Some(block))
             .collect(),
         None => (0..s_blocks.len()).map(|_| None).collect(),
     };
     s_blocks
         .into_par_iter()
         .zip(l_blocks)
-        .enumerate()
-        .for_each(|(b, (s_block, mut l_block))| {
-            let rows = block_rows(n, b);
+        .for_each(|((first, s_block), mut l_block)| {
+            let rows = first..(first + ROW_BLOCK).min(n);
             let base = pattern.row_ptr[rows.start];
             for i in rows {
                 let range = pattern.row_ptr[i] - base..pattern.row_ptr[i + 1] - base;

@@ -117,10 +117,11 @@ pub fn file_record(path: &Path) -> Result<FileRecord> {
         hasher.update(&buf[..n]);
         bytes += n as u64;
     }
-    Ok(FileRecord {
+    Ok(crate::io::Written {
         bytes,
-        xxh3: format!("{:016x}", hasher.digest()),
-    })
+        xxh3: hasher.digest(),
+    }
+    .into())
 }
 
 /// Writes `solution.vtu` (with `run_id` in its field data) and `nodes.csv` of `fields` on

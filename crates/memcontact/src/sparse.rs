@@ -262,6 +262,28 @@ pub fn norm_inf(a: &[f64]) -> f64 {
     a.iter().fold(0.0, |m, x| m.max(x.abs()))
 }
 
+/// Splits the value array of a matrix on `pattern` into blocks of `rows` consecutive rows:
+/// `(first row, values of those rows)`, so that blocks can be filled in parallel.
+pub(crate) fn row_chunks<'a>(
+    pattern: &Pattern,
+    val: &'a mut [f64],
+    rows: usize,
+) -> Vec<(usize, &'a mut [f64])> {
+    let n = pattern.n();
+    let mut out = Vec::with_capacity(n / rows + 1);
+    let mut rest = val;
+    let mut start = 0;
+    while start < n {
+        let end = (start + rows).min(n);
+        let len = pattern.row_ptr[end] - pattern.row_ptr[start];
+        let (head, tail) = rest.split_at_mut(len);
+        out.push((start, head));
+        rest = tail;
+        start = end;
+    }
+    out
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -12,8 +12,9 @@
 //! `E_Q L_low E_Q` to the Hessian and `− E_Q L_low q` (`q = (φ_low − V)⁺`) to the gradient;
 //! vertices on either body's surface, or held by a rigid one, are truncated.
 
-use super::multigrid::transfer::{par_rows, row_chunks, PAR_ROWS};
+use super::multigrid::transfer::{par_rows, PAR_ROWS};
 use crate::model::{FoundationMatrix, Model};
+use crate::sparse::row_chunks;
 use crate::sparse::{Csr, Pattern};
 use rayon::prelude::*;
 

@@ -11,7 +11,7 @@
 
 use crate::mesh::refine::Refinement;
 use crate::mesh::DofMap;
-use crate::sparse::{Csr, Pattern};
+use crate::sparse::{row_chunks, Csr, Pattern};
 use crate::{Error, Result};
 use rayon::prelude::*;
 use std::sync::Arc;
@@ -335,28 +335,6 @@ pub(crate) fn par_rows<T: Send>(x: &mut [T], f: impl Fn(usize, &mut T) + Sync + 
             f(i, xi);
         }
     }
-}
-
-/// Splits the value array of a matrix on `pattern` into blocks of `rows` consecutive rows:
-/// `(first row, values of those rows)`, so that blocks can be filled in parallel.
-pub(crate) fn row_chunks<'a>(
-    pattern: &Pattern,
-    val: &'a mut [f64],
-    rows: usize,
-) -> Vec<(usize, &'a mut [f64])> {
-    let n = pattern.n();
-    let mut out = Vec::with_capacity(n / rows + 1);
-    let mut rest = val;
-    let mut start = 0;
-    while start < n {
-        let end = (start + rows).min(n);
-        let len = pattern.row_ptr[end] - pattern.row_ptr[start];
-        let (head, tail) = rest.split_at_mut(len);
-        out.push((start, head));
-        rest = tail;
-        start = end;
-    }
-    out
 }
 
 /// The Galerkin patterns of a chain of transfers, coarsest first, ending with `finest`.
