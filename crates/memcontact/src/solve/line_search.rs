@@ -347,8 +347,9 @@ fn elastic_step(model: &Model, v: &[f64], dir: &[f64], g0: f64, s2: f64) -> Opti
 
 /// `v ← v + α δ`, snapping onto its kink every coordinate whose breakpoint is α (up to
 /// rounding), so that touching vertices are exactly touching (on φ, or on φ_low with a
-/// body below), and keeping rigid bodies' constraints exact.
-pub fn apply_step(model: &Model, v: &mut [f64], dir: &[f64], alpha: f64) {
+/// body below), and keeping rigid bodies' constraints exact. Returns whether any
+/// coordinate changed.
+pub fn apply_step(model: &Model, v: &mut [f64], dir: &[f64], alpha: f64) -> bool {
     let extended = model.is_extended();
     // Snaps `new` onto the kink `f` crossed at this step, if it is one.
     let snaps = |old: f64, new: f64, f: f64, d: f64| -> bool {
@@ -357,17 +358,14 @@ pub fn apply_step(model: &Model, v: &mut [f64], dir: &[f64], alpha: f64) {
         let hits = (t - alpha).abs() <= tol || (new - f).abs() <= 1e-15 * f.abs().max(old.abs());
         hits && (old - f) * d < 0.0
     };
-    for i in 0..v.len() {
-        if dir[i] == 0.0 {
-            continue;
-        }
-        let old = v[i];
-        let new = old + alpha * dir[i];
+    // The new value of coordinate i.
+    let step = |i: usize, old: f64| -> f64 {
+        let d = dir[i];
+        let new = old + alpha * d;
         if model.can_touch[i] {
             let fi = model.phi[i];
-            if snaps(old, new, fi, dir[i]) {
-                v[i] = fi;
-                continue;
+            if snaps(old, new, fi, d) {
+                return fi;
             }
             let rigid = if extended {
                 model.rigid_at(i)
@@ -375,23 +373,39 @@ pub fn apply_step(model: &Model, v: &mut [f64], dir: &[f64], alpha: f64) {
                 model.is_rigid()
             };
             if rigid && new > fi {
-                v[i] = fi;
-                continue;
+                return fi;
             }
         }
         if extended {
             if let Some(low) = &model.lower {
                 if low.can_touch[i] {
                     let fi = low.phi[i];
-                    if snaps(old, new, fi, dir[i]) || (low.rigid_at(i) && new < fi) {
-                        v[i] = fi;
-                        continue;
+                    if snaps(old, new, fi, d) || (low.rigid_at(i) && new < fi) {
+                        return fi;
                     }
                 }
             }
         }
-        v[i] = new;
+        new
+    };
+    let chunk = |lo: usize, xs: &mut [f64]| -> bool {
+        let mut changed = false;
+        for (k, x) in xs.iter_mut().enumerate() {
+            if dir[lo + k] != 0.0 {
+                let new = step(lo + k, *x);
+                changed |= new != *x;
+                *x = new;
+            }
+        }
+        changed
+    };
+    if v.len() < PAR_ROWS {
+        return chunk(0, v);
     }
+    v.par_chunks_mut(BLOCK)
+        .enumerate()
+        .map(|(b, xs)| chunk(b * BLOCK, xs))
+        .reduce(|| false, |a, b| a || b)
 }
 
 #[cfg(test)]

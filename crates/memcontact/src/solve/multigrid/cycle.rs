@@ -41,8 +41,9 @@ pub struct Levels {
     pub kind: Kind,
     /// Unknowns of every level, coarsest first.
     pub sizes: Vec<usize>,
-    /// Geometric hierarchies: the unknowns of every level's mesh, coarsest first (levels
-    /// without unknowns are left out). Empty for an algebraic hierarchy.
+    /// Geometric hierarchies: the unknowns of every level's mesh but the finest (the
+    /// model's own), coarsest first (levels without unknowns are left out). Empty for an
+    /// algebraic hierarchy.
     pub dofs: Vec<DofMap>,
     /// Operator patterns, coarsest first; the finest is the pattern of S.
     pub patterns: Vec<Arc<Pattern>>,
@@ -75,29 +76,32 @@ impl Levels {
         }
         check_pattern(last, finest, &pattern)?;
         // The unknowns of the coarser levels, from the finer ones: a coarse vertex is
-        // interior exactly when the fine vertex sitting on it is (nested meshes).
-        let mut dofs = vec![finest.clone()];
+        // interior exactly when the fine vertex sitting on it is (nested meshes). The
+        // finest level's unknowns are the model's own: no copy is kept.
+        let mut dofs: Vec<DofMap> = Vec::with_capacity(nl - 1);
         for k in (0..nl - 1).rev() {
             let coarse = coarse_dofs(
                 &hierarchy.refinements[k],
                 hierarchy.levels[k].n_vertices(),
-                dofs.last().expect("the finer level"),
+                dofs.last().unwrap_or(finest),
             )?;
             dofs.push(coarse);
         }
         dofs.reverse();
+        let level = |k: usize| dofs.get(k).unwrap_or(finest);
         // Levels without unknowns cannot carry a correction: start above them.
-        let first = dofs.iter().position(|d| !d.is_empty()).unwrap_or(nl - 1);
+        let first = (0..nl).position(|k| !level(k).is_empty()).unwrap_or(nl - 1);
         let mut transfers = Vec::with_capacity(nl - 1 - first);
         for k in first..nl - 1 {
-            let t = Transfer::new(&hierarchy.refinements[k], &dofs[k], &dofs[k + 1])?;
+            let t = Transfer::new(&hierarchy.refinements[k], level(k), level(k + 1))?;
             transfers.push(t);
         }
+        let sizes = (first..nl).map(|k| level(k).len()).collect();
         let dofs: Vec<DofMap> = dofs.into_iter().skip(first).collect();
         let patterns = galerkin_patterns(&transfers, pattern);
         Ok(Levels {
             kind: Kind::Geometric,
-            sizes: dofs.iter().map(DofMap::len).collect(),
+            sizes,
             dofs,
             patterns,
             transfers,
@@ -277,14 +281,16 @@ impl<'a> Multigrid<'a> {
     /// one, so that a preconditioner that varies from step to step is allowed) for
     /// `A x = b` on the top level from `x = 0`, preconditioned by one [`Multigrid::cycle`]
     /// per step, until `‖b − A x‖∞ ≤ target` or `max_steps` steps; rows flagged in `held`
-    /// (zero rows of A) stay 0. Returns the steps done. Every step lowers the quadratic
-    /// `½xᵀAx − bᵀx`, so `x` is a descent direction of it from the first step on.
+    /// (zero rows of A) stay 0. `b` is overwritten by the final residual `b − A x` (it is
+    /// the iteration's residual vector: no copy of it is kept). Returns the steps done.
+    /// Every step lowers the quadratic `½xᵀAx − bᵀx`, so `x` is a descent direction of it
+    /// from the first step on.
     #[allow(clippy::too_many_arguments)]
     pub fn fcg(
         &mut self,
         a: &Csr,
         x: &mut [f64],
-        b: &[f64],
+        b: &mut [f64],
         target: f64,
         max_steps: usize,
         held: &[bool],
@@ -292,9 +298,9 @@ impl<'a> Multigrid<'a> {
     ) -> usize {
         let n = x.len();
         work.resize(n);
-        let FcgWork { r, z, w, p, ap } = work;
+        let FcgWork { z, p, ap } = work;
+        let r = b;
         x.iter_mut().for_each(|v| *v = 0.0);
-        r.copy_from_slice(b);
         let mut pap_prev = 0.0;
         let mut steps = 0;
         while steps < max_steps {
@@ -305,15 +311,15 @@ impl<'a> Multigrid<'a> {
                     *v = 0.0
                 }
             });
-            a.mul_into(z, w);
+            // p = z + β p with β making p A-orthogonal to the previous direction; A p is
+            // formed by one product (no separate A z is stored).
             if steps == 0 {
                 p.copy_from_slice(z);
-                ap.copy_from_slice(w);
             } else {
                 let beta = -det_dot(z, ap) / pap_prev;
                 par_rows(p, |i, v| *v = z[i] + beta * *v);
-                par_rows(ap, |i, v| *v = w[i] + beta * *v);
             }
+            a.mul_into(p, ap);
             let pap = det_dot(p, ap);
             if !(pap > 0.0 && pap.is_finite()) {
                 break;
@@ -595,22 +601,14 @@ impl<'a> Multigrid<'a> {
 /// The work vectors of [`Multigrid::fcg`] (allocated once per solve).
 #[derive(Debug, Default)]
 pub struct FcgWork {
-    r: Vec<f64>,
     z: Vec<f64>,
-    w: Vec<f64>,
     p: Vec<f64>,
     ap: Vec<f64>,
 }
 
 impl FcgWork {
     fn resize(&mut self, n: usize) {
-        for v in [
-            &mut self.r,
-            &mut self.z,
-            &mut self.w,
-            &mut self.p,
-            &mut self.ap,
-        ] {
+        for v in [&mut self.z, &mut self.p, &mut self.ap] {
             v.resize(n, 0.0);
         }
     }

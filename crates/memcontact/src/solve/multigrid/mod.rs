@@ -225,8 +225,12 @@ pub fn solve_with(
     } else {
         start_from(model, start)
     };
+    // Each coarse model is dropped as soon as its level is solved: the finest level's
+    // iteration, the largest user of memory, runs without them.
+    let mut models = models.into_iter();
     for k in first..=top {
-        let m = models.get(k).unwrap_or(model);
+        let coarse = if k < top { models.next() } else { None };
+        let m = coarse.as_ref().unwrap_or(model);
         if k > first {
             let mut next = vec![0.0; m.n()];
             levels.transfers[k - 1].prolongate(&v, &mut next);
@@ -272,7 +276,6 @@ pub fn solve_with(
             seconds,
         });
     }
-    drop(models);
     let certificate = match final_certificate {
         Some(c) => c,
         None => timer.time("certificate", || model.certificate(&v)),
@@ -403,7 +406,6 @@ fn level_solve(ls: LevelSolve) -> Result<(usize, f64, Option<Certificate>)> {
     let mut delta = vec![0.0; n];
     let mut g = vec![0.0; n];
     let mut r = vec![0.0; n];
-    let mut before = vec![0.0; n];
     let mut prev: Option<NewtonStates> = None;
     let mut changed = vec![false; n];
     let mut dirty = vec![false; n];
@@ -436,10 +438,11 @@ fn level_solve(ls: LevelSolve) -> Result<(usize, f64, Option<Certificate>)> {
             break;
         }
         iterations += 1;
+        // Whether the iterate moved at all in this iteration (smoothing or step).
+        let mut moved = false;
         timer.time("smoothing", || {
-            before.copy_from_slice(v);
             for _ in 0..options.presmoothing {
-                sweep_forward(model, v);
+                moved |= sweep_forward(model, v);
             }
         });
         // The truncated Newton system at the smoothed iterate.
@@ -475,7 +478,7 @@ fn level_solve(ls: LevelSolve) -> Result<(usize, f64, Option<Certificate>)> {
                 mg.fcg(
                     &a,
                     &mut delta,
-                    &g,
+                    &mut g,
                     eta * scale,
                     steps,
                     &st.truncated,
@@ -513,11 +516,11 @@ fn level_solve(ls: LevelSolve) -> Result<(usize, f64, Option<Certificate>)> {
         timer.time("line search", || {
             let (g0, s2) = line_data(model, &delta, &r);
             if let Some(alpha) = exact_step(model, v, &delta, g0, s2) {
-                apply_step(model, v, &delta, alpha);
+                moved |= apply_step(model, v, &delta, alpha);
             }
         });
         prev = Some(st);
-        if *v == before {
+        if !moved {
             stalled += 1;
         } else {
             stalled = 0;
@@ -567,7 +570,9 @@ pub fn kernel_timings(
     time("certificate", &mut || {
         std::hint::black_box(crate::certificate::evaluate(model, &v));
     });
-    time("nonsmooth sweep", &mut || sweep_forward(model, &mut v));
+    time("nonsmooth sweep", &mut || {
+        sweep_forward(model, &mut v);
+    });
     let mut st = NewtonStates::of(model, &v);
     time("states", &mut || st = NewtonStates::of(model, &v));
     let mut a = Csr::zeros(model.s.pattern.clone());

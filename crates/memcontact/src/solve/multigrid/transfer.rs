@@ -29,14 +29,15 @@ pub struct Transfer {
     /// interior parent at all has weights `[0, 0]`.
     pub parents: Vec<[u32; 2]>,
     /// The weights of `parents` (½ and ½, or 1 and 0, or 0 where a parent was dropped).
-    pub weights: Vec<[f64; 2]>,
+    /// Single precision holds them exactly, in half the memory.
+    pub weights: Vec<[f32; 2]>,
     /// Columns of P: the children of coarse unknown `I` are
     /// `children[child_ptr[I]..child_ptr[I + 1]]`, in increasing order.
     pub child_ptr: Vec<usize>,
     /// Fine unknowns, grouped by coarse parent.
     pub children: Vec<u32>,
-    /// `P[child, I]` for every entry of `children`.
-    pub child_weights: Vec<f64>,
+    /// `P[child, I]` for every entry of `children` (exact in single precision).
+    pub child_weights: Vec<f32>,
 }
 
 impl Transfer {
@@ -65,7 +66,7 @@ impl Transfer {
             )));
         }
         let n_fine = fine.len();
-        let map = |&v: &u32| -> ([u32; 2], [f64; 2]) {
+        let map = |&v: &u32| -> ([u32; 2], [f32; 2]) {
             let [a, b] = refinement.parents[v as usize];
             let (da, db) = (coarse.dof[a as usize], coarse.dof[b as usize]);
             if a == b {
@@ -82,7 +83,7 @@ impl Transfer {
                 }
             }
         };
-        let (parents, weights): (Vec<[u32; 2]>, Vec<[f64; 2]>) = if n_fine >= PAR_ROWS {
+        let (parents, weights): (Vec<[u32; 2]>, Vec<[f32; 2]>) = if n_fine >= PAR_ROWS {
             fine.vertex.par_iter().with_min_len(4096).map(map).unzip()
         } else {
             fine.vertex.iter().map(map).unzip()
@@ -94,7 +95,7 @@ impl Transfer {
     /// aggregate `aggregate[v] < n_coarse` (`P[v, aggregate[v]] = 1`), or to none
     /// (`aggregate[v] = u32::MAX`: a zero row of P).
     pub fn aggregation(aggregate: &[u32], n_coarse: usize) -> Transfer {
-        let (parents, weights): (Vec<[u32; 2]>, Vec<[f64; 2]>) = aggregate
+        let (parents, weights): (Vec<[u32; 2]>, Vec<[f32; 2]>) = aggregate
             .iter()
             .map(|&a| {
                 if (a as usize) < n_coarse {
@@ -109,7 +110,7 @@ impl Transfer {
 
     /// P from its rows (up to two parents per fine unknown; weight 0 for a missing one),
     /// with the columns built by a counting sort (children in increasing fine order).
-    fn from_rows(parents: Vec<[u32; 2]>, weights: Vec<[f64; 2]>, n_coarse: usize) -> Transfer {
+    fn from_rows(parents: Vec<[u32; 2]>, weights: Vec<[f32; 2]>, n_coarse: usize) -> Transfer {
         let mut child_ptr = vec![0usize; n_coarse + 1];
         for (p, w) in parents.iter().zip(&weights) {
             for s in 0..2 {
@@ -154,7 +155,7 @@ impl Transfer {
     fn row(&self, v: usize, xc: &[f64]) -> f64 {
         let [a, b] = self.parents[v];
         let [wa, wb] = self.weights[v];
-        wa * xc[a as usize] + wb * xc[b as usize]
+        f64::from(wa) * xc[a as usize] + f64::from(wb) * xc[b as usize]
     }
 
     /// `x_f = P x_c`.
@@ -179,7 +180,7 @@ impl Transfer {
         par_rows(rc, |i, r| {
             let mut s = 0.0;
             for k in self.child_ptr[i]..self.child_ptr[i + 1] {
-                s += self.child_weights[k] * rf[self.children[k] as usize];
+                s += f64::from(self.child_weights[k]) * rf[self.children[k] as usize];
             }
             *r = s;
         });
@@ -270,7 +271,7 @@ impl Transfer {
             }
             for c in self.child_ptr[i]..self.child_ptr[i + 1] {
                 let v = self.children[c] as usize;
-                let wv = self.child_weights[c];
+                let wv = f64::from(self.child_weights[c]);
                 let (s, e) = (fpat.row_ptr[v], fpat.row_ptr[v + 1]);
                 for (&w, &a) in fpat.col[s..e].iter().zip(&fine.val[s..e]) {
                     if a == 0.0 {
@@ -279,7 +280,7 @@ impl Transfer {
                     let a = a * wv;
                     let w = w as usize;
                     let [p0, p1] = self.parents[w];
-                    let [w0, w1] = self.weights[w];
+                    let [w0, w1] = self.weights[w].map(f64::from);
                     if w0 != 0.0 {
                         vals[marker[p0 as usize] as usize] += a * w0;
                         // A dropped second parent repeats the first with weight 0.
