@@ -39,23 +39,29 @@ const STAGNATION: f64 = 0.7;
 /// At most this many levels.
 const MAX_LEVELS: usize = 40;
 
-/// The strong neighbours of every row: negative couplings above [`BETA`] times the
-/// strongest of the row, among the rows taking part in the matching.
+/// Rows per block of a parallel matching (see [`pairwise`]).
+const MATCH_BLOCK: usize = 1 << 16;
+
+/// The strong neighbours of the rows `lo..hi`: negative couplings above [`BETA`] times
+/// the strongest of the row, among the rows of the range taking part in the matching.
+/// Vectors are indexed from `lo`.
 struct Strong<'a> {
     a: &'a Csr,
+    lo: usize,
     free: Vec<bool>,
     threshold: Vec<f64>,
 }
 
 impl Strong<'_> {
-    /// `(j, a_ij)` for the strong neighbours `j` of row `i`.
+    /// `(j, a_ij)` for the strong neighbours `j` of row `i` (global indices).
     fn of(&self, i: usize) -> impl Iterator<Item = (usize, f64)> + '_ {
         let (cols, vals) = self.a.row(i);
-        let t = self.threshold[i];
+        let t = self.threshold[i - self.lo];
+        let (lo, hi) = (self.lo, self.lo + self.free.len());
         cols.iter()
             .zip(vals)
             .map(|(&j, &v)| (j as usize, v))
-            .filter(move |&(j, v)| j != i && self.free[j] && -v > t)
+            .filter(move |&(j, v)| j != i && j >= lo && j < hi && self.free[j - lo] && -v > t)
     }
 }
 
@@ -63,12 +69,44 @@ impl Strong<'_> {
 /// for rows left to the smoother (zero or dominant diagonal); returns the aggregate index
 /// of every row and the number of aggregates. Rows are taken in order of fewest unmatched
 /// strong neighbours (Notay's rule, which leaves few rows unpaired), each paired with its
-/// strongest unmatched neighbour. Deterministic.
+/// strongest unmatched neighbour.
+///
+/// Large matrices are matched by blocks of [`MATCH_BLOCK`] consecutive rows in parallel,
+/// pairs never crossing a block's edge (as in parallel aggregation codes: with rows in a
+/// locality order, a block is a compact piece of the domain and few rows lie on its
+/// edge); aggregates are numbered block by block. The blocks depend on the size alone:
+/// the result is the same for any number of threads.
 fn pairwise(a: &Csr) -> (Vec<u32>, usize) {
+    use rayon::prelude::*;
     let n = a.n();
-    let mut free = vec![true; n];
-    let mut threshold = vec![0.0; n];
-    for i in 0..n {
+    if n < 2 * MATCH_BLOCK {
+        return pairwise_range(a, 0, n);
+    }
+    let parts: Vec<(Vec<u32>, usize)> = (0..n.div_ceil(MATCH_BLOCK))
+        .into_par_iter()
+        .map(|b| pairwise_range(a, b * MATCH_BLOCK, ((b + 1) * MATCH_BLOCK).min(n)))
+        .collect();
+    let mut agg = Vec::with_capacity(n);
+    let mut count = 0usize;
+    for (local, c) in parts {
+        let offset = count as u32;
+        agg.extend(
+            local
+                .iter()
+                .map(|&g| if g == NONE { NONE } else { g + offset }),
+        );
+        count += c;
+    }
+    (agg, count)
+}
+
+/// [`pairwise`] on the rows `lo..hi` alone (couplings to other rows ignored); aggregates
+/// numbered from 0.
+fn pairwise_range(a: &Csr, lo: usize, hi: usize) -> (Vec<u32>, usize) {
+    let m = hi - lo;
+    let mut free = vec![true; m];
+    let mut threshold = vec![0.0; m];
+    for i in lo..hi {
         let (cols, vals) = a.row(i);
         let (mut diag, mut off, mut strongest) = (0.0, 0.0, 0.0f64);
         for (&j, &v) in cols.iter().zip(vals) {
@@ -79,15 +117,20 @@ fn pairwise(a: &Csr) -> (Vec<u32>, usize) {
                 strongest = strongest.max(-v);
             }
         }
-        free[i] = diag > 0.0 && diag < DOMINANT * off;
-        threshold[i] = BETA * strongest;
+        free[i - lo] = diag > 0.0 && diag < DOMINANT * off;
+        threshold[i - lo] = BETA * strongest;
     }
-    let strong = Strong { a, free, threshold };
-    let mut agg = vec![NONE; n];
+    let strong = Strong {
+        a,
+        lo,
+        free,
+        threshold,
+    };
+    let mut agg = vec![NONE; m];
     // A bucket queue by the number of unmatched strong neighbours, with lazy deletion.
-    let mut degree: Vec<u32> = (0..n)
+    let mut degree: Vec<u32> = (lo..hi)
         .map(|i| {
-            if strong.free[i] {
+            if strong.free[i - lo] {
                 strong.of(i).count() as u32
             } else {
                 0
@@ -96,7 +139,7 @@ fn pairwise(a: &Csr) -> (Vec<u32>, usize) {
         .collect();
     let top = degree.iter().copied().max().unwrap_or(0) as usize;
     let mut buckets: Vec<Vec<u32>> = vec![Vec::new(); top + 1];
-    for i in (0..n).rev() {
+    for i in (0..m).rev() {
         if strong.free[i] {
             buckets[degree[i] as usize].push(i as u32);
         }
@@ -115,14 +158,15 @@ fn pairwise(a: &Csr) -> (Vec<u32>, usize) {
             continue; // matched, or queued again with a smaller degree
         }
         let mut best: Option<(usize, f64)> = None;
-        for (j, v) in strong.of(i) {
-            if agg[j] == NONE && best.is_none_or(|(_, b)| v < b) {
-                best = Some((j, v));
+        for (j, v) in strong.of(lo + i) {
+            if agg[j - lo] == NONE && best.is_none_or(|(_, b)| v < b) {
+                best = Some((j - lo, v));
             }
         }
-        for m in std::iter::once(i).chain(best.map(|b| b.0)) {
-            agg[m] = count;
-            for (k, _) in strong.of(m) {
+        for r in std::iter::once(i).chain(best.map(|b| b.0)) {
+            agg[r] = count;
+            for (k, _) in strong.of(lo + r) {
+                let k = k - lo;
                 if agg[k] == NONE && degree[k] > 0 {
                     degree[k] -= 1;
                     buckets[degree[k] as usize].push(k as u32);
@@ -220,8 +264,14 @@ mod tests {
 
     #[test]
     fn aggregates_are_small_connected_and_cover_the_coupled_rows() {
-        let a = lap2d(100);
-        let (transfers, sizes, patterns) = hierarchy(&a, COARSEST);
+        // 10⁴ rows: one matching over all rows; 1.6·10⁵: by blocks in parallel.
+        for m in [100, 400] {
+            check_aggregates(&lap2d(m), m * m);
+        }
+    }
+
+    fn check_aggregates(a: &Csr, n: usize) {
+        let (transfers, sizes, patterns) = hierarchy(a, COARSEST);
         // The patterns built from the half-size products are those of PᵀAP for the
         // composed transfers, computed directly from the finest pattern.
         let direct = galerkin_patterns(&transfers, a.pattern.clone());
@@ -231,7 +281,7 @@ mod tests {
             assert_eq!(p.col, q.col);
         }
         assert!(sizes.len() >= 3, "{sizes:?}");
-        assert_eq!(*sizes.last().unwrap(), 10_000);
+        assert_eq!(*sizes.last().unwrap(), n);
         assert!(sizes[0] <= COARSEST, "{sizes:?}");
         // Coarsening ratio close to 4 per level.
         for w in sizes.windows(2) {
@@ -252,6 +302,20 @@ mod tests {
                 assert!(m.len() == 1 || m.iter().any(|&u| u != v && a.get(u, v) != 0.0));
             }
         }
+    }
+
+    /// The block-parallel matching gives the same aggregates on one thread as on several.
+    #[test]
+    fn matching_does_not_depend_on_the_thread_count() {
+        let a = lap2d(400);
+        assert!(a.n() >= 2 * MATCH_BLOCK);
+        let many = pairwise(&a);
+        let one = rayon::ThreadPoolBuilder::new()
+            .num_threads(1)
+            .build()
+            .unwrap()
+            .install(|| pairwise(&a));
+        assert_eq!(many, one);
     }
 
     #[test]
