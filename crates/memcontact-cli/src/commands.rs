@@ -207,7 +207,7 @@ pub fn check(case_path: &Path, sets: &[String]) -> Result<()> {
     println!("case {}: valid", case_path.display());
     print!(
         "{}",
-        output::mesh_report(mesh, &mesh.quality(), d.hierarchy.depth())
+        output::mesh_report(mesh, &d.quality, d.hierarchy.depth())
     );
     println!(
         "  obstacle     {} vertices can touch (M), foundation {}{}",

@@ -71,11 +71,11 @@ pub fn human(label: &str, outcome: &Outcome, written: Option<(&Summary, &Path)>)
     let r = &outcome.report;
     let m = &d.model;
     let mesh = d.mesh();
-    let q = mesh.quality();
-    let (_, t) = outcome.fields();
+    let q = &d.quality;
+    let t = outcome.totals();
     let mut o = String::new();
     let _ = writeln!(o, "memcontact: {label}");
-    o.push_str(&mesh_report(mesh, &q, d.hierarchy.depth()));
+    o.push_str(&mesh_report(mesh, q, d.hierarchy.depth()));
     let _ = writeln!(
         o,
         "  model        t = {}, foundation {}, sampling {}{}",
@@ -121,12 +121,8 @@ pub fn human(label: &str, outcome: &Outcome, written: Option<(&Summary, &Path)>)
         );
     }
     let fixed = m.dofs.dof.iter().filter(|d| d.is_none()).count();
-    let free = mesh
-        .boundary_vertices()
-        .iter()
-        .enumerate()
-        .filter(|(v, &b)| b && m.dofs.dof[*v].is_some())
-        .count();
+    // The unknowns beyond the interior vertices: those on free edges.
+    let free = m.n().saturating_sub(q.unknowns);
     if free > 0 || !m.boundary_values.is_empty() {
         let heights = m
             .boundary_values

@@ -106,8 +106,9 @@ impl PyResult_ {
         step: Option<usize>,
     ) -> ResultData {
         let (fields, totals) = outcome.fields();
-        let quality = outcome.mesh().quality();
-        let mut summary = Summary::new(&label, outcome, &quality, &totals);
+        let fields = fields.into_owned();
+        let quality = &outcome.discretization.quality;
+        let mut summary = Summary::new(&label, outcome, quality, &totals);
         summary.run_id = new_run_id();
         summary.input_hash = input_hash(&case);
         summary.time_total_s = seconds;
@@ -584,6 +585,7 @@ pub fn _result_from_state(state: &Bound<'_, PyDict>) -> PyResult<PyResult_> {
         solver_phases: phases_in(s.solver_phases),
         u: vec("u_dofs")?,
         multipliers,
+        derived: None,
     };
     let mesh = PyMesh::new_from(hierarchy_from_state(&get("mesh")?)?);
     Ok(PyResult_ {

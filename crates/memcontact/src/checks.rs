@@ -20,8 +20,19 @@ use crate::{Error, Result};
 pub fn assemble(mesh: &Mesh, data: &ProblemData, ext: &Extensions) -> Result<Model> {
     let adj = VertexTriangles::new(mesh);
     let boundary = mesh.boundary_vertices_with(&adj);
-    check_boundary_data_on(mesh, &adj, &boundary, data, ext)?;
-    let model = Model::assemble_on(mesh, &adj, &boundary, data, ext)?;
+    assemble_on(mesh, &adj, &boundary, data, ext)
+}
+
+/// [`assemble`] given the mesh's vertex → triangles adjacency and its boundary vertices.
+pub fn assemble_on(
+    mesh: &Mesh,
+    adj: &VertexTriangles,
+    boundary: &[bool],
+    data: &ProblemData,
+    ext: &Extensions,
+) -> Result<Model> {
+    check_boundary_data_on(mesh, adj, boundary, data, ext)?;
+    let model = Model::assemble_on(mesh, adj, boundary, data, ext)?;
     check_model(mesh, &model)?;
     Ok(model)
 }

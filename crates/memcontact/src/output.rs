@@ -87,9 +87,29 @@ pub fn input_hash(case: &Case) -> String {
     let mut h = xxhash_rust::xxh3::Xxh3::new();
     h.update(json.as_bytes());
     if let crate::problem::MeshSource::File(path) = &case.problem.mesh.source {
-        match crate::resources::read_input(path, crate::resources::MESH_FILE) {
-            Ok(bytes) => h.update(&bytes),
-            Err(_) => h.update(b"(the mesh file could not be read)"),
+        // Streamed through the hash (the digest of the whole file's bytes), never held in
+        // memory whole.
+        use std::io::Read;
+        let kind = crate::resources::MESH_FILE;
+        let streamed = crate::resources::open_input(path, kind).and_then(|(file, _)| {
+            let mut reader = file.take(kind.cap + 1);
+            let mut buf = vec![0u8; 1 << 20];
+            loop {
+                match reader.read(&mut buf) {
+                    Ok(0) => return Ok(()),
+                    Ok(n) => h.update(&buf[..n]),
+                    Err(e) if e.kind() == std::io::ErrorKind::Interrupted => {}
+                    Err(e) => {
+                        return Err(Error::Io {
+                            path: path.clone(),
+                            source: e,
+                        })
+                    }
+                }
+            }
+        });
+        if streamed.is_err() {
+            h.update(b"(the mesh file could not be read)");
         }
     }
     format!("{:016x}", h.digest())
@@ -219,9 +239,12 @@ pub fn write_files(
     let run_id = options.run_id.clone().unwrap_or_else(new_run_id);
     let written = write_fields(dir, outcome, &fields, options.vtu, &run_id)?;
     let names = extra(dir, &fields)?;
-    // Order-independent: the mesh in the solver's numbering will do.
-    let quality = outcome.discretization.mesh().quality();
-    let mut summary = Summary::new(&options.label, outcome, &quality, &totals);
+    let mut summary = Summary::new(
+        &options.label,
+        outcome,
+        &outcome.discretization.quality,
+        &totals,
+    );
     summary.run_id = run_id;
     summary.input_hash = input_hash(case);
     summary.plot_options = options.plot_options.clone();
@@ -424,3 +447,35 @@ pub fn write_manifest(dir: &Path, kind: &str, run_id: &str, input_hash: &str) ->
 
 /// The file name of a [`Manifest`].
 pub const MANIFEST: &str = "manifest.json";
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn input_hash_covers_the_case_and_the_whole_mesh_file() {
+        let dir = std::env::temp_dir().join(format!("memcontact-hash-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        // Only hashed, never parsed: any bytes will do, over several read blocks.
+        let mesh = dir.join("site.msh");
+        let bytes: Vec<u8> = (0..3_000_001u32)
+            .map(|i| (i.wrapping_mul(2_654_435_761) >> 24) as u8)
+            .collect();
+        std::fs::write(&mesh, &bytes).unwrap();
+        let text = "[mesh]\nfile = \"site.msh\"\n[membrane]\ntension = 1.0\nload = 1.0\n\
+                    [obstacle]\nshape = 0.1\nstiffness = 10.0\n";
+        let case = Case::from_toml_str(text, Some(&dir.join("case.toml"))).unwrap();
+        // The digest of the case's JSON followed by the file's bytes, all at once.
+        let mut whole = serde_json::to_string(&case).unwrap().into_bytes();
+        whole.extend_from_slice(&bytes);
+        let expected = format!("{:016x}", xxhash_rust::xxh3::xxh3_64(&whole));
+        assert_eq!(input_hash(&case), expected);
+        // One byte of the mesh changed changes the hash.
+        let mut changed = bytes.clone();
+        let last = changed.len() - 2;
+        changed[last] ^= 1;
+        std::fs::write(&mesh, &changed).unwrap();
+        assert_ne!(input_hash(&case), expected);
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+}

@@ -48,6 +48,24 @@ pub const MESH_FILE: InputKind = InputKind {
 /// checked on the opened descriptor, then read with the cap (a file growing meanwhile is
 /// still refused, not read without end).
 pub fn read_input(path: &Path, kind: InputKind) -> Result<Vec<u8>> {
+    let (file, size) = open_input(path, kind)?;
+    let mut bytes = Vec::with_capacity(size as usize);
+    file.take(kind.cap + 1)
+        .read_to_end(&mut bytes)
+        .map_err(|e| Error::File {
+            path: path.to_path_buf(),
+            message: format!("cannot read: {e}"),
+        })?;
+    if bytes.len() as u64 > kind.cap {
+        return Err(too_big(path, kind, bytes.len() as u64));
+    }
+    Ok(bytes)
+}
+
+/// Opens an input file for reading as [`read_input`] does (a regular file of at most
+/// `kind.cap` bytes, opened without blocking); returns it with its size. Readers must
+/// stop at `kind.cap + 1` bytes, as [`read_input`] does.
+pub fn open_input(path: &Path, kind: InputKind) -> Result<(std::fs::File, u64)> {
     let file_err = |message: String| Error::File {
         path: path.to_path_buf(),
         message,
@@ -72,23 +90,21 @@ pub fn read_input(path: &Path, kind: InputKind) -> Result<Vec<u8>> {
             kind.what
         )));
     }
-    let too_big = |size: u64| {
-        file_err(format!(
+    if meta.len() > kind.cap {
+        return Err(too_big(path, kind, meta.len()));
+    }
+    Ok((file, meta.len()))
+}
+
+/// The error for an input file of `size` bytes, more than `kind` allows.
+fn too_big(path: &Path, kind: InputKind, size: u64) -> Error {
+    Error::File {
+        path: path.to_path_buf(),
+        message: format!(
             "is {size} bytes, more than {} can be ({} bytes)",
             kind.what, kind.cap
-        ))
-    };
-    if meta.len() > kind.cap {
-        return Err(too_big(meta.len()));
+        ),
     }
-    let mut bytes = Vec::with_capacity(meta.len() as usize);
-    file.take(kind.cap + 1)
-        .read_to_end(&mut bytes)
-        .map_err(|e| file_err(format!("cannot read: {e}")))?;
-    if bytes.len() as u64 > kind.cap {
-        return Err(too_big(bytes.len() as u64));
-    }
-    Ok(bytes)
 }
 
 /// How a file that is not a regular file is named.

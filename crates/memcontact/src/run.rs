@@ -13,7 +13,7 @@
 
 use crate::field::BoundField;
 use crate::mesh::refine::Hierarchy;
-use crate::mesh::Mesh;
+use crate::mesh::{Mesh, MeshQuality};
 use crate::model::{
     BodyData, BoundaryData, Certificate, Extensions, Model, ProblemData, Stiffness,
 };
@@ -23,6 +23,7 @@ use crate::solve::{
     self, Choice, Fallback, IterationRecord, Method, Observer, Settings, Solution, Status,
 };
 use crate::{Error, Result};
+use std::borrow::Cow;
 use std::time::Instant;
 
 /// The problem's data f, φ, h (and the data beyond the paper's frame: boundary heights,
@@ -207,6 +208,8 @@ pub struct Discretization {
     pub hierarchy: Hierarchy,
     /// S, L, D, φₙ, M on the finest mesh.
     pub model: Model,
+    /// The finest mesh's quality report (counts, `l_n`, `s_n`, smallest angle, area).
+    pub quality: MeshQuality,
     /// Warnings from reading the mesh (skipped element types, ...).
     pub warnings: Vec<String>,
     /// Wall-clock seconds of `mesh` and `assembly`.
@@ -250,12 +253,21 @@ impl Discretization {
         observer.phase_finished("reorder", t_reorder);
         observer.phase_started("assembly");
         let t0 = Instant::now();
-        let model = assemble_model(problem, hierarchy.finest())?;
+        let mesh = hierarchy.finest();
+        // The adjacency and the boundary serve the checks, assembly and the quality report.
+        let adj = crate::fem::VertexTriangles::new(mesh);
+        let boundary = mesh.boundary_vertices_with(&adj);
+        let bound = BoundData::new(problem, mesh)?;
+        let data = bound.data(problem);
+        let model =
+            crate::checks::assemble_on(mesh, &adj, &boundary, &data, &bound.extensions(problem))?;
+        let quality = mesh.quality_with(&boundary);
         let seconds = t0.elapsed().as_secs_f64();
         observer.phase_finished("assembly", seconds);
         Ok(Discretization {
             hierarchy,
             model,
+            quality,
             warnings: Vec::new(),
             phases: vec![
                 Phase {
@@ -374,6 +386,7 @@ impl Discretization {
         // too: refused here, before any caller reports or writes them.
         let (fields, totals) = derive_from(self.mesh(), &self.model, &a.solution.u);
         crate::checks::check_results(self.mesh(), &fields, &totals)?;
+        let derived = Some(std::sync::Arc::new((fields, totals)));
         let seconds = t0.elapsed().as_secs_f64();
         observer.phase_finished("solve", seconds);
         let mut phases = self.phases.clone();
@@ -404,6 +417,7 @@ impl Discretization {
                 .collect(),
             u: s.u,
             multipliers: s.multipliers,
+            derived,
         })
     }
 }
@@ -464,6 +478,10 @@ pub struct Report {
     /// The solver's multipliers of 2e, when it computes them (the QP does).
     #[serde(skip)]
     pub multipliers: Option<solve::Multipliers>,
+    /// The vertex fields and totals of `u` in the solver's numbering, derived and checked
+    /// once when the solve ended (`None`: derived again from `u` when asked for).
+    #[serde(skip)]
+    pub derived: Option<std::sync::Arc<(NodalFields, Totals)>>,
 }
 
 impl Report {
@@ -532,14 +550,45 @@ impl Outcome {
 
     /// The vertex fields (u, φ, penetration, pressure, contact forces, states) in the
     /// user's vertex numbering, and the totals.
-    pub fn fields(&self) -> (NodalFields, Totals) {
+    pub fn fields(&self) -> (Cow<'_, NodalFields>, Totals) {
+        let (fields, totals) = self.solver_fields();
+        (self.to_user(fields), totals)
+    }
+
+    /// The totals of the answer (load, reaction, contact area, ...).
+    pub fn totals(&self) -> Totals {
+        self.solver_fields().1
+    }
+
+    /// [`Outcome::fields`], checked to be finite ([`crate::checks::check_results`]): the
+    /// fields that result files hold.
+    pub fn checked_fields(&self) -> Result<(Cow<'_, NodalFields>, Totals)> {
+        let (fields, totals) = self.solver_fields();
+        crate::checks::check_results(self.discretization.mesh(), &fields, &totals)?;
+        Ok((self.to_user(fields), totals))
+    }
+
+    /// The fields and totals in the solver's numbering: those of the report, or derived
+    /// from its `u` when it has none.
+    fn solver_fields(&self) -> (Cow<'_, NodalFields>, Totals) {
+        match &self.report.derived {
+            Some(d) => (Cow::Borrowed(&d.0), d.1),
+            None => {
+                let d = &self.discretization;
+                let (f, totals) = derive_from(d.mesh(), &d.model, &self.report.u);
+                (Cow::Owned(f), totals)
+            }
+        }
+    }
+
+    /// Vertex fields in the solver's numbering mapped to the user's.
+    fn to_user<'a>(&self, f: Cow<'a, NodalFields>) -> Cow<'a, NodalFields> {
         let mesh = self.discretization.mesh();
-        let (f, totals) = derive_from(mesh, &self.discretization.model, &self.report.u);
         if mesh.numbering.is_none() {
-            return (f, totals);
+            return f;
         }
         let user = |x: &[f64]| mesh.vertex_values_to_user(x);
-        let fields = NodalFields {
+        Cow::Owned(NodalFields {
             u: user(&f.u),
             phi: user(&f.phi),
             penetration: user(&f.penetration),
@@ -555,16 +604,7 @@ impl Outcome {
                 state: mesh.vertex_values_to_user(&l.state),
                 covered: mesh.vertex_values_to_user(&l.covered),
             }),
-        };
-        (fields, totals)
-    }
-
-    /// [`Outcome::fields`], refused when a field or total is not a finite number
-    /// ([`crate::checks::check_results`]): what result files are written from.
-    pub fn checked_fields(&self) -> Result<(NodalFields, Totals)> {
-        let (fields, totals) = self.fields();
-        crate::checks::check_results(&self.mesh(), &fields, &totals)?;
-        Ok((fields, totals))
+        })
     }
 }
 

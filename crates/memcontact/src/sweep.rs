@@ -395,7 +395,7 @@ pub struct StepRow {
 impl StepRow {
     /// The row of `step`, solved as `outcome` in `seconds`.
     pub fn of(step: &StepSpec, outcome: &Outcome, seconds: f64) -> StepRow {
-        let (_, t) = outcome.fields();
+        let t = outcome.totals();
         let r = &outcome.report;
         StepRow {
             step: step.index,

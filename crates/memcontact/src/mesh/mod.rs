@@ -366,13 +366,41 @@ impl Mesh {
     }
 
     /// [`Mesh::boundary_vertices`] with a prebuilt vertex → triangles adjacency.
+    ///
+    /// The triangles are oriented alike and use every directed edge once ([`Mesh::new`]),
+    /// so an edge `v → b` is shared exactly when `b → v` exists: v is interior when the
+    /// vertices following it in its triangles are the vertices preceding it (its fan
+    /// closes). One parallel pass over the vertices, without branches on the mesh's data
+    /// for the usual fans of up to [`SMALL_FAN`] triangles.
     pub fn boundary_vertices_with(&self, adj: &VertexTriangles) -> Vec<bool> {
-        let mut on = vec![false; self.points.len()];
-        for [a, b] in self.boundary_edges_with(adj) {
-            on[a as usize] = true;
-            on[b as usize] = true;
-        }
-        on
+        use rayon::prelude::*;
+        const NEXT: [usize; 3] = [1, 2, 0];
+        const PREV: [usize; 3] = [2, 0, 1];
+        let tri = &self.triangles;
+        (0..self.points.len())
+            .into_par_iter()
+            .with_min_len(4096)
+            .map(|v| {
+                let fan = adj.of(v);
+                let v = v as u32;
+                let ends = |k: u32| {
+                    let t = tri[k as usize];
+                    let a = (t[1] == v) as usize + 2 * (t[2] == v) as usize;
+                    (t[NEXT[a]], t[PREV[a]])
+                };
+                match fan.len() {
+                    0..=8 => !fan_closes::<8>(fan, ends),
+                    9..=SMALL_FAN => !fan_closes::<SMALL_FAN>(fan, ends),
+                    _ => {
+                        let (mut next, mut prev): (Vec<u32>, Vec<u32>) =
+                            fan.iter().map(|&k| ends(k)).unzip();
+                        next.sort_unstable();
+                        prev.sort_unstable();
+                        next != prev
+                    }
+                }
+            })
+            .collect()
     }
 
     /// Signed area of triangle `k` (positive: counter-clockwise).
@@ -398,8 +426,12 @@ impl Mesh {
     /// The quality report: counts, `l_n`, `s_n`, smallest angle (one parallel pass over
     /// the triangles; the smallest angle comes from the largest cosine, one `acos` in all).
     pub fn quality(&self) -> MeshQuality {
+        self.quality_with(&self.boundary_vertices())
+    }
+
+    /// [`Mesh::quality`] given the boundary vertices ([`Mesh::boundary_vertices`]).
+    pub fn quality_with(&self, boundary: &[bool]) -> MeshQuality {
         use rayon::prelude::*;
-        let boundary = self.boundary_vertices();
         let (l_n, s_n, max_cos, area) = (0..self.triangles.len())
             .into_par_iter()
             .with_min_len(4096)
@@ -440,6 +472,27 @@ impl Mesh {
             .unwrap_or_else(|| tag.to_string())
     }
 }
+
+/// Whether a fan of at most `N` triangles closes: every vertex following the centre in
+/// one of them (`ends(k).0`) precedes it in another (`ends(k).1`). The vertices following
+/// the centre are distinct, and so are those preceding it, so it closes exactly when every
+/// one finds its match. Compared in fixed-size buffers, without branches.
+#[inline]
+fn fan_closes<const N: usize>(fan: &[u32], ends: impl Fn(u32) -> (u32, u32)) -> bool {
+    let (mut next, mut prev) = ([0; N], [u32::MAX; N]);
+    for (i, &k) in fan.iter().enumerate() {
+        (next[i], prev[i]) = ends(k);
+    }
+    let shared: usize = next[..fan.len()]
+        .iter()
+        .map(|&b| prev.iter().map(|&c| (b == c) as usize).sum::<usize>())
+        .sum();
+    shared == fan.len()
+}
+
+/// Fans of up to this many triangles are compared in fixed-size buffers by
+/// [`Mesh::boundary_vertices_with`] (larger ones by sorting).
+const SMALL_FAN: usize = 16;
 
 /// The triangles around every vertex (the patch `Q_i` of the paper).
 #[derive(Debug, Clone)]
@@ -578,6 +631,78 @@ mod tests {
         assert!((q.area - 1.0).abs() < 1e-15);
         assert!((q.min_angle_deg - 45.0).abs() < 1e-12);
         assert!((q.l_n - 1.0).abs() < 1e-15);
+    }
+
+    /// The boundary vertices as the ends of the boundary edges (an edge of one triangle).
+    fn ends_of_boundary_edges(m: &Mesh) -> Vec<bool> {
+        let mut on = vec![false; m.n_vertices()];
+        for [a, b] in m.boundary_edges() {
+            on[a as usize] = true;
+            on[b as usize] = true;
+        }
+        on
+    }
+
+    #[test]
+    fn boundary_vertices_are_the_ends_of_boundary_edges() {
+        let sq = |a: f64, b: f64| vec![[a, a], [b, a], [b, b], [a, b]];
+        let holed = generate::polygon(&generate::PolygonSpec {
+            outer: sq(0.0, 1.0),
+            holes: vec![sq(0.3, 0.5), sq(0.6, 0.8)],
+            regions: Vec::new(),
+            size: 0.05,
+            min_angle: 25.0,
+        })
+        .unwrap();
+        // Fans larger than the small buffers: a wheel of 40 spokes around an interior
+        // centre, and a half wheel of 20 around a boundary one.
+        let wheel = |spokes: u32, turn: f64| {
+            let mut p = vec![[0.0, 0.0]];
+            p.extend((0..=spokes).map(|i| {
+                let a = turn * i as f64 / spokes as f64;
+                [a.cos(), a.sin()]
+            }));
+            let full = turn == std::f64::consts::TAU;
+            if full {
+                p.pop();
+            }
+            let t = (1..=spokes)
+                .map(|i| [0, i, if full && i == spokes { 1 } else { i + 1 }])
+                .collect();
+            Mesh::new(p, t, vec![], BTreeMap::new()).unwrap()
+        };
+        // Two triangles touching at one vertex (a pinched boundary).
+        let bowtie = Mesh::new(
+            vec![
+                [0.0, 0.0],
+                [1.0, 0.0],
+                [1.0, 1.0],
+                [-1.0, 0.0],
+                [-1.0, -1.0],
+            ],
+            vec![[0, 1, 2], [0, 3, 4]],
+            vec![],
+            BTreeMap::new(),
+        )
+        .unwrap();
+        let meshes = [
+            square(),
+            generate::disk([0.0, 0.0], 1.0, 0.05).unwrap(),
+            holed,
+            wheel(40, std::f64::consts::TAU),
+            wheel(20, std::f64::consts::PI),
+            bowtie,
+        ];
+        for m in &meshes {
+            let b = m.boundary_vertices();
+            assert_eq!(b, ends_of_boundary_edges(m));
+            assert!(b.iter().any(|&x| x));
+        }
+        for m in &meshes[..4] {
+            assert!(m.boundary_vertices().iter().any(|&x| !x));
+        }
+        assert!(!meshes[3].boundary_vertices()[0]);
+        assert!(meshes[4].boundary_vertices()[0]);
     }
 
     #[test]
