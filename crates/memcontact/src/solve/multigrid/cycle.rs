@@ -11,7 +11,9 @@
 //! * Smoother: Gauss-Seidel, forward before and backward after the coarse correction (the
 //!   V-cycle is then a symmetric operator). Rows whose diagonal is zero (truncated
 //!   vertices, or coarse vertices all of whose children are truncated) are left alone: in
-//!   a positive semidefinite matrix they are zero rows, decoupled from the rest.
+//!   a positive semidefinite matrix they are zero rows, decoupled from the rest. A sweep
+//!   from zero (every cycle of the flexible CG, every coarse level) and the residual after
+//!   it are one pass over the matrix ([`gauss_seidel_from_zero`]).
 //! * Coarsest level: sparse Cholesky ([`Cholesky`], symbolic analysis once), zero rows
 //!   replaced by the identity.
 
@@ -226,6 +228,8 @@ pub struct Multigrid<'a> {
     r: Vec<Vec<f64>>,
     /// The block smoother's copy of the iterate, per level (empty for small levels).
     snap: Vec<Vec<f64>>,
+    /// The rows coupled to another smoothing block, per level ([`seam_rows`]).
+    seams: Vec<Vec<u32>>,
     dirty: Vec<Vec<bool>>,
     /// Level 0's operator with zero rows replaced by the identity, and its factor.
     coarsest: Csr,
@@ -261,6 +265,7 @@ impl<'a> Multigrid<'a> {
                     }
                 })
                 .collect(),
+            seams: (0..=top).map(|k| seam_rows(&levels.patterns[k])).collect(),
             dirty: (0..top).map(|k| vec![true; levels.n(k)]).collect(),
             coarsest: Csr::zeros(levels.patterns[0].clone()),
             chol: None,
@@ -304,8 +309,7 @@ impl<'a> Multigrid<'a> {
         let mut pap_prev = 0.0;
         let mut steps = 0;
         while steps < max_steps {
-            z.iter_mut().for_each(|v| *v = 0.0);
-            self.cycle(a, z, r);
+            self.cycle_from_zero(a, z, r);
             par_rows(z, |i, v| {
                 if held[i] || !v.is_finite() {
                     *v = 0.0
@@ -345,6 +349,40 @@ impl<'a> Multigrid<'a> {
         }
     }
 
+    /// [`Multigrid::cycle`] from `x = 0`, whatever `x` holds on entry (the preconditioner
+    /// of [`Multigrid::fcg`]): the first smoothing sweep and the residual after it are then
+    /// one pass over A ([`gauss_seidel_from_zero`]).
+    pub fn cycle_from_zero(&mut self, fine: &Csr, x: &mut [f64], b: &[f64]) {
+        if self.top == 0 {
+            x.iter_mut().for_each(|v| *v = 0.0);
+            return self.cycle(fine, x, b);
+        }
+        self.presmooth_top(fine, x, b, true);
+        match self.levels.kind {
+            Kind::Geometric => self.v_cycle_below(fine, x, b),
+            Kind::Algebraic => self.k_cycle_below(fine, x, b),
+        }
+    }
+
+    /// Pre-smoothing on the top level and its residual into `r[top]`; from `x = 0` when
+    /// `from_zero` (then fused into one pass when A's pattern is the top level's own).
+    fn presmooth_top(&mut self, fine: &Csr, x: &mut [f64], b: &[f64], from_zero: bool) {
+        let top = self.top;
+        let nu1 = self.smoothing.0;
+        if from_zero && nu1 == 1 && Arc::ptr_eq(&fine.pattern, &self.levels.patterns[top]) {
+            let (inv, seams) = (&self.inv_diag[top], &self.seams[top]);
+            gauss_seidel_from_zero(fine, inv, x, b, &mut self.r[top], seams);
+            return;
+        }
+        if from_zero {
+            x.iter_mut().for_each(|v| *v = 0.0);
+        }
+        for _ in 0..nu1 {
+            gauss_seidel(fine, &self.inv_diag[top], x, b, &mut self.snap[top], false);
+        }
+        residual(fine, x, b, &mut self.r[top]);
+    }
+
     /// One K-cycle (Y. Notay, P. S. Vassilevski, "Recursive Krylov-based multigrid
     /// cycles", Numer. Linear Algebra Appl. 15 (2008)) for `A x = b` on the top level,
     /// improving `x` in place: Gauss-Seidel before and after the coarse correction, as in
@@ -358,15 +396,17 @@ impl<'a> Multigrid<'a> {
         if top == 0 {
             return self.v_cycle(fine, x, b);
         }
-        let (nu1, nu2) = self.smoothing;
-        for _ in 0..nu1 {
-            gauss_seidel(fine, &self.inv_diag[top], x, b, &mut self.snap[top], false);
-        }
-        residual(fine, x, b, &mut self.r[top]);
+        self.presmooth_top(fine, x, b, false);
+        self.k_cycle_below(fine, x, b);
+    }
+
+    /// The K-cycle after the top level's pre-smoothing (its residual is in `r[top]`).
+    fn k_cycle_below(&mut self, fine: &Csr, x: &mut [f64], b: &[f64]) {
+        let top = self.top;
         self.levels.transfers[top - 1].restrict(&self.r[top], &mut self.b[top - 1]);
         self.krylov_correction(top - 1);
         self.levels.transfers[top - 1].prolongate_add(&self.x[top - 1], x);
-        for _ in 0..nu2 {
+        for _ in 0..self.smoothing.1 {
             gauss_seidel(fine, &self.inv_diag[top], x, b, &mut self.snap[top], true);
         }
     }
@@ -430,11 +470,15 @@ impl<'a> Multigrid<'a> {
     fn presmooth_and_restrict(&mut self, k: usize) {
         let (a, inv) = (&self.coarse[k], &self.inv_diag[k]);
         let (xk, bk) = (&mut self.x[k], &self.b[k]);
-        xk.iter_mut().for_each(|v| *v = 0.0);
-        for _ in 0..self.smoothing.0 {
-            gauss_seidel(a, inv, xk, bk, &mut self.snap[k], false);
+        if self.smoothing.0 == 1 {
+            gauss_seidel_from_zero(a, inv, xk, bk, &mut self.r[k], &self.seams[k]);
+        } else {
+            xk.iter_mut().for_each(|v| *v = 0.0);
+            for _ in 0..self.smoothing.0 {
+                gauss_seidel(a, inv, xk, bk, &mut self.snap[k], false);
+            }
+            residual(a, xk, bk, &mut self.r[k]);
         }
-        residual(a, xk, bk, &mut self.r[k]);
         let (bl, _) = self.b.split_at_mut(k);
         self.levels.transfers[k - 1].restrict(&self.r[k], &mut bl[k - 1]);
     }
@@ -536,7 +580,6 @@ impl<'a> Multigrid<'a> {
     /// unchanged (the caller may zero them afterwards).
     pub fn v_cycle(&mut self, fine: &Csr, x: &mut [f64], b: &[f64]) {
         let top = self.top;
-        let (nu1, nu2) = self.smoothing;
         if top == 0 {
             // One level: the direct solve, on the residual equation.
             let r = &mut self.r[0];
@@ -551,10 +594,13 @@ impl<'a> Multigrid<'a> {
             return;
         }
         // Down: smooth, restrict the residual.
-        for _ in 0..nu1 {
-            gauss_seidel(fine, &self.inv_diag[top], x, b, &mut self.snap[top], false);
-        }
-        residual(fine, x, b, &mut self.r[top]);
+        self.presmooth_top(fine, x, b, false);
+        self.v_cycle_below(fine, x, b);
+    }
+
+    /// The V-cycle after the top level's pre-smoothing (its residual is in `r[top]`).
+    fn v_cycle_below(&mut self, fine: &Csr, x: &mut [f64], b: &[f64]) {
+        let top = self.top;
         self.levels.transfers[top - 1].restrict(&self.r[top], &mut self.b[top - 1]);
         for k in (1..top).rev() {
             self.presmooth_and_restrict(k);
@@ -566,7 +612,7 @@ impl<'a> Multigrid<'a> {
             self.prolongate_and_postsmooth(k);
         }
         self.levels.transfers[top - 1].prolongate_add(&self.x[top - 1], x);
-        for _ in 0..nu2 {
+        for _ in 0..self.smoothing.1 {
             gauss_seidel(fine, &self.inv_diag[top], x, b, &mut self.snap[top], true);
         }
     }
@@ -632,7 +678,7 @@ fn det_dot(a: &[f64], b: &[f64]) -> f64 {
 }
 
 /// `1 / A_ii`, or 0 where `A_ii ≤ 0` (zero rows).
-fn fill_inv_diag(a: &Csr, inv: &mut [f64]) {
+pub(crate) fn fill_inv_diag(a: &Csr, inv: &mut [f64]) {
     let pat = &a.pattern;
     par_rows(inv, |i, d| {
         let (s, e) = (pat.row_ptr[i], pat.row_ptr[i + 1]);
@@ -723,6 +769,100 @@ pub(crate) fn gauss_seidel(
     x.par_chunks_mut(GS_BLOCK)
         .enumerate()
         .for_each(|(k, xs)| sweep(k * GS_BLOCK, xs, outside));
+}
+
+/// The rows of `pattern` that couple to another block of [`GS_BLOCK`] rows (none up to
+/// one block): the rows whose residual [`gauss_seidel_from_zero`] completes at the end.
+pub(crate) fn seam_rows(pattern: &Pattern) -> Vec<u32> {
+    use rayon::prelude::*;
+    let n = pattern.n();
+    if n <= GS_BLOCK {
+        return Vec::new();
+    }
+    (0..n)
+        .into_par_iter()
+        .with_min_len(4096)
+        .filter(|&i| {
+            let block = i / GS_BLOCK;
+            pattern.col[pattern.row_ptr[i]..pattern.row_ptr[i + 1]]
+                .iter()
+                .any(|&j| j as usize / GS_BLOCK != block)
+        })
+        .map(|i| i as u32)
+        .collect()
+}
+
+/// One forward sweep of [`gauss_seidel`] from `x = 0` (whatever `x` holds on entry), with
+/// the residual `r = b − A x` after it, in one pass over a symmetric A instead of two.
+/// When row i sets x_i, the part `Σ_{j ≤ i} a_ij x_j` of its own product is complete
+/// (later unknowns of its block are still 0); the later rows' part reaches r_i from
+/// them, `a_ki x_k = a_ik x_k` scattered from row k as soon as x_k is known. Unknowns of
+/// other blocks are 0 during the sweep (the hybrid sweep's start), so their part is added
+/// at the end, on the rows of `seams` ([`seam_rows`] of A's pattern) alone.
+pub(crate) fn gauss_seidel_from_zero(
+    a: &Csr,
+    inv: &[f64],
+    x: &mut [f64],
+    b: &[f64],
+    r: &mut [f64],
+    seams: &[u32],
+) {
+    use rayon::prelude::*;
+    let pat = &a.pattern;
+    let n = x.len();
+    let sweep = |lo: usize, xs: &mut [f64], rs: &mut [f64]| {
+        for (k, i) in (lo..lo + xs.len()).enumerate() {
+            let (s, e) = (pat.row_ptr[i], pat.row_ptr[i + 1]);
+            let (cols, vals) = (&pat.col[s..e], &a.val[s..e]);
+            // Columns are sorted: those of the block before i are `first..diag` (the ones
+            // before the block, and i's later neighbours, are still 0 in this sweep).
+            let first: usize = cols.iter().map(|&c| ((c as usize) < lo) as usize).sum();
+            let diag: usize = cols.iter().map(|&c| ((c as usize) < i) as usize).sum();
+            let (lc, lv) = (&cols[first..diag], &vals[first..diag]);
+            let lower: f64 = lc
+                .iter()
+                .zip(lv)
+                .map(|(&c, &v)| v * xs[c as usize - lo])
+                .sum();
+            let xi = (b[i] - lower) * inv[i];
+            xs[k] = xi;
+            let aii = match cols.get(diag) {
+                Some(&c) if c as usize == i => vals[diag],
+                _ => 0.0,
+            };
+            rs[k] = b[i] - lower - aii * xi;
+            for (&c, &v) in lc.iter().zip(lv) {
+                rs[c as usize - lo] -= v * xi;
+            }
+        }
+    };
+    if n <= GS_BLOCK {
+        sweep(0, x, r);
+        return;
+    }
+    x.par_chunks_mut(GS_BLOCK)
+        .zip(r.par_chunks_mut(GS_BLOCK))
+        .enumerate()
+        .for_each(|(k, (xs, rs))| sweep(k * GS_BLOCK, xs, rs));
+    // The other blocks' unknowns, now known, on the rows that see them.
+    let x: &[f64] = x;
+    r.par_chunks_mut(GS_BLOCK).enumerate().for_each(|(k, rs)| {
+        let lo = k * GS_BLOCK;
+        let hi = lo + rs.len();
+        let from = seams.partition_point(|&i| (i as usize) < lo);
+        let to = seams.partition_point(|&i| (i as usize) < hi);
+        for &i in &seams[from..to] {
+            let i = i as usize;
+            let (s, e) = (pat.row_ptr[i], pat.row_ptr[i + 1]);
+            let outside: f64 = pat.col[s..e]
+                .iter()
+                .zip(&a.val[s..e])
+                .filter(|(&j, _)| (j as usize) < lo || (j as usize) >= hi)
+                .map(|(&j, &v)| v * x[j as usize])
+                .sum();
+            rs[i - lo] -= outside;
+        }
+    });
 }
 
 /// The result of a linear multigrid solve.

@@ -347,3 +347,64 @@ fn block_gauss_seidel_keeps_the_rate_and_ignores_the_thread_count() {
     assert_eq!(one.x, two.x);
     assert!(one.cycles <= 24, "{}", one.cycles);
 }
+
+#[test]
+fn fused_sweep_from_zero_is_the_sweep_and_its_residual() {
+    // One level below GS_BLOCK (one sequential sweep) and one above (blocks and seams),
+    // with truncated unknowns: their rows and columns zero, as in the Newton matrix.
+    for levels in [5, 7] {
+        let h = square_hierarchy(4, levels);
+        let model = bench_model(h.finest(), Some(0.0), Foundation::Lumped);
+        let n = model.n();
+        let held = |i: usize| i % 7 == 3 || (i / 50) % 9 == 4;
+        let mut a = model.s.clone();
+        for i in 0..n {
+            for k in a.pattern.row_ptr[i]..a.pattern.row_ptr[i + 1] {
+                let j = a.pattern.col[k] as usize;
+                if held(i) || held(j) {
+                    a.val[k] = 0.0;
+                }
+            }
+        }
+        let mut inv = vec![0.0; n];
+        cycle::fill_inv_diag(&a, &mut inv);
+        let b: Vec<f64> = (0..n).map(|i| ((i as f64) * 0.71).sin()).collect();
+        // The reference: the sweep from zero, then the residual, separately.
+        let mut x_ref = vec![0.0; n];
+        let mut snap = vec![0.0; n];
+        cycle::gauss_seidel(&a, &inv, &mut x_ref, &b, &mut snap, false);
+        let mut r_ref = vec![0.0; n];
+        cycle::residual(&a, &x_ref, &b, &mut r_ref);
+        let seams = cycle::seam_rows(&a.pattern);
+        assert_eq!(seams.is_empty(), n <= cycle::GS_BLOCK);
+        let fused = |threads: usize| {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap();
+            // Whatever x holds on entry is ignored.
+            let (mut x, mut r) = (vec![1.0; n], vec![f64::NAN; n]);
+            pool.install(|| cycle::gauss_seidel_from_zero(&a, &inv, &mut x, &b, &mut r, &seams));
+            (x, r)
+        };
+        let (x, r) = fused(1);
+        assert_eq!((x.clone(), r.clone()), fused(3), "thread count");
+        let scale = norm_inf(&b);
+        for i in 0..n {
+            assert!((x[i] - x_ref[i]).abs() <= 1e-13 * scale, "x[{i}]");
+            assert!(
+                (r[i] - r_ref[i]).abs() <= 1e-13 * scale,
+                "r[{i}]: {} {}",
+                r[i],
+                r_ref[i]
+            );
+            if held(i) {
+                assert_eq!((x[i], r[i]), (0.0, b[i]));
+            }
+        }
+        assert!(
+            norm_inf(&r) > 1e-3 * scale,
+            "the residual is not trivially 0"
+        );
+    }
+}
