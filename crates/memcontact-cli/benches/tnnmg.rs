@@ -62,6 +62,7 @@ fn assembly(args: &[String]) {
         memcontact::mesh::reorder::edge_span(&mesh)
     );
     let adj = VertexTriangles::new(&mesh);
+    let boundary = mesh.boundary_vertices_with(&adj);
     time("vertex triangles", &mut || {
         std::hint::black_box(VertexTriangles::new(&mesh));
     });
@@ -69,9 +70,9 @@ fn assembly(args: &[String]) {
     time("dof map (boundary)", &mut || {
         std::hint::black_box(DofMap::with_adjacency(&mesh, &adj));
     });
-    let pattern = std::sync::Arc::new(unknowns_pattern(&mesh, &dofs, &adj));
+    let pattern = std::sync::Arc::new(unknowns_pattern(&mesh, &dofs, &adj, &boundary));
     time("pattern", &mut || {
-        std::hint::black_box(unknowns_pattern(&mesh, &dofs, &adj));
+        std::hint::black_box(unknowns_pattern(&mesh, &dofs, &adj, &boundary));
     });
     time("S and consistent L", &mut || {
         std::hint::black_box(assemble_stiffness_and_mass(

@@ -385,7 +385,7 @@ impl Mesh {
                 let v = v as u32;
                 let ends = |k: u32| {
                     let t = tri[k as usize];
-                    let a = (t[1] == v) as usize + 2 * (t[2] == v) as usize;
+                    let a = corner(t, v);
                     (t[NEXT[a]], t[PREV[a]])
                 };
                 match fan.len() {
@@ -586,6 +586,13 @@ impl DofMap {
     pub fn to_unknowns(&self, x: &[f64]) -> Vec<f64> {
         self.vertex.iter().map(|&v| x[v as usize]).collect()
     }
+}
+
+/// The local index (0, 1 or 2) of vertex `v` in triangle `t`, which must contain it
+/// (computed without branches: assembly asks it for every triangle of every patch).
+#[inline]
+pub fn corner(t: [u32; 3], v: u32) -> usize {
+    (t[1] == v) as usize + 2 * (t[2] == v) as usize
 }
 
 /// Twice-signed area / 2 of a triangle given by vertex indices.
