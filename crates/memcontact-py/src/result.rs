@@ -118,7 +118,12 @@ impl PyResult_ {
             mesh,
             fields,
             summary,
-            report: outcome.report.clone(),
+            // The result holds the fields in the user's numbering: the report's own copy
+            // (the solver's numbering) would only double them.
+            report: Report {
+                derived: None,
+                ..outcome.report.clone()
+            },
             warnings: outcome.discretization.warnings.clone(),
             seconds,
             step,
