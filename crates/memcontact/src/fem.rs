@@ -313,23 +313,25 @@ pub fn assemble_stiffness_and_mass(
     (s, l)
 }
 
-/// `∫_T c λ_a` for every corner a of triangle `k`, with `c` constant on the triangle's region
-/// (`|T| c / 3`, no element geometry beyond the area) or by quadrature.
+/// `∫_T c λ_a` for corner a of triangle `k`, with `c` constant on the triangle's region
+/// (`|T| c / 3`, from the triangle's entry of `areas` ([`Mesh::areas`])) or by quadrature.
 #[inline]
-fn element_load(mesh: &Mesh, k: usize, c: &dyn Coefficient, a: usize) -> f64 {
+fn element_load(mesh: &Mesh, areas: &[f64], k: usize, c: &dyn Coefficient, a: usize) -> f64 {
     let region = mesh.regions[k];
     match c.on_region(region) {
-        Some(v) => v * mesh.area(k) / 3.0,
+        Some(v) => v * areas[k] / 3.0,
         None => Element::of(mesh, k).weighted_load(c, region, a),
     }
 }
 
 /// The load-type vector `∫ c g_i` over unknowns (the paper's D for c = f, the lumped
-/// foundation diagonal for c = h): element areas only where c is constant on a region.
+/// foundation diagonal for c = h): element areas (`areas`, [`Mesh::areas`]) only where c
+/// is constant on a region.
 pub fn assemble_load(
     mesh: &Mesh,
     dofs: &DofMap,
     adj: &VertexTriangles,
+    areas: &[f64],
     c: &dyn Coefficient,
 ) -> Vec<f64> {
     dofs.vertex
@@ -341,7 +343,7 @@ pub fn assemble_load(
                 .map(|&k| {
                     let t = mesh.triangles[k as usize];
                     let a = corner(t, v);
-                    element_load(mesh, k as usize, c, a)
+                    element_load(mesh, areas, k as usize, c, a)
                 })
                 .sum()
         })
@@ -349,12 +351,17 @@ pub fn assemble_load(
 }
 
 /// `∫_Ω c` over the whole mesh (the total load for c = f), by the same element integrals
-/// as [`assemble_load`].
-pub fn integrate(mesh: &Mesh, c: &dyn Coefficient) -> f64 {
+/// as [`assemble_load`] (`areas` is [`Mesh::areas`]).
+pub fn integrate(mesh: &Mesh, areas: &[f64], c: &dyn Coefficient) -> f64 {
     (0..mesh.n_triangles())
         .into_par_iter()
         .with_min_len(4096)
-        .map(|k| (0..3).map(|a| element_load(mesh, k, c, a)).sum::<f64>())
+        .map(|k| match c.on_region(mesh.regions[k]) {
+            Some(v) => v * areas[k],
+            None => (0..3)
+                .map(|a| element_load(mesh, areas, k, c, a))
+                .sum::<f64>(),
+        })
         .sum()
 }
 

@@ -324,9 +324,11 @@ impl Model {
         };
         let (s, l_consistent) =
             assemble_stiffness_and_mass(mesh, &dofs, adj, &pattern, t, consistent_h);
-        let body = assemble_body(mesh, adj, &dofs, &upper, l_consistent, NAMES_UPPER)?;
+        // The triangle areas, shared by every load-type integral below.
+        let areas = mesh.areas();
+        let body = assemble_body(mesh, adj, &areas, &dofs, &upper, l_consistent, NAMES_UPPER)?;
         let load = data.load;
-        let mut d = assemble_load(mesh, &dofs, adj, load);
+        let mut d = assemble_load(mesh, &dofs, adj, &areas, load);
         if let Some(i) = d.iter().position(|v| !v.is_finite()) {
             let p = mesh.points[dofs.vertex[i] as usize];
             return Err(Error::Data(format!(
@@ -334,7 +336,7 @@ impl Model {
                 p[0], p[1]
             )));
         }
-        let total_load = integrate(mesh, load);
+        let total_load = integrate(mesh, &areas, load);
         // Boundary heights and the lifting S_fix G.
         let (boundary_values, lift) = match (&ext.boundary, &fixed) {
             (Some(b), Some(f)) => {
@@ -363,6 +365,7 @@ impl Model {
                 Some(assemble_body(
                     mesh,
                     adj,
+                    &areas,
                     &dofs,
                     low,
                     l_consistent,
@@ -721,6 +724,7 @@ impl Coefficient for Masked<'_> {
 fn assemble_body(
     mesh: &Mesh,
     adj: &VertexTriangles,
+    areas: &[f64],
     dofs: &DofMap,
     data: &BodyData,
     l_consistent: Option<Csr>,
@@ -763,7 +767,7 @@ fn assemble_body(
     let l = match (masked.elastic(), l_consistent) {
         _ if wholly_rigid => FoundationMatrix::Rigid,
         (_, Some(l)) => FoundationMatrix::Consistent(l),
-        (Some(h), None) => FoundationMatrix::Lumped(assemble_load(mesh, dofs, adj, h)),
+        (Some(h), None) => FoundationMatrix::Lumped(assemble_load(mesh, dofs, adj, areas, h)),
         (None, None) => FoundationMatrix::Rigid,
     };
     let rigid: Option<Vec<bool>> = match (&rigid_vertex, wholly_rigid) {
@@ -1022,13 +1026,16 @@ fn check_centroids(mesh: &Mesh, name: &str, c: &dyn Coefficient, non_negative: b
         .with_min_len(4096)
         .find_map_first(|k| {
             let r = mesh.regions[k];
-            let cs = mesh.corners(k);
-            let p = [
-                (cs[0][0] + cs[1][0] + cs[2][0]) / 3.0,
-                (cs[0][1] + cs[1][1] + cs[2][1]) / 3.0,
-            ];
-            let v = c.on_region(r).unwrap_or_else(|| c.at(p, r));
-            bad(v).then_some((v, p))
+            // The centroid only where c is not constant on the region (or to name a bad value).
+            let centroid = || {
+                let cs = mesh.corners(k);
+                [
+                    (cs[0][0] + cs[1][0] + cs[2][0]) / 3.0,
+                    (cs[0][1] + cs[1][1] + cs[2][1]) / 3.0,
+                ]
+            };
+            let v = c.on_region(r).unwrap_or_else(|| c.at(centroid(), r));
+            bad(v).then(|| (v, centroid()))
         });
     match found {
         Some((v, p)) => Err(bad_value(name, v, p)),
