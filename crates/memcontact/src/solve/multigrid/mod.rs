@@ -418,11 +418,9 @@ fn level_solve(ls: LevelSolve) -> Result<(usize, f64, Option<Certificate>)> {
     let mut watch = crate::certificate::FloorWatch::default();
     let mut fcg = cycle::FcgWork::default();
     let mut scale;
-    let mut floor;
     loop {
         let ev = timer.time("certificate", || crate::certificate::evaluate(model, v));
         scale = ev.certificate.force_scale;
-        floor = ev.certificate.rounding_floor;
         kkt = ev.certificate.kkt();
         if iterations > 0 {
             let record = IterationRecord::new(iterations, &ev);
@@ -455,12 +453,8 @@ fn level_solve(ls: LevelSolve) -> Result<(usize, f64, Option<Certificate>)> {
             .as_ref()
             .map(|p| mark_dirty(&pattern, p, &st, &mut changed, &mut dirty));
         // The states are (nearly) those of the last iteration: the piece of J is likely the
-        // solution's, and the Newton step on it is worth computing accurately. When they
-        // are exactly those of the last iteration, J is one quadratic on the piece and its
-        // Newton step is its minimiser: solved to the final accuracy, it ends the solve
-        // unless a state changes.
+        // solution's, and the Newton step on it is worth computing accurately.
         let settled = dirty_rows.is_some_and(|d| d <= n / 1000);
-        let repeated = dirty_rows == Some(0);
         let rows = dirty_rows.map(|_| dirty.as_slice());
         timer.time("newton system", || {
             newton_system(model, v, &st, &mut a, rows, &mut g, &mut r)
@@ -474,11 +468,8 @@ fn level_solve(ls: LevelSolve) -> Result<(usize, f64, Option<Certificate>)> {
             if options.krylov_steps > 0 {
                 // Inexact Newton: the linear residual is driven below a forcing term, the
                 // square of the current scaled KKT residual (a quarter of the tolerance at
-                // the end, or the rounding floor), and straight to that once the states
-                // repeat exactly; until the states (nearly) repeat, a few steps only.
-                let (eta, steps) = if repeated {
-                    ((0.25 * tolerance).max(floor), options.krylov_steps)
-                } else if settled {
+                // the end); until the states repeat, a few steps only.
+                let (eta, steps) = if settled {
                     (
                         kkt.min(0.5).powi(2).max(0.25 * tolerance),
                         options.krylov_steps,
