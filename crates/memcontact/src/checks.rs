@@ -18,8 +18,7 @@ use crate::{Error, Result};
 /// ([`Model::assemble_with`]) between the checks of the boundary data
 /// ([`check_boundary_data`]) and of overflow ([`check_model`]).
 pub fn assemble(mesh: &Mesh, data: &ProblemData, ext: &Extensions) -> Result<Model> {
-    let adj = VertexTriangles::new(mesh);
-    let boundary = mesh.boundary_vertices_with(&adj);
+    let (adj, boundary) = mesh.patches();
     assemble_on(mesh, &adj, &boundary, data, ext)
 }
 
@@ -42,8 +41,7 @@ pub fn assemble_on(
 /// next to the fixed boundary, that it leaves room for the prescribed height g there
 /// (`φ ≥ g` above, `φ_low ≤ g` below: otherwise no continuous solution exists).
 pub fn check_boundary_data(mesh: &Mesh, data: &ProblemData, ext: &Extensions) -> Result<()> {
-    let adj = VertexTriangles::new(mesh);
-    let boundary = mesh.boundary_vertices_with(&adj);
+    let (adj, boundary) = mesh.patches();
     check_boundary_data_on(mesh, &adj, &boundary, data, ext)
 }
 

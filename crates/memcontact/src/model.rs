@@ -272,8 +272,7 @@ impl Model {
     /// that is not finite, a membrane that nothing holds (no fixed boundary and no body
     /// that can stop it), both bodies rigid with φ_low > φ at some unknown.
     pub fn assemble_with(mesh: &Mesh, data: &ProblemData, ext: &Extensions) -> Result<Model> {
-        let adj = VertexTriangles::new(mesh);
-        let boundary = mesh.boundary_vertices_with(&adj);
+        let (adj, boundary) = mesh.patches();
         Model::assemble_on(mesh, &adj, &boundary, data, ext)
     }
 

@@ -255,8 +255,7 @@ impl Discretization {
         let t0 = Instant::now();
         let mesh = hierarchy.finest();
         // The adjacency and the boundary serve the checks, assembly and the quality report.
-        let adj = crate::fem::VertexTriangles::new(mesh);
-        let boundary = mesh.boundary_vertices_with(&adj);
+        let (adj, boundary) = mesh.patches();
         let bound = BoundData::new(problem, mesh)?;
         let data = bound.data(problem);
         let model =

@@ -362,7 +362,16 @@ impl Mesh {
 
     /// `true` for every vertex on the boundary ∂Ω_n.
     pub fn boundary_vertices(&self) -> Vec<bool> {
-        self.boundary_vertices_with(&VertexTriangles::new(self))
+        self.patches().1
+    }
+
+    /// The vertex → triangles adjacency (the patches `Q_i`) and the boundary vertices
+    /// ([`Mesh::boundary_vertices_with`]): built once, shared by assembly, its data checks
+    /// and the quality report.
+    pub fn patches(&self) -> (VertexTriangles, Vec<bool>) {
+        let adj = VertexTriangles::new(self);
+        let boundary = self.boundary_vertices_with(&adj);
+        (adj, boundary)
     }
 
     /// [`Mesh::boundary_vertices`] with a prebuilt vertex → triangles adjacency.
