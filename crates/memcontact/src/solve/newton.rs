@@ -117,21 +117,83 @@ pub fn newton_system(
     g: &mut [f64],
     r: &mut [f64],
 ) {
-    if model.is_extended() {
-        newton_system_with::<true>(model, v, st, a, rows, g, r)
-    } else {
-        newton_system_with::<false>(model, v, st, a, rows, g, r)
+    newton_system_into(model, v, st, Hessian::Rows(a, rows), g, r)
+}
+
+/// The truncated Newton matrix as TNNMG keeps it between iterations.
+#[derive(Debug, Clone)]
+pub enum NewtonMatrix {
+    /// Assembled on the pattern of S (a consistent foundation couples neighbours).
+    Assembled(Csr),
+    /// When every body's foundation is lumped or rigid, the Hessian differs from S only on
+    /// the diagonal and in the truncated rows and columns: the diagonal added to S alone,
+    /// read with S as a [`Shifted`](super::multigrid::operator::Shifted) operator (one vector instead of a copy of S's values).
+    Diagonal(Vec<f64>),
+}
+
+impl NewtonMatrix {
+    /// The form `model`'s Newton matrices take, zero.
+    pub fn for_model(model: &Model) -> NewtonMatrix {
+        let consistent = |l: &FoundationMatrix| matches!(l, FoundationMatrix::Consistent(_));
+        if consistent(&model.l) || model.lower.as_ref().is_some_and(|b| consistent(&b.l)) {
+            NewtonMatrix::Assembled(Csr::zeros(model.s.pattern.clone()))
+        } else {
+            NewtonMatrix::Diagonal(vec![0.0; model.n()])
+        }
+    }
+
+    /// [`newton_system`] into this matrix (a [`NewtonMatrix::Diagonal`] is always refilled
+    /// whole: it is one vector).
+    #[allow(clippy::too_many_arguments)]
+    pub fn fill(
+        &mut self,
+        model: &Model,
+        v: &[f64],
+        st: &NewtonStates,
+        rows: Option<&[bool]>,
+        g: &mut [f64],
+        r: &mut [f64],
+    ) {
+        let target = match self {
+            NewtonMatrix::Assembled(a) => Hessian::Rows(a, rows),
+            NewtonMatrix::Diagonal(d) => Hessian::Diagonal(d),
+        };
+        newton_system_into(model, v, st, target, g, r)
     }
 }
 
-/// [`newton_system`]; `EXT`: with the body below's terms `− E_Q L_low q` in the gradient
-/// and `E_Q L_low E_Q` in the Hessian (`q = (φ_low − V)⁺`, Q its penetrating vertices).
+/// Where [`newton_system_into`] puts the Hessian.
+enum Hessian<'x> {
+    /// Into a matrix on S's pattern, only the flagged rows when given.
+    Rows(&'x mut Csr, Option<&'x [bool]>),
+    /// The diagonal added to S (lumped and rigid foundations only), zero on truncated rows.
+    Diagonal(&'x mut [f64]),
+}
+
+/// [`newton_system`] into either form of the Hessian.
+fn newton_system_into(
+    model: &Model,
+    v: &[f64],
+    st: &NewtonStates,
+    hessian: Hessian,
+    g: &mut [f64],
+    r: &mut [f64],
+) {
+    if model.is_extended() {
+        newton_system_with::<true>(model, v, st, hessian, g, r)
+    } else {
+        newton_system_with::<false>(model, v, st, hessian, g, r)
+    }
+}
+
+/// [`newton_system_into`]; `EXT`: with the body below's terms `− E_Q L_low q` in the
+/// gradient and `E_Q L_low E_Q` in the Hessian (`q = (φ_low − V)⁺`, Q its penetrating
+/// vertices).
 fn newton_system_with<const EXT: bool>(
     model: &Model,
     v: &[f64],
     st: &NewtonStates,
-    a: &mut Csr,
-    rows: Option<&[bool]>,
+    hessian: Hessian,
     g: &mut [f64],
     r: &mut [f64],
 ) {
@@ -145,7 +207,7 @@ fn newton_system_with<const EXT: bool>(
             0.0
         }
     };
-    let row = |i: usize, arow: &mut [f64], gi: &mut f64, ri: &mut f64| {
+    let gradient = |i: usize, gi: &mut f64, ri: &mut f64| {
         let (s, e) = (pat.row_ptr[i], pat.row_ptr[i + 1]);
         let cols = &pat.col[s..e];
         let mut sv = 0.0;
@@ -192,9 +254,27 @@ fn newton_system_with<const EXT: bool>(
                 };
             }
         }
-        if !rows.is_none_or(|d| d[i]) {
-            return;
+    };
+    // The diagonal added to S in row i (lumped and rigid foundations).
+    let shift = |i: usize| -> f64 {
+        if st.truncated[i] {
+            return 0.0;
         }
+        let mut d = if st.penetrating[i] {
+            model.l.diag(i)
+        } else {
+            0.0
+        };
+        if let Some(low) = lower {
+            if st.below(i) {
+                d += low.l.diag(i);
+            }
+        }
+        d
+    };
+    let matrix_row = |i: usize, arow: &mut [f64]| {
+        let (s, e) = (pat.row_ptr[i], pat.row_ptr[i + 1]);
+        let cols = &pat.col[s..e];
         for (k, &j) in cols.iter().enumerate() {
             let j = j as usize;
             arow[k] = if st.truncated[i] || st.truncated[j] {
@@ -219,27 +299,55 @@ fn newton_system_with<const EXT: bool>(
             }
         }
     };
-    let blocks = row_chunks(&pat, &mut a.val, CHUNK);
-    type Block<'a> = ((usize, &'a mut [f64]), (&'a mut [f64], &'a mut [f64]));
-    let work = |((start, vals), (gc, rc)): Block| {
-        let mut off = 0;
-        for (k, (gi, ri)) in gc.iter_mut().zip(rc.iter_mut()).enumerate() {
-            let i = start + k;
-            let len = pat.row_ptr[i + 1] - pat.row_ptr[i];
-            row(i, &mut vals[off..off + len], gi, ri);
-            off += len;
+    match hessian {
+        Hessian::Rows(a, rows) => {
+            let blocks = row_chunks(&pat, &mut a.val, CHUNK);
+            type Block<'a> = ((usize, &'a mut [f64]), (&'a mut [f64], &'a mut [f64]));
+            let work = |((start, vals), (gc, rc)): Block| {
+                let mut off = 0;
+                for (k, (gi, ri)) in gc.iter_mut().zip(rc.iter_mut()).enumerate() {
+                    let i = start + k;
+                    let len = pat.row_ptr[i + 1] - pat.row_ptr[i];
+                    gradient(i, gi, ri);
+                    if rows.is_none_or(|d| d[i]) {
+                        matrix_row(i, &mut vals[off..off + len]);
+                    }
+                    off += len;
+                }
+            };
+            if v.len() >= PAR_ROWS {
+                blocks
+                    .into_par_iter()
+                    .zip(g.par_chunks_mut(CHUNK).zip(r.par_chunks_mut(CHUNK)))
+                    .for_each(work);
+            } else {
+                blocks
+                    .into_iter()
+                    .zip(g.chunks_mut(CHUNK).zip(r.chunks_mut(CHUNK)))
+                    .for_each(work);
+            }
         }
-    };
-    if v.len() >= PAR_ROWS {
-        blocks
-            .into_par_iter()
-            .zip(g.par_chunks_mut(CHUNK).zip(r.par_chunks_mut(CHUNK)))
-            .for_each(work);
-    } else {
-        blocks
-            .into_iter()
-            .zip(g.chunks_mut(CHUNK).zip(r.chunks_mut(CHUNK)))
-            .for_each(work);
+        Hessian::Diagonal(d) => {
+            type Block<'a> = (&'a mut [f64], (&'a mut [f64], &'a mut [f64]));
+            let work = |(start, (dc, (gc, rc))): (usize, Block)| {
+                for (k, (di, (gi, ri))) in dc.iter_mut().zip(gc.iter_mut().zip(rc)).enumerate() {
+                    let i = start * CHUNK + k;
+                    gradient(i, gi, ri);
+                    *di = shift(i);
+                }
+            };
+            if v.len() >= PAR_ROWS {
+                d.par_chunks_mut(CHUNK)
+                    .zip(g.par_chunks_mut(CHUNK).zip(r.par_chunks_mut(CHUNK)))
+                    .enumerate()
+                    .for_each(work);
+            } else {
+                d.chunks_mut(CHUNK)
+                    .zip(g.chunks_mut(CHUNK).zip(r.chunks_mut(CHUNK)))
+                    .enumerate()
+                    .for_each(work);
+            }
+        }
     }
 }
 
@@ -361,6 +469,28 @@ mod tests {
                     };
                     assert_eq!(a.get(i, j), expect, "{f:?} ({i}, {j})");
                 }
+            }
+            // Lumped and rigid foundations keep the diagonal added to S alone: read as an
+            // operator, it is the assembled matrix entry by entry, with the same gradient.
+            let mut m = NewtonMatrix::for_model(&model);
+            let (mut g2, mut r2) = (vec![0.0; n], vec![0.0; n]);
+            m.fill(&model, &v, &st, None, &mut g2, &mut r2);
+            assert_eq!((&g2, &r2), (&g, &r));
+            match (&m, f) {
+                (NewtonMatrix::Assembled(b), Foundation::Consistent) => assert_eq!(b.val, a.val),
+                (NewtonMatrix::Diagonal(d), Foundation::Lumped) => {
+                    let op = crate::solve::multigrid::operator::Shifted {
+                        s: &model.s,
+                        shift: d,
+                        held: &st.truncated,
+                    };
+                    let mut vals = vec![0.0; a.val.len()];
+                    crate::solve::multigrid::operator::values_into(&op, &mut vals);
+                    for (p, q) in vals.iter().zip(&a.val) {
+                        assert!((p - q).abs() <= 1e-12 * q.abs(), "{p} against {q}");
+                    }
+                }
+                _ => panic!("{f:?}: the wrong form of the Newton matrix"),
             }
             // Only the flagged rows are refilled.
             let mut b = a.clone();

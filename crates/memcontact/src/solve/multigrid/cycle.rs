@@ -17,6 +17,7 @@
 //! * Coarsest level: sparse Cholesky ([`Cholesky`], symbolic analysis once), zero rows
 //!   replaced by the identity.
 
+use super::operator::{apply, values_into, zero_held, TopOperator};
 use super::transfer::{galerkin_patterns, par_rows, Transfer};
 use crate::mesh::refine::{Hierarchy, Refinement};
 use crate::mesh::{DofMap, Mesh};
@@ -223,11 +224,12 @@ pub struct Multigrid<'a> {
     /// `1 / A_ii`, or 0 on zero rows, for levels `0..=top`.
     inv_diag: Vec<Vec<f64>>,
     /// Iterate, right-hand side and residual per level `0..top`, and the residual on top.
+    /// A level's residual vector is also the block smoother's copy of the iterate
+    /// ([`gauss_seidel`]) whenever it is free: before the residual is computed, and after
+    /// it was restricted.
     x: Vec<Vec<f64>>,
     b: Vec<Vec<f64>>,
     r: Vec<Vec<f64>>,
-    /// The block smoother's copy of the iterate, per level (empty for small levels).
-    snap: Vec<Vec<f64>>,
     /// The rows coupled to another smoothing block, per level ([`seam_rows`]).
     seams: Vec<Vec<u32>>,
     dirty: Vec<Vec<bool>>,
@@ -256,15 +258,6 @@ impl<'a> Multigrid<'a> {
             x: (0..top).map(zeros).collect(),
             b: (0..top).map(zeros).collect(),
             r: (0..=top).map(zeros).collect(),
-            snap: (0..=top)
-                .map(|k| {
-                    if levels.n(k) > GS_BLOCK {
-                        zeros(k)
-                    } else {
-                        Vec::new()
-                    }
-                })
-                .collect(),
             seams: (0..=top).map(|k| seam_rows(&levels.patterns[k])).collect(),
             dirty: (0..top).map(|k| vec![true; levels.n(k)]).collect(),
             coarsest: Csr::zeros(levels.patterns[0].clone()),
@@ -291,9 +284,9 @@ impl<'a> Multigrid<'a> {
     /// Every step lowers the quadratic `½xᵀAx − bᵀx`, so `x` is a descent direction of it
     /// from the first step on.
     #[allow(clippy::too_many_arguments)]
-    pub fn fcg(
+    pub fn fcg<A: TopOperator>(
         &mut self,
-        a: &Csr,
+        a: &A,
         x: &mut [f64],
         b: &mut [f64],
         target: f64,
@@ -323,7 +316,7 @@ impl<'a> Multigrid<'a> {
                 let beta = -det_dot(z, ap) / pap_prev;
                 par_rows(p, |i, v| *v = z[i] + beta * *v);
             }
-            a.mul_into(p, ap);
+            apply(a, p, ap);
             let pap = det_dot(p, ap);
             if !(pap > 0.0 && pap.is_finite()) {
                 break;
@@ -342,7 +335,7 @@ impl<'a> Multigrid<'a> {
 
     /// One cycle for `A x = b` on the top level: the V-cycle on a geometric hierarchy, the
     /// K-cycle on an algebraic one (see [`Multigrid::v_cycle`], [`Multigrid::k_cycle`]).
-    pub fn cycle(&mut self, fine: &Csr, x: &mut [f64], b: &[f64]) {
+    pub fn cycle<A: TopOperator>(&mut self, fine: &A, x: &mut [f64], b: &[f64]) {
         match self.levels.kind {
             Kind::Geometric => self.v_cycle(fine, x, b),
             Kind::Algebraic => self.k_cycle(fine, x, b),
@@ -352,7 +345,7 @@ impl<'a> Multigrid<'a> {
     /// [`Multigrid::cycle`] from `x = 0`, whatever `x` holds on entry (the preconditioner
     /// of [`Multigrid::fcg`]): the first smoothing sweep and the residual after it are then
     /// one pass over A ([`gauss_seidel_from_zero`]).
-    pub fn cycle_from_zero(&mut self, fine: &Csr, x: &mut [f64], b: &[f64]) {
+    pub fn cycle_from_zero<A: TopOperator>(&mut self, fine: &A, x: &mut [f64], b: &[f64]) {
         if self.top == 0 {
             x.iter_mut().for_each(|v| *v = 0.0);
             return self.cycle(fine, x, b);
@@ -366,19 +359,28 @@ impl<'a> Multigrid<'a> {
 
     /// Pre-smoothing on the top level and its residual into `r[top]`; from `x = 0` when
     /// `from_zero` (then fused into one pass when A's pattern is the top level's own).
-    fn presmooth_top(&mut self, fine: &Csr, x: &mut [f64], b: &[f64], from_zero: bool) {
+    fn presmooth_top<A: TopOperator>(
+        &mut self,
+        fine: &A,
+        x: &mut [f64],
+        b: &[f64],
+        from_zero: bool,
+    ) {
         let top = self.top;
         let nu1 = self.smoothing.0;
-        if from_zero && nu1 == 1 && Arc::ptr_eq(&fine.pattern, &self.levels.patterns[top]) {
+        if from_zero && nu1 == 1 && Arc::ptr_eq(&fine.matrix().pattern, &self.levels.patterns[top])
+        {
             let (inv, seams) = (&self.inv_diag[top], &self.seams[top]);
             gauss_seidel_from_zero(fine, inv, x, b, &mut self.r[top], seams);
             return;
         }
         if from_zero {
             x.iter_mut().for_each(|v| *v = 0.0);
+        } else {
+            zero_held(fine, x);
         }
         for _ in 0..nu1 {
-            gauss_seidel(fine, &self.inv_diag[top], x, b, &mut self.snap[top], false);
+            gauss_seidel(fine, &self.inv_diag[top], x, b, &mut self.r[top], false);
         }
         residual(fine, x, b, &mut self.r[top]);
     }
@@ -391,7 +393,7 @@ impl<'a> Multigrid<'a> {
     /// next level (one step when it already reduces the residual by 4). With the
     /// piecewise-constant prolongation of aggregation, the V-cycle's convergence degrades
     /// with every level; the K-cycle's does not. Zero rows of A leave their x unchanged.
-    pub fn k_cycle(&mut self, fine: &Csr, x: &mut [f64], b: &[f64]) {
+    pub fn k_cycle<A: TopOperator>(&mut self, fine: &A, x: &mut [f64], b: &[f64]) {
         let top = self.top;
         if top == 0 {
             return self.v_cycle(fine, x, b);
@@ -401,13 +403,14 @@ impl<'a> Multigrid<'a> {
     }
 
     /// The K-cycle after the top level's pre-smoothing (its residual is in `r[top]`).
-    fn k_cycle_below(&mut self, fine: &Csr, x: &mut [f64], b: &[f64]) {
+    fn k_cycle_below<A: TopOperator>(&mut self, fine: &A, x: &mut [f64], b: &[f64]) {
         let top = self.top;
         self.levels.transfers[top - 1].restrict(&self.r[top], &mut self.b[top - 1]);
         self.krylov_correction(top - 1);
         self.levels.transfers[top - 1].prolongate_add(&self.x[top - 1], x);
+        zero_held(fine, x);
         for _ in 0..self.smoothing.1 {
-            gauss_seidel(fine, &self.inv_diag[top], x, b, &mut self.snap[top], true);
+            gauss_seidel(fine, &self.inv_diag[top], x, b, &mut self.r[top], true);
         }
     }
 
@@ -475,7 +478,7 @@ impl<'a> Multigrid<'a> {
         } else {
             xk.iter_mut().for_each(|v| *v = 0.0);
             for _ in 0..self.smoothing.0 {
-                gauss_seidel(a, inv, xk, bk, &mut self.snap[k], false);
+                gauss_seidel(a, inv, xk, bk, &mut self.r[k], false);
             }
             residual(a, xk, bk, &mut self.r[k]);
         }
@@ -494,7 +497,7 @@ impl<'a> Multigrid<'a> {
                 &self.inv_diag[k],
                 &mut xu[0],
                 &self.b[k],
-                &mut self.snap[k],
+                &mut self.r[k],
                 true,
             );
         }
@@ -516,14 +519,14 @@ impl<'a> Multigrid<'a> {
     /// top level). With `dirty_fine`, only the coarse rows that depend on the flagged fine
     /// rows are recomputed (the caller guarantees the other fine rows did not change since
     /// the last update).
-    pub fn update(&mut self, fine: &Csr, dirty_fine: Option<&[bool]>) -> Result<()> {
+    pub fn update<A: TopOperator>(&mut self, fine: &A, dirty_fine: Option<&[bool]>) -> Result<()> {
         let top = self.top;
-        if fine.n() != self.levels.n(top) {
+        if fine.matrix().n() != self.levels.n(top) {
             return Err(Error::Solver {
                 solver: "multigrid".into(),
                 message: format!(
                     "operator of {} rows for a level of {} unknowns",
-                    fine.n(),
+                    fine.matrix().n(),
                     self.levels.n(top)
                 ),
             });
@@ -533,7 +536,6 @@ impl<'a> Multigrid<'a> {
         for k in (0..top).rev() {
             let t = &self.levels.transfers[k];
             let (lower, upper) = self.coarse.split_at_mut(k + 1);
-            let finer: &Csr = if k + 1 == top { fine } else { &upper[0] };
             let (dl, du) = self.dirty.split_at_mut(k + 1);
             let dirty_here = &mut dl[k];
             let use_dirty = match (k + 1 == top, dirty_fine) {
@@ -551,14 +553,21 @@ impl<'a> Multigrid<'a> {
             if !use_dirty {
                 dirty_here.iter_mut().for_each(|d| *d = true);
             }
-            t.galerkin_values(finer, &mut lower[k], Some(dirty_here));
+            if k + 1 == top {
+                t.galerkin_values(fine, &mut lower[k], Some(dirty_here));
+            } else {
+                t.galerkin_values(&upper[0], &mut lower[k], Some(dirty_here));
+            }
             fill_inv_diag(&lower[k], &mut self.inv_diag[k]);
         }
         // The coarsest level: refactor when anything changed there.
         let changed = first || top == 0 || self.dirty[0].iter().any(|&d| d);
         if changed {
-            let a0 = if top == 0 { fine } else { &self.coarse[0] };
-            self.coarsest.val.copy_from_slice(&a0.val);
+            if top == 0 {
+                values_into(fine, &mut self.coarsest.val);
+            } else {
+                self.coarsest.val.copy_from_slice(&self.coarse[0].val);
+            }
             let pat = self.coarsest.pattern.clone();
             for i in 0..pat.n() {
                 if self.inv_diag[0][i] == 0.0 {
@@ -578,10 +587,11 @@ impl<'a> Multigrid<'a> {
     /// One V-cycle for `A x = b` on the top level (`fine` = its operator, as given to the
     /// last [`Multigrid::update`]), improving `x` in place. Zero rows of A leave their x
     /// unchanged (the caller may zero them afterwards).
-    pub fn v_cycle(&mut self, fine: &Csr, x: &mut [f64], b: &[f64]) {
+    pub fn v_cycle<A: TopOperator>(&mut self, fine: &A, x: &mut [f64], b: &[f64]) {
         let top = self.top;
         if top == 0 {
             // One level: the direct solve, on the residual equation.
+            zero_held(fine, x);
             let r = &mut self.r[0];
             residual(fine, x, b, r);
             self.solve_coarsest_in_place(None);
@@ -599,7 +609,7 @@ impl<'a> Multigrid<'a> {
     }
 
     /// The V-cycle after the top level's pre-smoothing (its residual is in `r[top]`).
-    fn v_cycle_below(&mut self, fine: &Csr, x: &mut [f64], b: &[f64]) {
+    fn v_cycle_below<A: TopOperator>(&mut self, fine: &A, x: &mut [f64], b: &[f64]) {
         let top = self.top;
         self.levels.transfers[top - 1].restrict(&self.r[top], &mut self.b[top - 1]);
         for k in (1..top).rev() {
@@ -612,8 +622,9 @@ impl<'a> Multigrid<'a> {
             self.prolongate_and_postsmooth(k);
         }
         self.levels.transfers[top - 1].prolongate_add(&self.x[top - 1], x);
+        zero_held(fine, x);
         for _ in 0..self.smoothing.1 {
-            gauss_seidel(fine, &self.inv_diag[top], x, b, &mut self.snap[top], true);
+            gauss_seidel(fine, &self.inv_diag[top], x, b, &mut self.r[top], true);
         }
     }
 
@@ -677,14 +688,15 @@ fn det_dot(a: &[f64], b: &[f64]) -> f64 {
     }
 }
 
-/// `1 / A_ii`, or 0 where `A_ii ≤ 0` (zero rows).
-pub(crate) fn fill_inv_diag(a: &Csr, inv: &mut [f64]) {
+/// `1 / A_ii`, or 0 where `A_ii ≤ 0` (zero rows, held rows).
+pub(crate) fn fill_inv_diag<A: TopOperator>(op: &A, inv: &mut [f64]) {
+    let a = op.matrix();
     let pat = &a.pattern;
     par_rows(inv, |i, d| {
         let (s, e) = (pat.row_ptr[i], pat.row_ptr[i + 1]);
         let k = pat.col[s..e].partition_point(|&j| (j as usize) < i);
         let aii = if s + k < e && pat.col[s + k] as usize == i {
-            a.val[s + k]
+            super::operator::entry(op, i, i, a.val[s + k])
         } else {
             0.0
         };
@@ -692,13 +704,29 @@ pub(crate) fn fill_inv_diag(a: &Csr, inv: &mut [f64]) {
     });
 }
 
-/// `r = b − A x`.
-pub(crate) fn residual(a: &Csr, x: &[f64], b: &[f64], r: &mut [f64]) {
+/// `r = b − A x` (x zero on held unknowns).
+pub(crate) fn residual<A: TopOperator>(op: &A, x: &[f64], b: &[f64], r: &mut [f64]) {
+    let a = op.matrix();
     let pat = &a.pattern;
     par_rows(r, |i, ri| {
+        if !A::PLAIN && op.held(i) {
+            *ri = b[i];
+            return;
+        }
         let (s, e) = (pat.row_ptr[i], pat.row_ptr[i + 1]);
-        *ri = b[i] - row_sum(&pat.col[s..e], &a.val[s..e], |j| x[j]);
+        *ri = b[i] - (row_sum(&pat.col[s..e], &a.val[s..e], |j| x[j]) + shift_term(op, i, x[i]));
     });
+}
+
+/// `shift_i x_i`: the part of row i's product that the stored matrix lacks (none for an
+/// assembled matrix, not even a rounding of zero).
+#[inline(always)]
+fn shift_term<A: TopOperator>(op: &A, i: usize, xi: f64) -> f64 {
+    if A::PLAIN {
+        0.0
+    } else {
+        op.shift(i) * xi
+    }
 }
 
 /// Rows per block of the block Gauss-Seidel smoother. The blocks are fixed by the matrix
@@ -725,9 +753,9 @@ fn row_sum(cols: &[u32], vals: &[f64], x: impl Fn(usize) -> f64) -> f64 {
 /// backward. Up to [`GS_BLOCK`] unknowns it is the classical sweep; beyond, the rows are cut
 /// into blocks of [`GS_BLOCK`] that are swept in parallel, each by Gauss-Seidel inside the
 /// block and with the values of the other blocks from before the sweep (hybrid
-/// Gauss-Seidel, kept in `snapshot`).
-pub(crate) fn gauss_seidel(
-    a: &Csr,
+/// Gauss-Seidel, kept in `snapshot`). `x` is zero on held unknowns, and stays so.
+pub(crate) fn gauss_seidel<A: TopOperator>(
+    op: &A,
     inv: &[f64],
     x: &mut [f64],
     b: &[f64],
@@ -735,6 +763,7 @@ pub(crate) fn gauss_seidel(
     backward: bool,
 ) {
     use rayon::prelude::*;
+    let a = op.matrix();
     let pat = &a.pattern;
     let n = x.len();
     let sweep = |lo: usize, xs: &mut [f64], outside: &[f64]| {
@@ -751,7 +780,7 @@ pub(crate) fn gauss_seidel(
                 } else {
                     outside[j]
                 }
-            });
+            }) + shift_term(op, i, xs[i - lo]);
             xs[i - lo] += (b[i] - ax) * d;
         };
         if backward {
@@ -798,9 +827,10 @@ pub(crate) fn seam_rows(pattern: &Pattern) -> Vec<u32> {
 /// (later unknowns of its block are still 0); the later rows' part reaches r_i from
 /// them, `a_ki x_k = a_ik x_k` scattered from row k as soon as x_k is known. Unknowns of
 /// other blocks are 0 during the sweep (the hybrid sweep's start), so their part is added
-/// at the end, on the rows of `seams` ([`seam_rows`] of A's pattern) alone.
-pub(crate) fn gauss_seidel_from_zero(
-    a: &Csr,
+/// at the end, on the rows of `seams` ([`seam_rows`] of A's pattern) alone. Held rows
+/// keep `x = 0` and `r = b`.
+pub(crate) fn gauss_seidel_from_zero<A: TopOperator>(
+    op: &A,
     inv: &[f64],
     x: &mut [f64],
     b: &[f64],
@@ -808,6 +838,7 @@ pub(crate) fn gauss_seidel_from_zero(
     seams: &[u32],
 ) {
     use rayon::prelude::*;
+    let a = op.matrix();
     let pat = &a.pattern;
     let n = x.len();
     let sweep = |lo: usize, xs: &mut [f64], rs: &mut [f64]| {
@@ -827,7 +858,7 @@ pub(crate) fn gauss_seidel_from_zero(
             let xi = (b[i] - lower) * inv[i];
             xs[k] = xi;
             let aii = match cols.get(diag) {
-                Some(&c) if c as usize == i => vals[diag],
+                Some(&c) if c as usize == i => vals[diag] + shift_term(op, i, 1.0),
                 _ => 0.0,
             };
             rs[k] = b[i] - lower - aii * xi;
@@ -836,8 +867,19 @@ pub(crate) fn gauss_seidel_from_zero(
             }
         }
     };
+    // A free row scatters its part into a held neighbour's residual: put back `r = b`.
+    let restore_held = |r: &mut [f64]| {
+        if !A::PLAIN {
+            par_rows(r, |i, ri| {
+                if op.held(i) {
+                    *ri = b[i];
+                }
+            });
+        }
+    };
     if n <= GS_BLOCK {
         sweep(0, x, r);
+        restore_held(r);
         return;
     }
     x.par_chunks_mut(GS_BLOCK)
@@ -863,6 +905,7 @@ pub(crate) fn gauss_seidel_from_zero(
             rs[i - lo] -= outside;
         }
     });
+    restore_held(r);
 }
 
 /// The result of a linear multigrid solve.

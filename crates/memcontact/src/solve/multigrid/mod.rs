@@ -28,6 +28,7 @@
 
 pub mod aggregation;
 pub mod cycle;
+pub mod operator;
 pub mod transfer;
 
 #[cfg(test)]
@@ -41,7 +42,7 @@ pub use transfer::Transfer;
 use super::active_set::start_from;
 use super::line_search::{apply_step, exact_step, line_data};
 use super::local::sweep_forward;
-use super::newton::{mark_dirty, newton_system, NewtonStates};
+use super::newton::{mark_dirty, newton_system, NewtonMatrix, NewtonStates};
 use super::{IterationRecord, Method, Observer, PhaseTimer, Settings, Solution};
 use crate::mesh::refine::Hierarchy;
 use crate::model::{Certificate, FoundationMatrix, Model};
@@ -368,6 +369,28 @@ fn coarse_model(fine: &Model, t: &Transfer, levels: &Levels, k: usize) -> Model 
     }
 }
 
+/// Evaluates `$body` with `$op` bound to the Newton matrix `$a` ([`NewtonMatrix`]) of
+/// `$model` at the states `$st`, as a multigrid top-level operator of its own type (the
+/// kernels are compiled for each form).
+macro_rules! with_operator {
+    ($a:expr, $model:expr, $st:expr, |$op:ident| $body:expr) => {
+        match &$a {
+            NewtonMatrix::Assembled(m) => {
+                let $op = m;
+                $body
+            }
+            NewtonMatrix::Diagonal(d) => {
+                let $op = &operator::Shifted {
+                    s: &$model.s,
+                    shift: d,
+                    held: &$st.truncated,
+                };
+                $body
+            }
+        }
+    };
+}
+
 /// Everything one level's TNNMG iteration needs.
 struct LevelSolve<'a, 'b> {
     model: &'a Model,
@@ -402,7 +425,7 @@ fn level_solve(ls: LevelSolve) -> Result<(usize, f64, Option<Certificate>)> {
     } = ls;
     let n = model.n();
     let pattern = model.s.pattern.clone();
-    let mut a = Csr::zeros(pattern.clone());
+    let mut a = NewtonMatrix::for_model(model);
     let mut mg = Multigrid::new(levels, top);
     mg.smoothing = options.smoothing;
     let mut delta = vec![0.0; n];
@@ -457,9 +480,11 @@ fn level_solve(ls: LevelSolve) -> Result<(usize, f64, Option<Certificate>)> {
         let settled = dirty_rows.is_some_and(|d| d <= n / 1000);
         let rows = dirty_rows.map(|_| dirty.as_slice());
         timer.time("newton system", || {
-            newton_system(model, v, &st, &mut a, rows, &mut g, &mut r)
+            a.fill(model, v, &st, rows, &mut g, &mut r)
         });
-        timer.time("coarse operators", || mg.update(&a, rows))?;
+        timer.time("coarse operators", || {
+            with_operator!(a, model, st, |op| mg.update(op, rows))
+        })?;
         timer.time("v-cycle", || {
             for x in g.iter_mut() {
                 *x = -*x;
@@ -477,18 +502,18 @@ fn level_solve(ls: LevelSolve) -> Result<(usize, f64, Option<Certificate>)> {
                 } else {
                     (0.0, options.cycles)
                 };
-                mg.fcg(
-                    &a,
+                with_operator!(a, model, st, |op| mg.fcg(
+                    op,
                     &mut delta,
                     &mut g,
                     eta * scale,
                     steps,
                     &st.truncated,
                     &mut fcg,
-                );
+                ));
             } else {
                 for _ in 0..options.cycles {
-                    mg.cycle(&a, &mut delta, &g);
+                    with_operator!(a, model, st, |op| mg.cycle(op, &mut delta, &g));
                 }
             }
             let extended = model.is_extended();

@@ -9,6 +9,7 @@
 //! restriction `Pᵀ` and for the Galerkin product, so that every coarse entry is a sum in a
 //! fixed order: results never depend on the number of threads.
 
+use super::operator::{entry, TopOperator};
 use crate::mesh::refine::Refinement;
 use crate::mesh::DofMap;
 use crate::sparse::{row_chunks, Csr, Pattern};
@@ -259,9 +260,15 @@ impl Transfer {
     /// [`Transfer::galerkin_pattern`] of `fine`'s pattern) with `Pᵀ A P`, only the rows
     /// flagged in `dirty` when given. Every entry is summed in a fixed order (children of
     /// the row, then the fine row's entries), whatever the number of threads.
-    pub fn galerkin_values(&self, fine: &Csr, coarse: &mut Csr, dirty: Option<&[bool]>) {
+    pub fn galerkin_values<A: TopOperator>(
+        &self,
+        op: &A,
+        coarse: &mut Csr,
+        dirty: Option<&[bool]>,
+    ) {
         let n_coarse = self.n_coarse;
         let cpat = coarse.pattern.clone();
+        let fine = op.matrix();
         let fpat = &fine.pattern;
         let row = |i: usize, vals: &mut [f64], marker: &mut [u32]| {
             let cols = &cpat.col[cpat.row_ptr[i]..cpat.row_ptr[i + 1]];
@@ -274,6 +281,7 @@ impl Transfer {
                 let wv = f64::from(self.child_weights[c]);
                 let (s, e) = (fpat.row_ptr[v], fpat.row_ptr[v + 1]);
                 for (&w, &a) in fpat.col[s..e].iter().zip(&fine.val[s..e]) {
+                    let a = entry(op, v, w as usize, a);
                     if a == 0.0 {
                         continue;
                     }
