@@ -278,6 +278,9 @@ impl Transfer {
             }
             for c in self.child_ptr[i]..self.child_ptr[i + 1] {
                 let v = self.children[c] as usize;
+                if !A::PLAIN && op.held(v) {
+                    continue; // a zero row
+                }
                 let wv = f64::from(self.child_weights[c]);
                 let (s, e) = (fpat.row_ptr[v], fpat.row_ptr[v + 1]);
                 for (&w, &a) in fpat.col[s..e].iter().zip(&fine.val[s..e]) {
