@@ -5,7 +5,8 @@
 //! * Levels: the unknowns (interior vertices) of every mesh of the hierarchy that has
 //!   any; prolongations [`Transfer`] between consecutive ones.
 //! * Operators: the finest one is given by the caller (S, or the truncated Hessian of
-//!   TNNMG, whose truncated rows and columns are zero); the coarser ones are the Galerkin
+//!   TNNMG, whose truncated rows and columns are zero, assembled or read from S with a
+//!   diagonal shift: [`super::operator`]); the coarser ones are the Galerkin
 //!   products `A_{k-1} = Pₖᵀ A_k Pₖ` on patterns computed once ([`Levels`]), refilled
 //!   value by value, and only in the rows that changed when the caller says which.
 //! * Smoother: Gauss-Seidel, forward before and backward after the coarse correction (the
