@@ -144,7 +144,6 @@ impl NewtonMatrix {
 
     /// [`newton_system`] into this matrix (a [`NewtonMatrix::Diagonal`] is always refilled
     /// whole: it is one vector).
-    #[allow(clippy::too_many_arguments)]
     pub fn fill(
         &mut self,
         model: &Model,
@@ -329,9 +328,9 @@ fn newton_system_with<const EXT: bool>(
         }
         Hessian::Diagonal(d) => {
             type Block<'a> = (&'a mut [f64], (&'a mut [f64], &'a mut [f64]));
-            let work = |(start, (dc, (gc, rc))): (usize, Block)| {
+            let work = |(block, (dc, (gc, rc))): (usize, Block)| {
                 for (k, (di, (gi, ri))) in dc.iter_mut().zip(gc.iter_mut().zip(rc)).enumerate() {
-                    let i = start * CHUNK + k;
+                    let i = block * CHUNK + k;
                     gradient(i, gi, ri);
                     *di = shift(i);
                 }

@@ -408,6 +408,18 @@ impl<'a> Multigrid<'a> {
         let top = self.top;
         self.levels.transfers[top - 1].restrict(&self.r[top], &mut self.b[top - 1]);
         self.krylov_correction(top - 1);
+        self.prolongate_and_postsmooth_top(fine, x, b);
+    }
+
+    /// On the top level: the correction of the level below prolongated into `x` (zero on
+    /// held unknowns), then `ν₂` Gauss-Seidel sweeps in reverse order.
+    fn prolongate_and_postsmooth_top<A: TopOperator>(
+        &mut self,
+        fine: &A,
+        x: &mut [f64],
+        b: &[f64],
+    ) {
+        let top = self.top;
         self.levels.transfers[top - 1].prolongate_add(&self.x[top - 1], x);
         zero_held(fine, x);
         for _ in 0..self.smoothing.1 {
@@ -622,11 +634,7 @@ impl<'a> Multigrid<'a> {
         for k in 1..top {
             self.prolongate_and_postsmooth(k);
         }
-        self.levels.transfers[top - 1].prolongate_add(&self.x[top - 1], x);
-        zero_held(fine, x);
-        for _ in 0..self.smoothing.1 {
-            gauss_seidel(fine, &self.inv_diag[top], x, b, &mut self.r[top], true);
-        }
+        self.prolongate_and_postsmooth_top(fine, x, b);
     }
 
     /// Level 0: `x₀ = A₀⁻¹ b₀` (into `self.x[0]` when `into = Some(0)`, else in place in
