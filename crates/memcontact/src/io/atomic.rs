@@ -2,6 +2,7 @@
 //! failed run never leaves a half-written output behind. The bytes are counted and hashed
 //! as they are written ([`Written`]), so a result set's manifest never reads its files back.
 
+use super::staged::Staged;
 use crate::{Error, Result};
 use std::io::Write;
 use std::path::Path;
@@ -42,66 +43,10 @@ impl<W: Write> Write for Hashing<W> {
     }
 }
 
-/// Bytes written between two requests to start writing back ([`Writeback`]).
-const WRITEBACK_STEP: u64 = 8 << 20;
-
-/// A file that asks the kernel to start writing its pages to disk every
-/// [`WRITEBACK_STEP`] bytes (Linux `sync_file_range`, which does not wait), so that the
-/// closing `fsync` finds most of a large file on disk already instead of writing all of it
-/// then. Elsewhere a plain file.
-struct Writeback {
-    file: std::fs::File,
-    written: u64,
-    started: u64,
-}
-
-impl Writeback {
-    fn new(file: std::fs::File) -> Writeback {
-        Writeback {
-            file,
-            written: 0,
-            started: 0,
-        }
-    }
-
-    /// Starts the writeback of the bytes written since the last start. A hint only: an
-    /// error shows at the `fsync` that follows.
-    fn start_writeback(&mut self) {
-        #[cfg(target_os = "linux")]
-        {
-            use std::os::fd::AsRawFd;
-            // SAFETY: the descriptor is the open file's; the call reads no memory.
-            unsafe {
-                libc::sync_file_range(
-                    self.file.as_raw_fd(),
-                    self.started as libc::off64_t,
-                    (self.written - self.started) as libc::off64_t,
-                    libc::SYNC_FILE_RANGE_WRITE,
-                );
-            }
-        }
-        self.started = self.written;
-    }
-}
-
-impl Write for Writeback {
-    fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
-        let n = self.file.write(buf)?;
-        self.written += n as u64;
-        if self.written - self.started >= WRITEBACK_STEP {
-            self.start_writeback();
-        }
-        Ok(n)
-    }
-
-    fn flush(&mut self) -> std::io::Result<()> {
-        self.file.flush()
-    }
-}
-
-/// Writes `path` atomically: `fill` writes into a buffered temporary file in the same
-/// directory, which is renamed over `path` only if `fill` and the flush succeed. Returns
-/// the size and digest of what was written.
+/// Writes `path` atomically: `fill` writes into a temporary file in the same directory
+/// (through staging buffers and a writer thread, [`Staged`]), which is synced and renamed
+/// over `path` only if `fill` and every write succeed. Returns the size and digest of what
+/// was written.
 pub fn write_atomic(
     path: &Path,
     fill: impl FnOnce(&mut dyn Write) -> std::io::Result<()>,
@@ -122,7 +67,7 @@ pub fn write_atomic(
     let result = (|| {
         let file = std::fs::File::create(&tmp)?;
         let mut w = Hashing {
-            inner: std::io::BufWriter::with_capacity(1 << 20, Writeback::new(file)),
+            inner: Staged::new(file),
             hasher: xxhash_rust::xxh3::Xxh3::new(),
             bytes: 0,
         };
@@ -132,11 +77,7 @@ pub fn write_atomic(
             bytes: w.bytes,
             xxh3: w.hasher.digest(),
         };
-        w.inner
-            .into_inner()
-            .map_err(|e| e.into_error())?
-            .file
-            .sync_all()?;
+        w.inner.finish()?.sync_all()?;
         std::fs::rename(&tmp, path)?;
         Ok(written)
     })();
@@ -150,13 +91,13 @@ pub fn write_atomic(
 mod tests {
     use super::*;
 
-    /// A file of several writeback steps (and a tail) is written whole, with the digest
+    /// A file of several staging buffers (and a tail) is written whole, with the digest
     /// of its bytes.
     #[test]
-    fn large_file_written_in_writeback_steps_is_whole() {
+    fn large_file_written_in_staging_buffers_is_whole() {
         let tmp = tempfile::tempdir().unwrap();
         let p = tmp.path().join("big.bin");
-        let data: Vec<u8> = (0..(2 * WRITEBACK_STEP + 12_345))
+        let data: Vec<u8> = (0..(5 * super::super::staged::STAGE as u64 + 12_345))
             .map(|i| (i % 253) as u8)
             .collect();
         let written = write_atomic(&p, |w| {

@@ -5,6 +5,7 @@ pub mod csv;
 pub mod gmsh;
 pub mod json;
 pub mod result_set;
+mod staged;
 pub mod vtu;
 pub use atomic::{write_atomic, Written};
 

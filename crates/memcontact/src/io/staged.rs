@@ -1,0 +1,363 @@
+//! A file written through two staging buffers and a writer thread, with direct I/O where
+//! the file system allows it.
+//!
+//! Large results (the node table and the VTU of a multi-million-vertex mesh are gigabytes)
+//! would otherwise pass through the page cache: gigabytes of kernel memory taken for bytes
+//! the run never reads again, which on a virtual machine costs as much to obtain as the
+//! solver's own memory. Written with `O_DIRECT` they go from the staging buffer to the disk,
+//! and the writer thread overlaps that transfer with the formatting of the next buffer.
+//!
+//! The policy, in one place:
+//! - A file smaller than one buffer never starts the thread; it is written at the end, buffered.
+//! - Full buffers are written by the thread, with `O_DIRECT` on Linux when the file system
+//!   accepts it ([`set_direct`]). Otherwise, or if a direct write is refused, buffered writes
+//!   with a hint to start the writeback ([`start_writeback`]), so the closing `fsync` finds
+//!   the bytes on disk already.
+//! - The tail (less than one buffer, of any length) is written buffered after the thread ends.
+
+use std::fs::File;
+use std::io::{Seek, SeekFrom, Write};
+use std::sync::mpsc::{sync_channel, Receiver, SyncSender};
+use std::thread::JoinHandle;
+
+/// Bytes in one staging buffer: a multiple of [`ALIGN`], large enough that one direct write
+/// keeps the disk busy, small enough that the two buffers of each file stay in cache-warm
+/// memory that is reused.
+pub(crate) const STAGE: usize = 4 << 20;
+
+/// Alignment of buffer addresses and file offsets for direct I/O (the largest logical block
+/// size in use).
+const ALIGN: usize = 4096;
+
+/// A [`STAGE`]-byte buffer whose start is [`ALIGN`]-aligned, carved out of a slightly larger
+/// vector so that no unsafe allocation is needed.
+struct Buffer {
+    bytes: Vec<u8>,
+    start: usize,
+}
+
+impl Buffer {
+    fn new() -> Buffer {
+        let bytes = vec![0u8; STAGE + ALIGN];
+        let start = bytes.as_ptr().align_offset(ALIGN);
+        Buffer { bytes, start }
+    }
+
+    fn slice(&self) -> &[u8] {
+        &self.bytes[self.start..self.start + STAGE]
+    }
+
+    fn slice_mut(&mut self) -> &mut [u8] {
+        &mut self.bytes[self.start..self.start + STAGE]
+    }
+}
+
+/// The writer thread of a [`Staged`] file: full buffers go to it, written buffers come back.
+struct Writer {
+    full: SyncSender<Buffer>,
+    empty: Receiver<Buffer>,
+    thread: JoinHandle<std::io::Result<(File, u64)>>,
+}
+
+/// A file written through staging buffers (see the module documentation). Call
+/// [`Staged::finish`] to write the tail and get the file back; dropping it without
+/// finishing abandons the bytes not yet written.
+pub(crate) struct Staged {
+    /// The file, until the writer thread takes it.
+    file: Option<File>,
+    /// The buffer being filled.
+    buf: Option<Buffer>,
+    /// Bytes of `buf` filled.
+    len: usize,
+    /// Buffers made so far (at most two).
+    made: u8,
+    writer: Option<Writer>,
+}
+
+impl Staged {
+    /// A staged writer for `file`, which must be empty and opened for writing.
+    pub(crate) fn new(file: File) -> Staged {
+        Staged {
+            file: Some(file),
+            buf: None,
+            len: 0,
+            made: 0,
+            writer: None,
+        }
+    }
+
+    /// Hands the full buffer to the writer thread (started on the first call) and takes an
+    /// empty one back.
+    fn pass_full(&mut self) -> std::io::Result<()> {
+        let full = self.buf.take().expect("a buffer is being filled");
+        self.len = 0;
+        let writer = match &mut self.writer {
+            Some(w) => w,
+            None => {
+                let file = self
+                    .file
+                    .take()
+                    .expect("the file is here until the thread starts");
+                let (full_tx, full_rx) = sync_channel::<Buffer>(1);
+                let (empty_tx, empty_rx) = sync_channel::<Buffer>(2);
+                let thread = std::thread::Builder::new()
+                    .name("memcontact-writer".into())
+                    .spawn(move || write_buffers(file, full_rx, empty_tx))?;
+                self.writer.insert(Writer {
+                    full: full_tx,
+                    empty: empty_rx,
+                    thread,
+                })
+            }
+        };
+        if writer.full.send(full).is_err() {
+            return Err(self.writer_error());
+        }
+        // A second buffer is made once; from then on the two take turns.
+        if self.made < 2 {
+            self.made += 1;
+            self.buf = Some(Buffer::new());
+            return Ok(());
+        }
+        match writer.empty.recv() {
+            Ok(b) => {
+                self.buf = Some(b);
+                Ok(())
+            }
+            Err(_) => Err(self.writer_error()),
+        }
+    }
+
+    /// The error that stopped the writer thread (it returns it when joined).
+    fn writer_error(&mut self) -> std::io::Error {
+        match self.writer.take() {
+            Some(w) => {
+                drop(w.full);
+                match w.thread.join() {
+                    Ok(Err(e)) => e,
+                    Ok(Ok(_)) => std::io::Error::other("the file writer stopped early"),
+                    Err(_) => std::io::Error::other("the file writer panicked"),
+                }
+            }
+            None => std::io::Error::other("the file writer is gone"),
+        }
+    }
+
+    /// Writes what is left, waits for the writer thread and returns the file, positioned
+    /// at its end. The caller syncs it.
+    pub(crate) fn finish(mut self) -> std::io::Result<File> {
+        let (mut file, offset) = match self.writer.take() {
+            None => (self.file.take().expect("the file"), 0),
+            Some(w) => {
+                drop(w.full);
+                match w.thread.join() {
+                    Ok(r) => r?,
+                    Err(_) => return Err(std::io::Error::other("the file writer panicked")),
+                }
+            }
+        };
+        set_direct(&file, false)?;
+        file.seek(SeekFrom::Start(offset))?;
+        if let Some(buf) = &self.buf {
+            file.write_all(&buf.slice()[..self.len])?;
+        }
+        Ok(file)
+    }
+}
+
+impl Write for Staged {
+    fn write(&mut self, data: &[u8]) -> std::io::Result<usize> {
+        if data.is_empty() {
+            return Ok(0);
+        }
+        let len = self.len;
+        let buf = match &mut self.buf {
+            Some(b) => b,
+            None => {
+                self.made = 1;
+                self.buf.insert(Buffer::new())
+            }
+        };
+        let n = data.len().min(STAGE - len);
+        buf.slice_mut()[len..len + n].copy_from_slice(&data[..n]);
+        self.len += n;
+        if self.len == STAGE {
+            self.pass_full()?;
+        }
+        Ok(n)
+    }
+
+    /// Buffers are written when full or at [`Staged::finish`]; nothing to do before.
+    fn flush(&mut self) -> std::io::Result<()> {
+        Ok(())
+    }
+}
+
+/// The writer thread: writes each full buffer at the next offset and sends it back, until
+/// the sending side closes. Returns the file and the bytes written.
+fn write_buffers(
+    mut file: File,
+    full: Receiver<Buffer>,
+    empty: SyncSender<Buffer>,
+) -> std::io::Result<(File, u64)> {
+    let mut direct = set_direct(&file, true).is_ok();
+    let mut offset = 0u64;
+    for buf in full {
+        let result = file.write_all(buf.slice());
+        match result {
+            Err(e) if direct && e.raw_os_error() == Some(einval()) => {
+                // The file system took the flag but refuses the write: rewrite the buffer
+                // (possibly in part already written, with the same bytes) through the cache.
+                direct = false;
+                set_direct(&file, false)?;
+                file.seek(SeekFrom::Start(offset))?;
+                file.write_all(buf.slice())?;
+            }
+            r => r?,
+        }
+        if !direct {
+            start_writeback(&file, offset, STAGE as u64);
+        }
+        offset += STAGE as u64;
+        // The filling side may have finished and gone; the buffer is then not needed.
+        let _ = empty.send(buf);
+    }
+    Ok((file, offset))
+}
+
+/// `EINVAL`, which a file system answers to a direct write it cannot do.
+fn einval() -> i32 {
+    #[cfg(unix)]
+    {
+        libc::EINVAL
+    }
+    #[cfg(not(unix))]
+    {
+        22
+    }
+}
+
+/// Turns direct I/O on or off for `file` (Linux `O_DIRECT` through `fcntl`). Fails where
+/// the file system refuses it, and off Linux when asked to turn it on.
+fn set_direct(file: &File, on: bool) -> std::io::Result<()> {
+    #[cfg(target_os = "linux")]
+    {
+        use std::os::fd::AsRawFd;
+        let fd = file.as_raw_fd();
+        // SAFETY: `fcntl` on the open file's descriptor; it reads no memory of ours.
+        let flags = unsafe { libc::fcntl(fd, libc::F_GETFL) };
+        if flags < 0 {
+            return Err(std::io::Error::last_os_error());
+        }
+        let wanted = if on {
+            flags | libc::O_DIRECT
+        } else {
+            flags & !libc::O_DIRECT
+        };
+        if wanted != flags {
+            // SAFETY: as above.
+            if unsafe { libc::fcntl(fd, libc::F_SETFL, wanted) } < 0 {
+                return Err(std::io::Error::last_os_error());
+            }
+        }
+        Ok(())
+    }
+    #[cfg(not(target_os = "linux"))]
+    {
+        let _ = file;
+        if on {
+            Err(std::io::Error::other("direct I/O is used on Linux only"))
+        } else {
+            Ok(())
+        }
+    }
+}
+
+/// Asks the kernel to start writing `len` bytes at `offset` of `file` to disk without
+/// waiting (Linux `sync_file_range`). A hint only: an error shows at the closing `fsync`.
+fn start_writeback(file: &File, offset: u64, len: u64) {
+    #[cfg(target_os = "linux")]
+    {
+        use std::os::fd::AsRawFd;
+        // SAFETY: the descriptor is the open file's; the call reads no memory.
+        unsafe {
+            libc::sync_file_range(
+                file.as_raw_fd(),
+                offset as libc::off64_t,
+                len as libc::off64_t,
+                libc::SYNC_FILE_RANGE_WRITE,
+            );
+        }
+    }
+    #[cfg(not(target_os = "linux"))]
+    let _ = (file, offset, len);
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::io::Read;
+
+    /// Writes `data` through a [`Staged`] file at `path` in pieces of `piece` bytes and
+    /// reads the file back.
+    fn round_trip(path: &std::path::Path, data: &[u8], piece: usize) -> Vec<u8> {
+        let mut staged = Staged::new(File::create(path).unwrap());
+        for chunk in data.chunks(piece.max(1)) {
+            staged.write_all(chunk).unwrap();
+        }
+        staged.finish().unwrap().sync_all().unwrap();
+        let mut back = Vec::new();
+        File::open(path).unwrap().read_to_end(&mut back).unwrap();
+        back
+    }
+
+    fn pattern(n: usize) -> Vec<u8> {
+        (0..n).map(|i| (i * 7 % 251) as u8).collect()
+    }
+
+    /// Every length around the buffer boundaries comes back byte for byte: no buffer,
+    /// a tail only, exactly full buffers (no tail), and buffers plus a tail.
+    #[test]
+    fn lengths_around_buffer_boundaries_round_trip() {
+        let tmp = tempfile::tempdir().unwrap();
+        for n in [
+            0,
+            1,
+            STAGE - 1,
+            STAGE,
+            STAGE + 1,
+            2 * STAGE,
+            3 * STAGE + 777,
+        ] {
+            let data = pattern(n);
+            let p = tmp.path().join(format!("f{n}"));
+            assert_eq!(round_trip(&p, &data, 65_537), data, "length {n}");
+        }
+    }
+
+    /// A file system that may refuse direct I/O (tmpfs) gets the same bytes.
+    #[test]
+    fn memory_file_system_gets_the_same_bytes() {
+        let shm = std::path::Path::new("/dev/shm");
+        if !shm.is_dir() {
+            return;
+        }
+        let tmp = tempfile::tempdir_in(shm).unwrap();
+        let data = pattern(2 * STAGE + 4321);
+        assert_eq!(round_trip(&tmp.path().join("f"), &data, 1 << 20), data);
+    }
+
+    /// A device that refuses every write (a full disk) gives an error, not a hang or a
+    /// panic, whether the writer thread or the tail meets it.
+    #[test]
+    fn full_device_is_an_error() {
+        let Ok(file) = std::fs::OpenOptions::new().write(true).open("/dev/full") else {
+            return;
+        };
+        let mut staged = Staged::new(file);
+        let data = pattern(3 * STAGE + 10);
+        let written = data.chunks(1 << 20).try_for_each(|c| staged.write_all(c));
+        let failed = written.is_err() || staged.finish().is_err();
+        assert!(failed, "writing to /dev/full succeeded");
+    }
+}
