@@ -29,26 +29,43 @@ pub(crate) const STAGE: usize = 4 << 20;
 /// size in use).
 const ALIGN: usize = 4096;
 
-/// A [`STAGE`]-byte buffer whose start is [`ALIGN`]-aligned, carved out of a slightly larger
-/// vector so that no unsafe allocation is needed.
+/// A buffer of up to [`STAGE`] bytes whose start is [`ALIGN`]-aligned: a vector reserved
+/// once with room for the padding and the bytes, never grown past it (so it never moves).
+/// Only the bytes written are touched: a small file costs no more memory than its size.
 struct Buffer {
     bytes: Vec<u8>,
+    /// Padding before the aligned start.
     start: usize,
 }
 
 impl Buffer {
     fn new() -> Buffer {
-        let bytes = vec![0u8; STAGE + ALIGN];
+        let mut bytes: Vec<u8> = Vec::with_capacity(STAGE + ALIGN);
         let start = bytes.as_ptr().align_offset(ALIGN);
+        bytes.resize(start, 0);
         Buffer { bytes, start }
     }
 
-    fn slice(&self) -> &[u8] {
-        &self.bytes[self.start..self.start + STAGE]
+    /// Bytes held.
+    fn len(&self) -> usize {
+        self.bytes.len() - self.start
     }
 
-    fn slice_mut(&mut self) -> &mut [u8] {
-        &mut self.bytes[self.start..self.start + STAGE]
+    /// Appends as much of `data` as fits; returns how much.
+    fn fill(&mut self, data: &[u8]) -> usize {
+        let n = data.len().min(STAGE - self.len());
+        self.bytes.extend_from_slice(&data[..n]);
+        n
+    }
+
+    /// The bytes held, from the aligned start.
+    fn data(&self) -> &[u8] {
+        &self.bytes[self.start..]
+    }
+
+    /// Empties the buffer for reuse.
+    fn clear(&mut self) {
+        self.bytes.truncate(self.start);
     }
 }
 
@@ -67,8 +84,6 @@ pub(crate) struct Staged {
     file: Option<File>,
     /// The buffer being filled.
     buf: Option<Buffer>,
-    /// Bytes of `buf` filled.
-    len: usize,
     /// Buffers made so far (at most two).
     made: u8,
     writer: Option<Writer>,
@@ -80,7 +95,6 @@ impl Staged {
         Staged {
             file: Some(file),
             buf: None,
-            len: 0,
             made: 0,
             writer: None,
         }
@@ -90,14 +104,13 @@ impl Staged {
     /// empty one back.
     fn pass_full(&mut self) -> std::io::Result<()> {
         let full = self.buf.take().expect("a buffer is being filled");
-        self.len = 0;
         let writer = match &mut self.writer {
             Some(w) => w,
             None => {
-                let file = self
-                    .file
-                    .take()
-                    .expect("the file is here until the thread starts");
+                // The file is here until the thread starts, and gone only after a failure.
+                let Some(file) = self.file.take() else {
+                    return Err(failed_before());
+                };
                 let (full_tx, full_rx) = sync_channel::<Buffer>(1);
                 let (empty_tx, empty_rx) = sync_channel::<Buffer>(2);
                 let thread = std::thread::Builder::new()
@@ -120,7 +133,8 @@ impl Staged {
             return Ok(());
         }
         match writer.empty.recv() {
-            Ok(b) => {
+            Ok(mut b) => {
+                b.clear();
                 self.buf = Some(b);
                 Ok(())
             }
@@ -147,7 +161,10 @@ impl Staged {
     /// at its end. The caller syncs it.
     pub(crate) fn finish(mut self) -> std::io::Result<File> {
         let (mut file, offset) = match self.writer.take() {
-            None => (self.file.take().expect("the file"), 0),
+            None => match self.file.take() {
+                Some(f) => (f, 0),
+                None => return Err(failed_before()),
+            },
             Some(w) => {
                 drop(w.full);
                 match w.thread.join() {
@@ -159,7 +176,7 @@ impl Staged {
         set_direct(&file, false)?;
         file.seek(SeekFrom::Start(offset))?;
         if let Some(buf) = &self.buf {
-            file.write_all(&buf.slice()[..self.len])?;
+            file.write_all(buf.data())?;
         }
         Ok(file)
     }
@@ -170,7 +187,6 @@ impl Write for Staged {
         if data.is_empty() {
             return Ok(0);
         }
-        let len = self.len;
         let buf = match &mut self.buf {
             Some(b) => b,
             None => {
@@ -178,10 +194,8 @@ impl Write for Staged {
                 self.buf.insert(Buffer::new())
             }
         };
-        let n = data.len().min(STAGE - len);
-        buf.slice_mut()[len..len + n].copy_from_slice(&data[..n]);
-        self.len += n;
-        if self.len == STAGE {
+        let n = buf.fill(data);
+        if buf.len() == STAGE {
             self.pass_full()?;
         }
         Ok(n)
@@ -191,6 +205,12 @@ impl Write for Staged {
     fn flush(&mut self) -> std::io::Result<()> {
         Ok(())
     }
+}
+
+/// The error of a write or finish after the writer thread failed (its own error was
+/// returned then).
+fn failed_before() -> std::io::Error {
+    std::io::Error::other("an earlier write to the file failed")
 }
 
 /// The writer thread: writes each full buffer at the next offset and sends it back, until
@@ -203,7 +223,7 @@ fn write_buffers(
     let mut direct = set_direct(&file, true).is_ok();
     let mut offset = 0u64;
     for buf in full {
-        let result = file.write_all(buf.slice());
+        let result = file.write_all(buf.data());
         match result {
             Err(e) if direct && e.raw_os_error() == Some(einval()) => {
                 // The file system took the flag but refuses the write: rewrite the buffer
@@ -211,7 +231,7 @@ fn write_buffers(
                 direct = false;
                 set_direct(&file, false)?;
                 file.seek(SeekFrom::Start(offset))?;
-                file.write_all(buf.slice())?;
+                file.write_all(buf.data())?;
             }
             r => r?,
         }
@@ -335,6 +355,24 @@ mod tests {
         }
     }
 
+    /// A buffer starts at an aligned address and keeps it when filled to the brim (direct
+    /// I/O refuses unaligned buffers), and holds exactly what was given to it.
+    #[test]
+    fn buffer_is_aligned_and_never_moves() {
+        let mut b = Buffer::new();
+        let at = b.data().as_ptr();
+        assert_eq!(at as usize % ALIGN, 0);
+        let data = pattern(STAGE + 10);
+        assert_eq!(b.fill(&data[..100]), 100);
+        assert_eq!(b.fill(&data[100..]), STAGE - 100);
+        assert_eq!(b.data(), &data[..STAGE]);
+        assert_eq!(b.data().as_ptr(), at);
+        b.clear();
+        assert_eq!(b.len(), 0);
+        assert_eq!(b.fill(&data[..7]), 7);
+        assert_eq!(b.data().as_ptr(), at);
+    }
+
     /// A file system that may refuse direct I/O (tmpfs) gets the same bytes.
     #[test]
     fn memory_file_system_gets_the_same_bytes() {
@@ -357,7 +395,12 @@ mod tests {
         let mut staged = Staged::new(file);
         let data = pattern(3 * STAGE + 10);
         let written = data.chunks(1 << 20).try_for_each(|c| staged.write_all(c));
-        let failed = written.is_err() || staged.finish().is_err();
-        assert!(failed, "writing to /dev/full succeeded");
+        if written.is_err() {
+            // Writing on after the failure is an error again, not a panic.
+            assert!(staged.write_all(&data[..STAGE]).is_err());
+            assert!(staged.finish().is_err());
+        } else {
+            assert!(staged.finish().is_err(), "writing to /dev/full succeeded");
+        }
     }
 }
