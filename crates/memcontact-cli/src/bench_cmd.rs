@@ -3,10 +3,10 @@
 //! 1e-10), solved by TNNMG, with one linear Poisson multigrid solve as the yardstick.
 
 use anyhow::{bail, Result};
-use memcontact::bench::{run_bench, BenchRow};
+use memcontact::bench::{run_bench, stolen_seconds, BenchRow};
 use memcontact::model::Foundation;
 use memcontact::solve::multigrid::Options;
-use memcontact_cli::bench::{square_header, square_row};
+use memcontact_cli::bench::{square_header, square_row, stolen_note};
 
 /// Runs the benchmark for `sizes` (cells per side) and the chosen foundations, printing
 /// one row per (size, foundation) as soon as it is measured.
@@ -25,7 +25,14 @@ pub fn run(sizes: &[usize], foundation: &str, phases: bool) -> Result<()> {
         rayon::current_num_threads()
     );
     println!("{}", square_header());
-    let mut print = |r: &BenchRow| println!("{}", square_row(r, phases));
+    // The host's share of each row: what it took since the previous row was printed.
+    let mut stolen_before = stolen_seconds();
+    let mut print = |r: &BenchRow| {
+        let now = stolen_seconds();
+        let stolen = now.zip(stolen_before).map(|(a, b)| a - b);
+        stolen_before = now;
+        println!("{}{}", square_row(r, phases), stolen_note(stolen));
+    };
     run_bench(sizes, &foundations, &Options::default(), &mut print)?;
     Ok(())
 }
