@@ -84,8 +84,6 @@ pub(crate) struct Staged {
     file: Option<File>,
     /// The buffer being filled.
     buf: Option<Buffer>,
-    /// Buffers made so far (at most two).
-    made: u8,
     writer: Option<Writer>,
 }
 
@@ -95,7 +93,6 @@ impl Staged {
         Staged {
             file: Some(file),
             buf: None,
-            made: 0,
             writer: None,
         }
     }
@@ -104,6 +101,7 @@ impl Staged {
     /// empty one back.
     fn pass_full(&mut self) -> std::io::Result<()> {
         let full = self.buf.take().expect("a buffer is being filled");
+        let starting = self.writer.is_none();
         let writer = match &mut self.writer {
             Some(w) => w,
             None => {
@@ -126,9 +124,8 @@ impl Staged {
         if writer.full.send(full).is_err() {
             return Err(self.writer_error());
         }
-        // A second buffer is made once; from then on the two take turns.
-        if self.made < 2 {
-            self.made += 1;
+        // The second buffer is made when the thread starts; from then on the two take turns.
+        if starting {
             self.buf = Some(Buffer::new());
             return Ok(());
         }
@@ -187,13 +184,7 @@ impl Write for Staged {
         if data.is_empty() {
             return Ok(0);
         }
-        let buf = match &mut self.buf {
-            Some(b) => b,
-            None => {
-                self.made = 1;
-                self.buf.insert(Buffer::new())
-            }
-        };
+        let buf = self.buf.get_or_insert_with(Buffer::new);
         let n = buf.fill(data);
         if buf.len() == STAGE {
             self.pass_full()?;
@@ -225,7 +216,7 @@ fn write_buffers(
     for buf in full {
         let result = file.write_all(buf.data());
         match result {
-            Err(e) if direct && e.raw_os_error() == Some(einval()) => {
+            Err(e) if direct && e.raw_os_error() == Some(libc::EINVAL) => {
                 // The file system took the flag but refuses the write: rewrite the buffer
                 // (possibly in part already written, with the same bytes) through the cache.
                 direct = false;
@@ -243,18 +234,6 @@ fn write_buffers(
         let _ = empty.send(buf);
     }
     Ok((file, offset))
-}
-
-/// `EINVAL`, which a file system answers to a direct write it cannot do.
-fn einval() -> i32 {
-    #[cfg(unix)]
-    {
-        libc::EINVAL
-    }
-    #[cfg(not(unix))]
-    {
-        22
-    }
 }
 
 /// Turns direct I/O on or off for `file` (Linux `O_DIRECT` through `fcntl`). Fails where
