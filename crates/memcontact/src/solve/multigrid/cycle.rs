@@ -297,37 +297,90 @@ impl<'a> Multigrid<'a> {
     ) -> usize {
         let n = x.len();
         work.resize(n);
-        let FcgWork { z, p, ap } = work;
+        let FcgWork { z, p, ap, az } = work;
         let r = b;
         x.iter_mut().for_each(|v| *v = 0.0);
         let mut pap_prev = 0.0;
         let mut steps = 0;
-        while steps < max_steps {
-            self.cycle_from_zero(a, z, r);
-            par_rows(z, |i, v| {
-                if held[i] || !v.is_finite() {
-                    *v = 0.0
-                }
-            });
-            // p = z + β p with β making p A-orthogonal to the previous direction; A p is
-            // formed by one product (no separate A z is stored).
-            if steps == 0 {
-                p.copy_from_slice(z);
+        // z with its held and non-finite entries taken as 0.
+        let masked = |z: &[f64], i: usize| {
+            if held[i] || !z[i].is_finite() {
+                0.0
             } else {
-                let beta = -det_dot(z, ap) / pap_prev;
-                par_rows(p, |i, v| *v = z[i] + beta * *v);
+                z[i]
             }
-            apply(a, p, ap);
-            let pap = det_dot(p, ap);
+        };
+        while steps < max_steps {
+            let known = self.cycle_from_zero_with_product(a, z, r, Some(az));
+            let (z, az): (&[f64], &[f64]) = (z, az);
+            // zᵀ A p of the previous direction, and whether z is finite: the held rows'
+            // entries leave A z as it is (their rows and columns of A are zero), a
+            // non-finite one does not, and A p is then formed by a product.
+            let [zap, bad] = sum_blocks(per_block(p, ap, |lo, _, apc| {
+                let mut s = [0.0, 0.0];
+                for (j, apj) in apc.iter().enumerate() {
+                    s[0] += masked(z, lo + j) * apj;
+                    s[1] += (!z[lo + j].is_finite()) as u8 as f64;
+                }
+                s
+            }));
+            let beta = if steps == 0 { 0.0 } else { -zap / pap_prev };
+            // p = z + β p with β making p A-orthogonal to the previous direction; A p is
+            // A z + β A p when the cycle gave A z, else one product. Then pᵀ A p and pᵀ r.
+            let first = steps == 0;
+            let [pap, pr] = if known && bad == 0.0 {
+                sum_blocks(per_block(p, ap, |lo, pc, apc| {
+                    let mut s = [0.0, 0.0];
+                    for (j, (pj, apj)) in pc.iter_mut().zip(apc.iter_mut()).enumerate() {
+                        let i = lo + j;
+                        if first {
+                            (*pj, *apj) = (masked(z, i), az[i]);
+                        } else {
+                            *pj = masked(z, i) + beta * *pj;
+                            *apj = az[i] + beta * *apj;
+                        }
+                        s[0] += *pj * *apj;
+                        s[1] += *pj * r[i];
+                    }
+                    s
+                }))
+            } else {
+                par_rows(p, |i, v| {
+                    *v = if first {
+                        masked(z, i)
+                    } else {
+                        masked(z, i) + beta * *v
+                    }
+                });
+                apply(a, p, ap);
+                sum_blocks(per_block(p, ap, |lo, pc, apc| {
+                    let mut s = [0.0, 0.0];
+                    for (j, (pj, apj)) in pc.iter().zip(apc.iter()).enumerate() {
+                        s[0] += pj * apj;
+                        s[1] += pj * r[lo + j];
+                    }
+                    s
+                }))
+            };
             if !(pap > 0.0 && pap.is_finite()) {
                 break;
             }
-            let alpha = det_dot(p, r) / pap;
-            par_rows(x, |i, v| *v += alpha * p[i]);
-            par_rows(r, |i, v| *v -= alpha * ap[i]);
+            let alpha = pr / pap;
+            let (p, ap): (&[f64], &[f64]) = (p, ap);
+            let norm = per_block(x, r, |lo, xc, rc| {
+                let mut m: f64 = 0.0;
+                for (j, (xj, rj)) in xc.iter_mut().zip(rc.iter_mut()).enumerate() {
+                    *xj += alpha * p[lo + j];
+                    *rj -= alpha * ap[lo + j];
+                    m = m.max(rj.abs());
+                }
+                [m]
+            })
+            .iter()
+            .fold(0.0, |m: f64, v| m.max(v[0]));
             pap_prev = pap;
             steps += 1;
-            if crate::sparse::norm_inf(r) <= target {
+            if norm <= target {
                 break;
             }
         }
@@ -347,15 +400,35 @@ impl<'a> Multigrid<'a> {
     /// of [`Multigrid::fcg`]): the first smoothing sweep and the residual after it are then
     /// one pass over A ([`gauss_seidel_from_zero`]).
     pub fn cycle_from_zero<A: TopOperator>(&mut self, fine: &A, x: &mut [f64], b: &[f64]) {
+        self.cycle_from_zero_with_product(fine, x, b, None);
+    }
+
+    /// [`Multigrid::cycle_from_zero`], and `A x` after it into `product` when the last
+    /// smoothing sweep can form it on the way ([`gauss_seidel_back_with_product`]): returns
+    /// whether it did.
+    pub fn cycle_from_zero_with_product<A: TopOperator>(
+        &mut self,
+        fine: &A,
+        x: &mut [f64],
+        b: &[f64],
+        product: Option<&mut [f64]>,
+    ) -> bool {
         if self.top == 0 {
             x.iter_mut().for_each(|v| *v = 0.0);
-            return self.cycle(fine, x, b);
+            self.cycle(fine, x, b);
+            return false;
         }
         self.presmooth_top(fine, x, b, true);
         match self.levels.kind {
-            Kind::Geometric => self.v_cycle_below(fine, x, b),
-            Kind::Algebraic => self.k_cycle_below(fine, x, b),
+            Kind::Geometric => self.v_cycle_below(fine, x, b, product),
+            Kind::Algebraic => self.k_cycle_below(fine, x, b, product),
         }
+    }
+
+    /// Whether `fine`'s pattern is the top level's own, so that the fused kernels may use
+    /// the top level's seam rows.
+    fn fused_on_top<A: TopOperator>(&self, fine: &A) -> bool {
+        Arc::ptr_eq(&fine.matrix().pattern, &self.levels.patterns[self.top])
     }
 
     /// Pre-smoothing on the top level and its residual into `r[top]`; from `x = 0` when
@@ -369,8 +442,7 @@ impl<'a> Multigrid<'a> {
     ) {
         let top = self.top;
         let nu1 = self.smoothing.0;
-        if from_zero && nu1 == 1 && Arc::ptr_eq(&fine.matrix().pattern, &self.levels.patterns[top])
-        {
+        if from_zero && nu1 == 1 && self.fused_on_top(fine) {
             let (inv, seams) = (&self.inv_diag[top], &self.seams[top]);
             gauss_seidel_from_zero(fine, inv, x, b, &mut self.r[top], seams);
             return;
@@ -400,31 +472,46 @@ impl<'a> Multigrid<'a> {
             return self.v_cycle(fine, x, b);
         }
         self.presmooth_top(fine, x, b, false);
-        self.k_cycle_below(fine, x, b);
+        self.k_cycle_below(fine, x, b, None);
     }
 
     /// The K-cycle after the top level's pre-smoothing (its residual is in `r[top]`).
-    fn k_cycle_below<A: TopOperator>(&mut self, fine: &A, x: &mut [f64], b: &[f64]) {
+    fn k_cycle_below<A: TopOperator>(
+        &mut self,
+        fine: &A,
+        x: &mut [f64],
+        b: &[f64],
+        product: Option<&mut [f64]>,
+    ) -> bool {
         let top = self.top;
         self.levels.transfers[top - 1].restrict(&self.r[top], &mut self.b[top - 1]);
         self.krylov_correction(top - 1);
-        self.prolongate_and_postsmooth_top(fine, x, b);
+        self.prolongate_and_postsmooth_top(fine, x, b, product)
     }
 
     /// On the top level: the correction of the level below prolongated into `x` (zero on
-    /// held unknowns), then `ν₂` Gauss-Seidel sweeps in reverse order.
+    /// held unknowns), then `ν₂` Gauss-Seidel sweeps in reverse order; with a `product`,
+    /// `A x` into it when a single sweep can form it (returns whether it did).
     fn prolongate_and_postsmooth_top<A: TopOperator>(
         &mut self,
         fine: &A,
         x: &mut [f64],
         b: &[f64],
-    ) {
+        product: Option<&mut [f64]>,
+    ) -> bool {
         let top = self.top;
         self.levels.transfers[top - 1].prolongate_add(&self.x[top - 1], x);
         zero_held(fine, x);
-        for _ in 0..self.smoothing.1 {
+        let nu2 = self.smoothing.1;
+        if let Some(y) = product.filter(|_| nu2 == 1 && self.fused_on_top(fine)) {
+            let (inv, seams) = (&self.inv_diag[top], &self.seams[top]);
+            gauss_seidel_back_with_product(fine, inv, x, b, &mut self.r[top], y, seams);
+            return true;
+        }
+        for _ in 0..nu2 {
             gauss_seidel(fine, &self.inv_diag[top], x, b, &mut self.r[top], true);
         }
+        false
     }
 
     /// `x[k] ≈ A_k⁻¹ b[k]` for a coarse level `k < top`: the direct solve on level 0, else
@@ -618,11 +705,18 @@ impl<'a> Multigrid<'a> {
         }
         // Down: smooth, restrict the residual.
         self.presmooth_top(fine, x, b, false);
-        self.v_cycle_below(fine, x, b);
+        self.v_cycle_below(fine, x, b, None);
     }
 
-    /// The V-cycle after the top level's pre-smoothing (its residual is in `r[top]`).
-    fn v_cycle_below<A: TopOperator>(&mut self, fine: &A, x: &mut [f64], b: &[f64]) {
+    /// The V-cycle after the top level's pre-smoothing (its residual is in `r[top]`); with
+    /// a `product`, see [`Multigrid::prolongate_and_postsmooth_top`].
+    fn v_cycle_below<A: TopOperator>(
+        &mut self,
+        fine: &A,
+        x: &mut [f64],
+        b: &[f64],
+        product: Option<&mut [f64]>,
+    ) -> bool {
         let top = self.top;
         self.levels.transfers[top - 1].restrict(&self.r[top], &mut self.b[top - 1]);
         for k in (1..top).rev() {
@@ -634,7 +728,7 @@ impl<'a> Multigrid<'a> {
         for k in 1..top {
             self.prolongate_and_postsmooth(k);
         }
-        self.prolongate_and_postsmooth_top(fine, x, b);
+        self.prolongate_and_postsmooth_top(fine, x, b, product)
     }
 
     /// Level 0: `x₀ = A₀⁻¹ b₀` (into `self.x[0]` when `into = Some(0)`, else in place in
@@ -670,20 +764,25 @@ pub struct FcgWork {
     z: Vec<f64>,
     p: Vec<f64>,
     ap: Vec<f64>,
+    /// `A z`, when the cycle formed it.
+    az: Vec<f64>,
 }
 
 impl FcgWork {
     fn resize(&mut self, n: usize) {
-        for v in [&mut self.z, &mut self.p, &mut self.ap] {
+        for v in [&mut self.z, &mut self.p, &mut self.ap, &mut self.az] {
             v.resize(n, 0.0);
         }
     }
 }
 
+/// Rows per block of the reductions of the Krylov methods.
+const DOT_BLOCK: usize = 4096;
+
 /// `aᵀb`, summed in fixed blocks (the same result for any number of threads).
 fn det_dot(a: &[f64], b: &[f64]) -> f64 {
     use rayon::prelude::*;
-    const BLOCK: usize = 4096;
+    const BLOCK: usize = DOT_BLOCK;
     let block = |(x, y): (&[f64], &[f64])| -> f64 { x.iter().zip(y).map(|(p, q)| p * q).sum() };
     if a.len() >= super::transfer::PAR_ROWS {
         let parts: Vec<f64> = a
@@ -695,6 +794,40 @@ fn det_dot(a: &[f64], b: &[f64]) -> f64 {
     } else {
         a.chunks(BLOCK).zip(b.chunks(BLOCK)).map(block).sum()
     }
+}
+
+/// `f(first row, a's block, b's block)` on the blocks of [`DOT_BLOCK`] rows of `a` and
+/// `b` (in parallel for long vectors), the results in block order: one pass of several
+/// vector updates and reductions instead of one pass each.
+fn per_block<const K: usize>(
+    a: &mut [f64],
+    b: &mut [f64],
+    f: impl Fn(usize, &mut [f64], &mut [f64]) -> [f64; K] + Sync + Send,
+) -> Vec<[f64; K]> {
+    use rayon::prelude::*;
+    if a.len() >= super::transfer::PAR_ROWS {
+        a.par_chunks_mut(DOT_BLOCK)
+            .zip(b.par_chunks_mut(DOT_BLOCK))
+            .enumerate()
+            .map(|(k, (x, y))| f(k * DOT_BLOCK, x, y))
+            .collect()
+    } else {
+        a.chunks_mut(DOT_BLOCK)
+            .zip(b.chunks_mut(DOT_BLOCK))
+            .enumerate()
+            .map(|(k, (x, y))| f(k * DOT_BLOCK, x, y))
+            .collect()
+    }
+}
+
+/// The sums of per-block results in block order (the same for any number of threads).
+fn sum_blocks<const K: usize>(parts: Vec<[f64; K]>) -> [f64; K] {
+    parts.iter().fold([0.0; K], |mut acc, v| {
+        for (a, x) in acc.iter_mut().zip(v) {
+            *a += x;
+        }
+        acc
+    })
 }
 
 /// `1 / A_ii`, or 0 where `A_ii ≤ 0` (zero rows, held rows).
@@ -915,6 +1048,104 @@ pub(crate) fn gauss_seidel_from_zero<A: TopOperator>(
         }
     });
     restore_held(r);
+}
+
+/// One backward sweep of [`gauss_seidel`], with the product `y = A x` after it, in one
+/// pass over a symmetric A instead of two. When row i is relaxed, its product with the
+/// current x is known; x_i's change then reaches the rows after it in the block, swept
+/// already, as `a_ki Δx_i = a_ik Δx_i` from row i's own entries, and the rows before it
+/// send theirs when they are relaxed. Unknowns of other blocks change during the sweep
+/// (the hybrid sweep reads them from `snapshot`, as they were before it), so their changes
+/// are added at the end, on the rows of `seams` ([`seam_rows`] of A's pattern) alone.
+/// Held rows keep x and get `y = 0`, as [`apply`] gives.
+pub(crate) fn gauss_seidel_back_with_product<A: TopOperator>(
+    op: &A,
+    inv: &[f64],
+    x: &mut [f64],
+    b: &[f64],
+    snapshot: &mut [f64],
+    y: &mut [f64],
+    seams: &[u32],
+) {
+    use rayon::prelude::*;
+    let a = op.matrix();
+    let pat = &a.pattern;
+    let n = x.len();
+    let sweep = |lo: usize, xs: &mut [f64], ys: &mut [f64], outside: &[f64]| {
+        let hi = lo + xs.len();
+        for k in (0..xs.len()).rev() {
+            let i = lo + k;
+            let (s, e) = (pat.row_ptr[i], pat.row_ptr[i + 1]);
+            let (cols, vals) = (&pat.col[s..e], &a.val[s..e]);
+            let ax = row_sum(cols, vals, |j| {
+                if j >= lo && j < hi {
+                    xs[j - lo]
+                } else {
+                    outside[j]
+                }
+            }) + shift_term(op, i, xs[k]);
+            let d = inv[i];
+            if d == 0.0 {
+                ys[k] = ax;
+                continue;
+            }
+            let dx = (b[i] - ax) * d;
+            xs[k] += dx;
+            // Columns are sorted: i's later neighbours in the block are `diag + 1..last`.
+            let diag: usize = cols.iter().map(|&c| ((c as usize) < i) as usize).sum();
+            let last: usize = cols.iter().map(|&c| ((c as usize) < hi) as usize).sum();
+            let aii = match cols.get(diag) {
+                Some(&c) if c as usize == i => vals[diag] + shift_term(op, i, 1.0),
+                _ => 0.0,
+            };
+            ys[k] = ax + aii * dx;
+            if diag < last {
+                for (&c, &v) in cols[diag + 1..last].iter().zip(&vals[diag + 1..last]) {
+                    ys[c as usize - lo] += v * dx;
+                }
+            }
+        }
+    };
+    let clear_held = |y: &mut [f64]| {
+        if !A::PLAIN {
+            par_rows(y, |i, yi| {
+                if op.held(i) {
+                    *yi = 0.0;
+                }
+            });
+        }
+    };
+    if n <= GS_BLOCK {
+        sweep(0, x, y, &[]);
+        clear_held(y);
+        return;
+    }
+    snapshot.copy_from_slice(x);
+    let before: &[f64] = snapshot;
+    x.par_chunks_mut(GS_BLOCK)
+        .zip(y.par_chunks_mut(GS_BLOCK))
+        .enumerate()
+        .for_each(|(k, (xs, ys))| sweep(k * GS_BLOCK, xs, ys, before));
+    // The other blocks' changes, now known, on the rows that see them.
+    let x: &[f64] = x;
+    y.par_chunks_mut(GS_BLOCK).enumerate().for_each(|(k, ys)| {
+        let lo = k * GS_BLOCK;
+        let hi = lo + ys.len();
+        let from = seams.partition_point(|&i| (i as usize) < lo);
+        let to = seams.partition_point(|&i| (i as usize) < hi);
+        for &i in &seams[from..to] {
+            let i = i as usize;
+            let (s, e) = (pat.row_ptr[i], pat.row_ptr[i + 1]);
+            let outside: f64 = pat.col[s..e]
+                .iter()
+                .zip(&a.val[s..e])
+                .filter(|(&j, _)| (j as usize) < lo || (j as usize) >= hi)
+                .map(|(&j, &v)| v * (x[j as usize] - before[j as usize]))
+                .sum();
+            ys[i - lo] += outside;
+        }
+    });
+    clear_held(y);
 }
 
 /// The result of a linear multigrid solve.

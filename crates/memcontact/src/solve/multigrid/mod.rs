@@ -619,6 +619,12 @@ pub fn kernel_timings(
     let mut delta = vec![0.0; n];
     let rhs: Vec<f64> = g.iter().map(|x| -x).collect();
     time("v-cycle", &mut || mg.v_cycle(&a, &mut delta, &rhs));
+    let mut work = cycle::FcgWork::default();
+    let mut b = rhs.clone();
+    time("flexible CG, 3 steps", &mut || {
+        b.copy_from_slice(&rhs);
+        mg.fcg(&a, &mut delta, &mut b, 0.0, 3, &st.truncated, &mut work);
+    });
     let inv: Vec<f64> = (0..n)
         .map(|i| {
             let d = a.get(i, i);

@@ -408,3 +408,112 @@ fn fused_sweep_from_zero_is_the_sweep_and_its_residual() {
         );
     }
 }
+
+#[test]
+fn backward_sweep_with_product_is_the_sweep_and_its_product() {
+    use super::operator::{apply, Shifted};
+    // One level below GS_BLOCK (one sequential sweep) and one above (blocks and seams), on
+    // the shifted Newton operator with held unknowns and on an assembled matrix.
+    for levels in [5, 7] {
+        let h = square_hierarchy(4, levels);
+        let model = bench_model(h.finest(), Some(0.0), Foundation::Lumped);
+        let n = model.n();
+        let held: Vec<bool> = (0..n).map(|i| i % 7 == 3 || (i / 50) % 9 == 4).collect();
+        let shift: Vec<f64> = (0..n).map(|i| 0.5 + ((i as f64) * 0.13).cos()).collect();
+        let op = Shifted {
+            s: &model.s,
+            shift: &shift,
+            held: &held,
+        };
+        let b: Vec<f64> = (0..n).map(|i| ((i as f64) * 0.71).sin()).collect();
+        // A start that is zero on the held unknowns, as the cycle leaves it.
+        let x0: Vec<f64> = (0..n)
+            .map(|i| {
+                if held[i] {
+                    0.0
+                } else {
+                    ((i as f64) * 0.3).cos()
+                }
+            })
+            .collect();
+        let seams = cycle::seam_rows(&model.s.pattern);
+        let check = |name: &str,
+                     fused: &dyn Fn(usize) -> (Vec<f64>, Vec<f64>),
+                     reference: (Vec<f64>, Vec<f64>)| {
+            let (x, y) = fused(1);
+            assert_eq!((x.clone(), y.clone()), fused(3), "{name}: thread count");
+            let (x_ref, y_ref) = reference;
+            let scale = norm_inf(&y_ref);
+            assert!(scale > 1e-3, "{name}: the product is not trivially 0");
+            for i in 0..n {
+                assert!(
+                    (x[i] - x_ref[i]).abs() <= 1e-13 * norm_inf(&x_ref),
+                    "{name}: x[{i}]"
+                );
+                assert!(
+                    (y[i] - y_ref[i]).abs() <= 1e-12 * scale,
+                    "{name}: y[{i}]: {} {}",
+                    y[i],
+                    y_ref[i]
+                );
+            }
+        };
+        // The shifted operator: held rows keep x = 0 and get y = 0.
+        let mut inv = vec![0.0; n];
+        cycle::fill_inv_diag(&op, &mut inv);
+        let reference = {
+            let (mut x, mut snap, mut y) = (x0.clone(), vec![0.0; n], vec![0.0; n]);
+            cycle::gauss_seidel(&op, &inv, &mut x, &b, &mut snap, true);
+            apply(&op, &x, &mut y);
+            (x, y)
+        };
+        let fused = |threads: usize| {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap();
+            let (mut x, mut snap, mut y) = (x0.clone(), vec![0.0; n], vec![f64::NAN; n]);
+            pool.install(|| {
+                cycle::gauss_seidel_back_with_product(
+                    &op, &inv, &mut x, &b, &mut snap, &mut y, &seams,
+                )
+            });
+            for i in (0..n).filter(|&i| held[i]) {
+                assert_eq!((x[i], y[i]), (0.0, 0.0), "held row {i}");
+            }
+            (x, y)
+        };
+        check("shifted", &fused, reference);
+        // An assembled matrix whose held rows and columns are zero (x is not zero there).
+        let mut a = model.s.clone();
+        for i in 0..n {
+            for k in a.pattern.row_ptr[i]..a.pattern.row_ptr[i + 1] {
+                if held[i] || held[a.pattern.col[k] as usize] {
+                    a.val[k] = 0.0;
+                }
+            }
+        }
+        let x1: Vec<f64> = (0..n).map(|i| ((i as f64) * 0.3).cos()).collect();
+        cycle::fill_inv_diag(&a, &mut inv);
+        let reference = {
+            let (mut x, mut snap) = (x1.clone(), vec![0.0; n]);
+            cycle::gauss_seidel(&a, &inv, &mut x, &b, &mut snap, true);
+            let y = a.mul(&x);
+            (x, y)
+        };
+        let fused = |threads: usize| {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap();
+            let (mut x, mut snap, mut y) = (x1.clone(), vec![0.0; n], vec![f64::NAN; n]);
+            pool.install(|| {
+                cycle::gauss_seidel_back_with_product(
+                    &a, &inv, &mut x, &b, &mut snap, &mut y, &seams,
+                )
+            });
+            (x, y)
+        };
+        check("assembled", &fused, reference);
+    }
+}
