@@ -39,9 +39,16 @@ impl Pattern {
 
     /// The position of every diagonal entry (all must be stored).
     pub fn diagonal_positions(&self) -> Vec<usize> {
-        (0..self.n())
-            .map(|i| self.find(i, i).expect("the pattern stores the diagonal"))
-            .collect()
+        let at = |i: usize| self.find(i, i).expect("the pattern stores the diagonal");
+        if self.n() >= PAR_ROWS {
+            (0..self.n())
+                .into_par_iter()
+                .with_min_len(4096)
+                .map(at)
+                .collect()
+        } else {
+            (0..self.n()).map(at).collect()
+        }
     }
 }
 
@@ -118,7 +125,15 @@ impl Csr {
 
     /// The diagonal.
     pub fn diag(&self) -> Vec<f64> {
-        (0..self.n()).map(|i| self.get(i, i)).collect()
+        if self.n() >= PAR_ROWS {
+            (0..self.n())
+                .into_par_iter()
+                .with_min_len(4096)
+                .map(|i| self.get(i, i))
+                .collect()
+        } else {
+            (0..self.n()).map(|i| self.get(i, i)).collect()
+        }
     }
 
     /// Row `i` as (columns, values).
@@ -157,22 +172,33 @@ impl Csr {
         y
     }
 
-    /// `xᵀ A x`.
+    /// `xᵀ A x`, summed over fixed blocks of rows in block order (the same result for any
+    /// number of threads).
     pub fn quad_form(&self, x: &[f64]) -> f64 {
-        if self.n() >= PAR_ROWS {
-            (0..self.n())
-                .into_par_iter()
-                .with_min_len(4096)
+        const BLOCK: usize = 4096;
+        let block = |b: usize| -> f64 {
+            (b * BLOCK..((b + 1) * BLOCK).min(self.n()))
                 .map(|i| x[i] * self.row_dot(i, x))
                 .sum()
+        };
+        let blocks = self.n().div_ceil(BLOCK);
+        if self.n() >= PAR_ROWS {
+            let parts: Vec<f64> = (0..blocks).into_par_iter().map(block).collect();
+            parts.iter().sum()
         } else {
-            (0..self.n()).map(|i| x[i] * self.row_dot(i, x)).sum()
+            (0..blocks).map(block).sum()
         }
     }
 
     /// `true` when every entry is finite.
     pub fn is_finite(&self) -> bool {
-        self.val.iter().all(|v| v.is_finite())
+        if self.val.len() >= PAR_ROWS {
+            self.val
+                .par_chunks(1 << 16)
+                .all(|c| c.iter().all(|v| v.is_finite()))
+        } else {
+            self.val.iter().all(|v| v.is_finite())
+        }
     }
 }
 
@@ -299,6 +325,37 @@ mod tests {
             }
         }
         Csr::from_triplets(n, &t)
+    }
+
+    #[test]
+    fn large_products_and_diagonals_ignore_the_thread_count() {
+        // Beyond PAR_ROWS the kernels run in parallel; their results must not move.
+        let n = 3 * PAR_ROWS + 17;
+        let a = lap1d(n);
+        let x: Vec<f64> = (0..n).map(|i| (i as f64 * 0.37).sin()).collect();
+        let run = |threads: usize| {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap();
+            pool.install(|| (a.quad_form(&x), a.diag(), a.pattern.diagonal_positions()))
+        };
+        let (q1, d1, p1) = run(1);
+        assert_eq!((q1, d1.clone(), p1.clone()), run(3));
+        // xᵀAx = Σ (x_i − x_{i−1})² + x_0² + x_{n−1}² for tridiag(−1, 2, −1).
+        let exact: f64 = x[0] * x[0]
+            + x[n - 1] * x[n - 1]
+            + x.windows(2).map(|w| (w[1] - w[0]).powi(2)).sum::<f64>();
+        assert!((q1 - exact).abs() <= 1e-10 * exact);
+        assert!(d1.iter().all(|&d| d == 2.0));
+        assert!(p1
+            .iter()
+            .enumerate()
+            .all(|(i, &k)| a.pattern.col[k] as usize == i));
+        let mut b = a.clone();
+        assert!(b.is_finite());
+        b.val[2 * PAR_ROWS] = f64::NAN;
+        assert!(!b.is_finite());
     }
 
     #[test]

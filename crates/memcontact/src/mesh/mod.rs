@@ -522,26 +522,83 @@ pub struct VertexTriangles {
 }
 
 impl VertexTriangles {
-    /// Builds the adjacency of `mesh`.
+    /// Builds the adjacency of `mesh`, each vertex's triangles in increasing order. Large
+    /// meshes are split into ranges of vertices, one per thread: each range scans every
+    /// triangle and keeps the corners it owns, so the lists come out in the same order
+    /// for any number of threads.
     pub fn new(mesh: &Mesh) -> VertexTriangles {
+        use rayon::prelude::*;
+        /// Vertices from which the ranges are built in parallel.
+        const PARALLEL: usize = 1 << 16;
         let n = mesh.n_vertices();
+        let parts = if n >= PARALLEL {
+            rayon::current_num_threads().clamp(1, 16)
+        } else {
+            1
+        };
+        let bounds: Vec<usize> = (0..=parts).map(|p| p * n / parts).collect();
+        // Counts of the range's vertices, then their running sums within the range.
         let mut ptr = vec![0usize; n + 1];
-        for t in &mesh.triangles {
-            for &v in t {
-                ptr[v as usize + 1] += 1;
+        let mut rest = &mut ptr[1..];
+        let mut ranges = Vec::with_capacity(parts);
+        for w in bounds.windows(2) {
+            let (head, tail) = rest.split_at_mut(w[1] - w[0]);
+            ranges.push((w[0], head));
+            rest = tail;
+        }
+        let totals: Vec<usize> = ranges
+            .into_par_iter()
+            .map(|(lo, counts)| {
+                let hi = lo + counts.len();
+                for t in &mesh.triangles {
+                    for &v in t {
+                        let v = v as usize;
+                        if v >= lo && v < hi {
+                            counts[v - lo] += 1;
+                        }
+                    }
+                }
+                let mut sum = 0;
+                for c in counts.iter_mut() {
+                    sum += *c;
+                    *c = sum;
+                }
+                sum
+            })
+            .collect();
+        // Offsets of the ranges.
+        let mut offset = 0;
+        for (w, total) in bounds.windows(2).zip(&totals) {
+            if offset > 0 {
+                ptr[w[0] + 1..=w[1]]
+                    .par_iter_mut()
+                    .for_each(|p| *p += offset);
             }
+            offset += total;
         }
-        for i in 0..n {
-            ptr[i + 1] += ptr[i];
+        // Each range fills its own part of `tri`, in triangle order.
+        let mut tri = vec![0u32; offset];
+        let mut rest = &mut tri[..];
+        let mut parts_tri = Vec::with_capacity(parts);
+        for w in bounds.windows(2) {
+            let (head, tail) = rest.split_at_mut(ptr[w[1]] - ptr[w[0]]);
+            parts_tri.push((w[0], w[1], head));
+            rest = tail;
         }
-        let mut fill = ptr.clone();
-        let mut tri = vec![0u32; ptr[n]];
-        for (k, t) in mesh.triangles.iter().enumerate() {
-            for &v in t {
-                tri[fill[v as usize]] = k as u32;
-                fill[v as usize] += 1;
+        let ptr_ref = &ptr;
+        parts_tri.into_par_iter().for_each(|(lo, hi, out)| {
+            let base = ptr_ref[lo];
+            let mut fill: Vec<usize> = ptr_ref[lo..hi].iter().map(|p| p - base).collect();
+            for (k, t) in mesh.triangles.iter().enumerate() {
+                for &v in t {
+                    let v = v as usize;
+                    if v >= lo && v < hi {
+                        out[fill[v - lo]] = k as u32;
+                        fill[v - lo] += 1;
+                    }
+                }
             }
-        }
+        });
         VertexTriangles { ptr, tri }
     }
 
@@ -645,6 +702,43 @@ mod tests {
         let p = vec![[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0], [0.5, 0.5]];
         let t = vec![[0, 1, 4], [1, 2, 4], [2, 3, 4], [3, 0, 4]];
         Mesh::new(p, t, vec![], BTreeMap::new()).unwrap()
+    }
+
+    #[test]
+    fn vertex_triangles_list_each_vertex_in_triangle_order_for_any_thread_count() {
+        // A grid large enough to be built in ranges, its triangles in a scattered order.
+        let w = 300;
+        let points: Vec<Point> = (0..w * w)
+            .map(|k| [(k % w) as f64, (k / w) as f64])
+            .collect();
+        let mut cells = Vec::new();
+        for j in 0..w - 1 {
+            for i in 0..w - 1 {
+                let v = (j * w + i) as u32;
+                let (r, u, ru) = (v + 1, v + w as u32, v + w as u32 + 1);
+                cells.push([v, r, ru]);
+                cells.push([v, ru, u]);
+            }
+        }
+        let m = cells.len();
+        let triangles: Vec<[u32; 3]> = (0..m).map(|k| cells[(k * 7919) % m]).collect();
+        let mesh = Mesh::new(points, triangles, vec![], BTreeMap::new()).unwrap();
+        let mut lists = vec![Vec::new(); mesh.n_vertices()];
+        for (k, t) in mesh.triangles.iter().enumerate() {
+            for &v in t {
+                lists[v as usize].push(k as u32);
+            }
+        }
+        for threads in [1, 2, 3] {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap();
+            let adj = pool.install(|| VertexTriangles::new(&mesh));
+            for (v, list) in lists.iter().enumerate() {
+                assert_eq!(adj.of(v), &list[..], "vertex {v}, {threads} threads");
+            }
+        }
     }
 
     #[test]
