@@ -452,27 +452,41 @@ impl Mesh {
     /// [`Mesh::quality`] given the boundary vertices ([`Mesh::boundary_vertices`]).
     pub fn quality_with(&self, boundary: &[bool]) -> MeshQuality {
         use rayon::prelude::*;
-        let (l_n, s_n, max_cos, area) = (0..self.triangles.len())
-            .into_par_iter()
-            .with_min_len(4096)
-            .map(|k| {
+        // Per block of triangles (fixed, so that the area sums alike for any thread count):
+        // the longest edge, the largest diameter-to-inscribed-diameter ratio, the cosine of
+        // the smallest angle (opposite the shortest edge) and the area.
+        const BLOCK: usize = 4096;
+        let block = |b: usize| {
+            let mut acc = (0.0f64, 0.0f64, f64::NEG_INFINITY, 0.0);
+            for k in b * BLOCK..((b + 1) * BLOCK).min(self.triangles.len()) {
                 let c = self.corners(k);
                 let e = [dist(c[1], c[2]), dist(c[2], c[0]), dist(c[0], c[1])];
                 let a = self.area(k).abs();
                 let d = e[0].max(e[1]).max(e[2]);
-                // Inscribed circle: radius 2A / perimeter.
-                let r = 2.0 * a / (e[0] + e[1] + e[2]);
-                let mut max_cos = f64::NEG_INFINITY;
-                for i in 0..3 {
-                    let (opp, b, cc) = (e[i], e[(i + 1) % 3], e[(i + 2) % 3]);
-                    max_cos = max_cos.max((b * b + cc * cc - opp * opp) / (2.0 * b * cc));
-                }
-                (d, d / (2.0 * r), max_cos, a)
-            })
-            .reduce(
-                || (0.0, 0.0, f64::NEG_INFINITY, 0.0),
-                |x, y| (x.0.max(y.0), x.1.max(y.1), x.2.max(y.2), x.3 + y.3),
-            );
+                // Inscribed circle: radius 2A / perimeter, so d / 2r = d · perimeter / 4A.
+                let ratio = d * (e[0] + e[1] + e[2]) / (4.0 * a);
+                let i = if e[0] <= e[1] && e[0] <= e[2] {
+                    0
+                } else if e[1] <= e[2] {
+                    1
+                } else {
+                    2
+                };
+                let (opp, b, cc) = (e[i], e[(i + 1) % 3], e[(i + 2) % 3]);
+                let cos = (b * b + cc * cc - opp * opp) / (2.0 * b * cc);
+                acc = (acc.0.max(d), acc.1.max(ratio), acc.2.max(cos), acc.3 + a);
+            }
+            acc
+        };
+        let blocks: Vec<(f64, f64, f64, f64)> = (0..self.triangles.len().div_ceil(BLOCK))
+            .into_par_iter()
+            .map(block)
+            .collect();
+        let (l_n, s_n, max_cos, area) = blocks
+            .iter()
+            .fold((0.0f64, 0.0f64, f64::NEG_INFINITY, 0.0), |x, y| {
+                (x.0.max(y.0), x.1.max(y.1), x.2.max(y.2), x.3 + y.3)
+            });
         MeshQuality {
             vertices: self.points.len(),
             triangles: self.triangles.len(),
@@ -752,6 +766,52 @@ mod tests {
         assert!((q.area - 1.0).abs() < 1e-15);
         assert!((q.min_angle_deg - 45.0).abs() < 1e-12);
         assert!((q.l_n - 1.0).abs() < 1e-15);
+    }
+
+    #[test]
+    fn quality_of_scalene_triangles() {
+        // Two triangles with different smallest angles, each at a different corner.
+        let p = vec![[0.0, 0.0], [4.0, 0.0], [1.0, 2.0], [5.0, 3.0]];
+        let m = Mesh::new(
+            p.clone(),
+            vec![[0, 1, 2], [1, 3, 2]],
+            vec![],
+            BTreeMap::new(),
+        )
+        .unwrap();
+        let q = m.quality();
+        let angle = |a: [f64; 2], b: [f64; 2], c: [f64; 2]| {
+            // At a, between b and c.
+            let (u, v) = ([b[0] - a[0], b[1] - a[1]], [c[0] - a[0], c[1] - a[1]]);
+            (u[0] * v[1] - u[1] * v[0])
+                .abs()
+                .atan2(u[0] * v[0] + u[1] * v[1])
+        };
+        let mut smallest = f64::INFINITY;
+        let mut ratio: f64 = 0.0;
+        let (mut longest, mut area): (f64, f64) = (0.0, 0.0);
+        for t in [[0, 1, 2], [1, 3, 2]] {
+            let [a, b, c] = t.map(|i| p[i]);
+            smallest = smallest
+                .min(angle(a, b, c))
+                .min(angle(b, c, a))
+                .min(angle(c, a, b));
+            let e = [dist(b, c), dist(c, a), dist(a, b)];
+            let d = e[0].max(e[1]).max(e[2]);
+            let t_area =
+                0.5 * ((b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0])).abs();
+            let r = 2.0 * t_area / (e[0] + e[1] + e[2]);
+            ratio = ratio.max(d / (2.0 * r));
+            longest = longest.max(d);
+            area += t_area;
+        }
+        assert!(
+            (q.min_angle_deg - smallest.to_degrees()).abs() < 1e-10,
+            "{q:?}"
+        );
+        assert!((q.s_n - ratio).abs() < 1e-12 * ratio, "{q:?}");
+        assert_eq!(q.l_n, longest);
+        assert!((q.area - area).abs() < 1e-14);
     }
 
     /// The boundary vertices as the ends of the boundary edges (an edge of one triangle).

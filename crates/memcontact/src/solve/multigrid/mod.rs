@@ -266,6 +266,7 @@ pub fn solve_with(
             history: if k == top { Some(&mut history) } else { None },
             timer: level_timer,
             confirm: k == top,
+            check_start: k == first,
         })?;
         let seconds = t0.elapsed().as_secs_f64();
         final_certificate = out.2;
@@ -405,6 +406,10 @@ struct LevelSolve<'a, 'b> {
     timer: &'b mut PhaseTimer,
     /// Confirm convergence with [`Model::certificate`] (the finest level).
     confirm: bool,
+    /// Whether `v` may already meet the tolerance. A start prolongated from the level below
+    /// is not checked (its residual is that of the coarser mesh, far above any tolerance):
+    /// the first iteration begins at once, without a certificate pass.
+    check_start: bool,
 }
 
 /// TNNMG on one level; returns the iterations, the scaled KKT residual reached and, when
@@ -422,6 +427,7 @@ fn level_solve(ls: LevelSolve) -> Result<(usize, f64, Option<Certificate>)> {
         mut history,
         timer,
         confirm,
+        check_start,
     } = ls;
     let n = model.n();
     let pattern = model.s.pattern.clone();
@@ -436,31 +442,34 @@ fn level_solve(ls: LevelSolve) -> Result<(usize, f64, Option<Certificate>)> {
     let mut dirty = vec![false; n];
     let mut iterations = 0;
     let mut stalled = 0;
-    let mut kkt;
     let mut certificate = None;
     let mut watch = crate::certificate::FloorWatch::default();
     let mut fcg = cycle::FcgWork::default();
-    let mut scale;
+    let mut scale = 1.0;
+    let mut skip_check = !check_start && max_iterations > 0;
+    let mut kkt = f64::INFINITY;
     loop {
-        let ev = timer.time("certificate", || crate::certificate::evaluate(model, v));
-        scale = ev.certificate.force_scale;
-        kkt = ev.certificate.kkt();
-        if iterations > 0 {
-            let record = IterationRecord::new(iterations, &ev);
-            observer.iteration(&record);
-            if let Some(h) = history.as_deref_mut() {
-                h.push(record);
+        if !std::mem::take(&mut skip_check) {
+            let ev = timer.time("certificate", || crate::certificate::evaluate(model, v));
+            scale = ev.certificate.force_scale;
+            kkt = ev.certificate.kkt();
+            if iterations > 0 {
+                let record = IterationRecord::new(iterations, &ev);
+                observer.iteration(&record);
+                if let Some(h) = history.as_deref_mut() {
+                    h.push(record);
+                }
             }
-        }
-        // Met the tolerance, or at the rounding floor (more iterations cannot help).
-        if ev.certificate.settled(tolerance) || watch.stuck(&ev.certificate) {
-            if confirm {
-                certificate = Some(ev.certificate);
+            // Met the tolerance, or at the rounding floor (more iterations cannot help).
+            if ev.certificate.settled(tolerance) || watch.stuck(&ev.certificate) {
+                if confirm {
+                    certificate = Some(ev.certificate);
+                }
+                break;
             }
-            break;
-        }
-        if !kkt.is_finite() || iterations >= max_iterations || stalled >= STALL_LIMIT {
-            break;
+            if !kkt.is_finite() || iterations >= max_iterations || stalled >= STALL_LIMIT {
+                break;
+            }
         }
         iterations += 1;
         // Whether the iterate moved at all in this iteration (smoothing or step).
