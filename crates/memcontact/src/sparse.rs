@@ -288,6 +288,101 @@ pub fn norm_inf(a: &[f64]) -> f64 {
     a.iter().fold(0.0, |m, x| m.max(x.abs()))
 }
 
+/// Groups the entries of items `0..m` by key, in compressed-row form: `entries(i)` gives
+/// item i's up to `K` entries `(key < n_keys, value)`, and the result `(ptr, values)` holds
+/// the values of key `k` in `values[ptr[k]..ptr[k + 1]]`, in increasing item order (a
+/// counting sort). Large inputs are split into ranges of keys, one per thread: each scans
+/// every item and keeps the entries it owns, so the result is the same for any number of
+/// threads.
+pub(crate) fn group_by_key<T, const K: usize>(
+    n_keys: usize,
+    m: usize,
+    entries: impl Fn(usize) -> [Option<(u32, T)>; K] + Sync,
+) -> (Vec<usize>, Vec<T>)
+where
+    T: Copy + Default + Send + Sync,
+{
+    /// Keys from which the ranges are built in parallel.
+    const PARALLEL: usize = 1 << 16;
+    let parts = if n_keys >= PARALLEL {
+        rayon::current_num_threads().clamp(1, 16)
+    } else {
+        1
+    };
+    let bounds: Vec<usize> = (0..=parts).map(|p| p * n_keys / parts).collect();
+    // Counts of each range's keys, then their running sums within the range.
+    let mut ptr = vec![0usize; n_keys + 1];
+    let mut ranges = Vec::with_capacity(parts);
+    let mut rest = &mut ptr[1..];
+    for w in bounds.windows(2) {
+        let (head, tail) = rest.split_at_mut(w[1] - w[0]);
+        ranges.push((w[0], head));
+        rest = tail;
+    }
+    let count = |(lo, counts): (usize, &mut [usize])| {
+        let hi = lo + counts.len();
+        for i in 0..m {
+            for e in entries(i) {
+                let Some((key, _)) = e else { continue };
+                let key = key as usize;
+                if key >= lo && key < hi {
+                    counts[key - lo] += 1;
+                }
+            }
+        }
+        let mut sum = 0;
+        for c in counts.iter_mut() {
+            sum += *c;
+            *c = sum;
+        }
+        sum
+    };
+    let totals: Vec<usize> = if parts > 1 {
+        ranges.into_par_iter().map(count).collect()
+    } else {
+        ranges.into_iter().map(count).collect()
+    };
+    let mut offset = 0;
+    for (w, total) in bounds.windows(2).zip(&totals) {
+        if offset > 0 {
+            ptr[w[0] + 1..=w[1]]
+                .par_iter_mut()
+                .for_each(|p| *p += offset);
+        }
+        offset += total;
+    }
+    // Each range fills its own part of the values, in item order.
+    let mut values = vec![T::default(); offset];
+    let mut pieces = Vec::with_capacity(parts);
+    let mut rest = &mut values[..];
+    for w in bounds.windows(2) {
+        let (head, tail) = rest.split_at_mut(ptr[w[1]] - ptr[w[0]]);
+        pieces.push((w[0], w[1], head));
+        rest = tail;
+    }
+    let ptr_ref = &ptr;
+    let fill = |(lo, hi, out): (usize, usize, &mut [T])| {
+        let base = ptr_ref[lo];
+        let mut next: Vec<usize> = ptr_ref[lo..hi].iter().map(|p| p - base).collect();
+        for i in 0..m {
+            for e in entries(i) {
+                let Some((key, value)) = e else { continue };
+                let key = key as usize;
+                if key >= lo && key < hi {
+                    out[next[key - lo]] = value;
+                    next[key - lo] += 1;
+                }
+            }
+        }
+    };
+    if parts > 1 {
+        pieces.into_par_iter().for_each(fill);
+    } else {
+        pieces.into_iter().for_each(fill);
+    }
+    (ptr, values)
+}
+
 /// Splits the value array of a matrix on `pattern` into blocks of `rows` consecutive rows:
 /// `(first row, values of those rows)`, so that blocks can be filled in parallel.
 pub(crate) fn row_chunks<'a>(
@@ -325,6 +420,41 @@ mod tests {
             }
         }
         Csr::from_triplets(n, &t)
+    }
+
+    #[test]
+    fn grouping_by_key_is_a_stable_counting_sort_for_any_thread_count() {
+        // Two entries per item, some missing, keys scattered; beyond the parallel size.
+        let (n_keys, m) = (70_000, 150_000);
+        let entries = |i: usize| {
+            let a = ((i * 7919) % n_keys) as u32;
+            let b = ((i * 104_729 + 13) % n_keys) as u32;
+            [
+                Some((a, i as u64)),
+                (i % 3 != 0).then_some((b, (i as u64) << 32)),
+            ]
+        };
+        let mut lists = vec![Vec::new(); n_keys];
+        for i in 0..m {
+            for (key, value) in entries(i).into_iter().flatten() {
+                lists[key as usize].push(value);
+            }
+        }
+        for threads in [1, 2, 3] {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap();
+            let (ptr, values) = pool.install(|| group_by_key(n_keys, m, entries));
+            assert_eq!(ptr.len(), n_keys + 1);
+            for (k, list) in lists.iter().enumerate() {
+                assert_eq!(
+                    &values[ptr[k]..ptr[k + 1]],
+                    &list[..],
+                    "key {k}, {threads} threads"
+                );
+            }
+        }
     }
 
     #[test]

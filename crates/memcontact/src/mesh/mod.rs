@@ -536,82 +536,11 @@ pub struct VertexTriangles {
 }
 
 impl VertexTriangles {
-    /// Builds the adjacency of `mesh`, each vertex's triangles in increasing order. Large
-    /// meshes are split into ranges of vertices, one per thread: each range scans every
-    /// triangle and keeps the corners it owns, so the lists come out in the same order
-    /// for any number of threads.
+    /// Builds the adjacency of `mesh`, each vertex's triangles in increasing order (on
+    /// all threads for large meshes, with the same result for any number of them).
     pub fn new(mesh: &Mesh) -> VertexTriangles {
-        use rayon::prelude::*;
-        /// Vertices from which the ranges are built in parallel.
-        const PARALLEL: usize = 1 << 16;
-        let n = mesh.n_vertices();
-        let parts = if n >= PARALLEL {
-            rayon::current_num_threads().clamp(1, 16)
-        } else {
-            1
-        };
-        let bounds: Vec<usize> = (0..=parts).map(|p| p * n / parts).collect();
-        // Counts of the range's vertices, then their running sums within the range.
-        let mut ptr = vec![0usize; n + 1];
-        let mut rest = &mut ptr[1..];
-        let mut ranges = Vec::with_capacity(parts);
-        for w in bounds.windows(2) {
-            let (head, tail) = rest.split_at_mut(w[1] - w[0]);
-            ranges.push((w[0], head));
-            rest = tail;
-        }
-        let totals: Vec<usize> = ranges
-            .into_par_iter()
-            .map(|(lo, counts)| {
-                let hi = lo + counts.len();
-                for t in &mesh.triangles {
-                    for &v in t {
-                        let v = v as usize;
-                        if v >= lo && v < hi {
-                            counts[v - lo] += 1;
-                        }
-                    }
-                }
-                let mut sum = 0;
-                for c in counts.iter_mut() {
-                    sum += *c;
-                    *c = sum;
-                }
-                sum
-            })
-            .collect();
-        // Offsets of the ranges.
-        let mut offset = 0;
-        for (w, total) in bounds.windows(2).zip(&totals) {
-            if offset > 0 {
-                ptr[w[0] + 1..=w[1]]
-                    .par_iter_mut()
-                    .for_each(|p| *p += offset);
-            }
-            offset += total;
-        }
-        // Each range fills its own part of `tri`, in triangle order.
-        let mut tri = vec![0u32; offset];
-        let mut rest = &mut tri[..];
-        let mut parts_tri = Vec::with_capacity(parts);
-        for w in bounds.windows(2) {
-            let (head, tail) = rest.split_at_mut(ptr[w[1]] - ptr[w[0]]);
-            parts_tri.push((w[0], w[1], head));
-            rest = tail;
-        }
-        let ptr_ref = &ptr;
-        parts_tri.into_par_iter().for_each(|(lo, hi, out)| {
-            let base = ptr_ref[lo];
-            let mut fill: Vec<usize> = ptr_ref[lo..hi].iter().map(|p| p - base).collect();
-            for (k, t) in mesh.triangles.iter().enumerate() {
-                for &v in t {
-                    let v = v as usize;
-                    if v >= lo && v < hi {
-                        out[fill[v - lo]] = k as u32;
-                        fill[v - lo] += 1;
-                    }
-                }
-            }
+        let (ptr, tri) = crate::sparse::group_by_key(mesh.n_vertices(), mesh.n_triangles(), |k| {
+            mesh.triangles[k].map(|v| Some((v, k as u32)))
         });
         VertexTriangles { ptr, tri }
     }

@@ -110,32 +110,15 @@ impl Transfer {
     }
 
     /// P from its rows (up to two parents per fine unknown; weight 0 for a missing one),
-    /// with the columns built by a counting sort (children in increasing fine order).
+    /// with the columns built by a counting sort (children in increasing fine order,
+    /// [`crate::sparse::group_by_key`]).
     fn from_rows(parents: Vec<[u32; 2]>, weights: Vec<[f32; 2]>, n_coarse: usize) -> Transfer {
-        let mut child_ptr = vec![0usize; n_coarse + 1];
-        for (p, w) in parents.iter().zip(&weights) {
-            for s in 0..2 {
-                if w[s] != 0.0 {
-                    child_ptr[p[s] as usize + 1] += 1;
-                }
-            }
-        }
-        for i in 0..n_coarse {
-            child_ptr[i + 1] += child_ptr[i];
-        }
-        let mut fill = child_ptr.clone();
-        let mut children = vec![0u32; child_ptr[n_coarse]];
-        let mut child_weights = vec![0.0; child_ptr[n_coarse]];
-        for (v, (p, w)) in parents.iter().zip(&weights).enumerate() {
-            for s in 0..2 {
-                if w[s] != 0.0 {
-                    let k = &mut fill[p[s] as usize];
-                    children[*k] = v as u32;
-                    child_weights[*k] = w[s];
-                    *k += 1;
-                }
-            }
-        }
+        let (child_ptr, entries) = crate::sparse::group_by_key(n_coarse, parents.len(), |v| {
+            let (p, w) = (parents[v], weights[v]);
+            [0, 1].map(|s| (w[s] != 0.0).then_some((p[s], (v as u32, w[s]))))
+        });
+        let children = entries.par_iter().with_min_len(4096).map(|e| e.0).collect();
+        let child_weights = entries.par_iter().with_min_len(4096).map(|e| e.1).collect();
         Transfer {
             n_coarse,
             parents,
