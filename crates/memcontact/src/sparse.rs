@@ -431,7 +431,7 @@ mod tests {
             let b = ((i * 104_729 + 13) % n_keys) as u32;
             [
                 Some((a, i as u64)),
-                (i % 3 != 0).then_some((b, (i as u64) << 32)),
+                (!i.is_multiple_of(3)).then_some((b, (i as u64) << 32)),
             ]
         };
         let mut lists = vec![Vec::new(); n_keys];
