@@ -576,7 +576,8 @@ impl Model {
     /// The vertex states: −1 clear (`U < φ`, or the vertex cannot touch), 0 touching
     /// (`U = φ`), 1 penetrating (`U > φ`).
     pub fn states(&self, u: &[f64]) -> Vec<i8> {
-        u.iter()
+        u.par_iter()
+            .with_min_len(4096)
             .zip(&self.phi)
             .zip(&self.can_touch)
             .map(|((ui, fi), &c)| {

@@ -5,6 +5,7 @@
 use crate::mesh::Mesh;
 use crate::model::Model;
 use crate::solve::Solution;
+use rayon::prelude::*;
 
 /// Fields over all mesh vertices (u = g on the fixed boundary, 0 by default).
 #[derive(Debug, Clone)]
@@ -110,9 +111,9 @@ pub fn derive(mesh: &Mesh, model: &Model, solution: &Solution) -> (NodalFields, 
 /// Nodal areas |Q_i| / 3 of every vertex.
 fn nodal_areas(mesh: &Mesh) -> Vec<f64> {
     let mut nodal_area = vec![0.0; mesh.n_vertices()];
-    for k in 0..mesh.n_triangles() {
-        let a = mesh.area(k) / 3.0;
-        for &v in &mesh.triangles[k] {
+    for (t, area) in mesh.triangles.iter().zip(mesh.areas()) {
+        let a = area / 3.0;
+        for &v in t {
             nodal_area[v as usize] += a;
         }
     }
@@ -123,6 +124,8 @@ fn nodal_areas(mesh: &Mesh) -> Vec<f64> {
 /// its nodal force per nodal area.
 fn pressure(h: &[f64], penetration: &[f64], force: &[f64], nodal_area: &[f64]) -> Vec<f64> {
     (0..h.len())
+        .into_par_iter()
+        .with_min_len(4096)
         .map(|v| {
             if h[v].is_infinite() {
                 if nodal_area[v] > 0.0 {
@@ -137,6 +140,19 @@ fn pressure(h: &[f64], penetration: &[f64], force: &[f64], nodal_area: &[f64]) -
         .collect()
 }
 
+/// `value(i)` at the vertex of every unknown i, `boundary` elsewhere (in parallel).
+fn gather<T: Copy + Send + Sync>(
+    dofs: &crate::mesh::DofMap,
+    value: impl Fn(usize) -> T + Sync,
+    boundary: T,
+) -> Vec<T> {
+    dofs.dof
+        .par_iter()
+        .with_min_len(4096)
+        .map(|d| d.map_or(boundary, |i| value(i as usize)))
+        .collect()
+}
+
 /// Computes the vertex fields and totals of the iterate `u` (over the unknowns).
 pub fn derive_from(mesh: &Mesh, model: &Model, u_dofs: &[f64]) -> (NodalFields, Totals) {
     let nv = mesh.n_vertices();
@@ -145,14 +161,19 @@ pub fn derive_from(mesh: &Mesh, model: &Model, u_dofs: &[f64]) -> (NodalFields, 
     let forces = crate::certificate::contact_forces(model, u_dofs);
     let contact_force = dofs.to_vertices(&forces.up, 0.0);
     let states = model.states(u_dofs);
-    let mut state = vec![-1i8; nv];
-    let mut penetration = vec![0.0; nv];
-    for (i, &v) in dofs.vertex.iter().enumerate() {
-        state[v as usize] = states[i];
-        if model.can_touch[i] {
-            penetration[v as usize] = (u_dofs[i] - model.phi[i]).max(0.0);
-        }
-    }
+    // Over the vertices, from the unknowns (boundary vertices: clear, no penetration).
+    let state: Vec<i8> = gather(dofs, |i| states[i], -1);
+    let penetration = gather(
+        dofs,
+        |i| {
+            if model.can_touch[i] {
+                (u_dofs[i] - model.phi[i]).max(0.0)
+            } else {
+                0.0
+            }
+        },
+        0.0,
+    );
     let nodal_area = nodal_areas(mesh);
     let pressure_up = pressure(&model.h_vertices, &penetration, &contact_force, &nodal_area);
     let count = |s: i8| states.iter().filter(|&&x| x == s).count();
@@ -172,14 +193,18 @@ pub fn derive_from(mesh: &Mesh, model: &Model, u_dofs: &[f64]) -> (NodalFields, 
     let (lower, lower_totals) = match &model.lower {
         Some(low) => {
             let states_low = model.lower_states(u_dofs);
-            let mut state_low = vec![-1i8; nv];
-            let mut penetration_low = vec![0.0; nv];
-            for (i, &v) in dofs.vertex.iter().enumerate() {
-                state_low[v as usize] = states_low[i];
-                if low.can_touch[i] {
-                    penetration_low[v as usize] = (low.phi[i] - u_dofs[i]).max(0.0);
-                }
-            }
+            let state_low: Vec<i8> = gather(dofs, |i| states_low[i], -1);
+            let penetration_low = gather(
+                dofs,
+                |i| {
+                    if low.can_touch[i] {
+                        (low.phi[i] - u_dofs[i]).max(0.0)
+                    } else {
+                        0.0
+                    }
+                },
+                0.0,
+            );
             let force_low = dofs.to_vertices(&forces.low, 0.0);
             let pressure_low = pressure(&low.h_vertices, &penetration_low, &force_low, &nodal_area);
             let covered_low: Vec<bool> = low.h_vertices.iter().map(|&h| h > 0.0).collect();

@@ -595,11 +595,13 @@ impl DofMap {
 
     /// A vector over unknowns extended to all vertices, with `boundary` on ∂Ω_n.
     pub fn to_vertices(&self, x: &[f64], boundary: f64) -> Vec<f64> {
-        let mut out = vec![boundary; self.dof.len()];
-        for (i, &v) in self.vertex.iter().enumerate() {
-            out[v as usize] = x[i];
+        use rayon::prelude::*;
+        let at = |d: &Option<u32>| d.map_or(boundary, |i| x[i as usize]);
+        if self.dof.len() >= 1 << 16 {
+            self.dof.par_iter().with_min_len(4096).map(at).collect()
+        } else {
+            self.dof.iter().map(at).collect()
         }
-        out
     }
 
     /// A vector over all vertices restricted to the unknowns.
