@@ -782,17 +782,19 @@ const DOT_BLOCK: usize = 4096;
 /// `aᵀb`, summed in fixed blocks (the same result for any number of threads).
 fn det_dot(a: &[f64], b: &[f64]) -> f64 {
     use rayon::prelude::*;
-    const BLOCK: usize = DOT_BLOCK;
     let block = |(x, y): (&[f64], &[f64])| -> f64 { x.iter().zip(y).map(|(p, q)| p * q).sum() };
     if a.len() >= super::transfer::PAR_ROWS {
         let parts: Vec<f64> = a
-            .par_chunks(BLOCK)
-            .zip(b.par_chunks(BLOCK))
+            .par_chunks(DOT_BLOCK)
+            .zip(b.par_chunks(DOT_BLOCK))
             .map(block)
             .collect();
         parts.iter().sum()
     } else {
-        a.chunks(BLOCK).zip(b.chunks(BLOCK)).map(block).sum()
+        a.chunks(DOT_BLOCK)
+            .zip(b.chunks(DOT_BLOCK))
+            .map(block)
+            .sum()
     }
 }
 
