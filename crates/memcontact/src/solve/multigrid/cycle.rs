@@ -1032,24 +1032,41 @@ pub(crate) fn gauss_seidel_from_zero<A: TopOperator>(
         .for_each(|(k, (xs, rs))| sweep(k * GS_BLOCK, xs, rs));
     // The other blocks' unknowns, now known, on the rows that see them.
     let x: &[f64] = x;
-    r.par_chunks_mut(GS_BLOCK).enumerate().for_each(|(k, rs)| {
-        let lo = k * GS_BLOCK;
-        let hi = lo + rs.len();
-        let from = seams.partition_point(|&i| (i as usize) < lo);
-        let to = seams.partition_point(|&i| (i as usize) < hi);
-        for &i in &seams[from..to] {
-            let i = i as usize;
-            let (s, e) = (pat.row_ptr[i], pat.row_ptr[i + 1]);
-            let outside: f64 = pat.col[s..e]
-                .iter()
-                .zip(&a.val[s..e])
-                .filter(|(&j, _)| (j as usize) < lo || (j as usize) >= hi)
-                .map(|(&j, &v)| v * x[j as usize])
-                .sum();
-            rs[i - lo] -= outside;
-        }
-    });
+    add_outside_blocks(a, seams, r, -1.0, |j| x[j]);
     restore_held(r);
+}
+
+/// `out_i += sign · Σ_j a_ij value(j)` over the columns j outside row i's block of
+/// [`GS_BLOCK`] rows, for the rows of `seams` ([`seam_rows`] of A's pattern): the hybrid
+/// sweeps' contribution of the other blocks, added once they are done.
+fn add_outside_blocks(
+    a: &Csr,
+    seams: &[u32],
+    out: &mut [f64],
+    sign: f64,
+    value: impl Fn(usize) -> f64 + Sync,
+) {
+    use rayon::prelude::*;
+    let pat = &a.pattern;
+    out.par_chunks_mut(GS_BLOCK)
+        .enumerate()
+        .for_each(|(k, os)| {
+            let lo = k * GS_BLOCK;
+            let hi = lo + os.len();
+            let from = seams.partition_point(|&i| (i as usize) < lo);
+            let to = seams.partition_point(|&i| (i as usize) < hi);
+            for &i in &seams[from..to] {
+                let i = i as usize;
+                let (s, e) = (pat.row_ptr[i], pat.row_ptr[i + 1]);
+                let outside: f64 = pat.col[s..e]
+                    .iter()
+                    .zip(&a.val[s..e])
+                    .filter(|(&j, _)| (j as usize) < lo || (j as usize) >= hi)
+                    .map(|(&j, &v)| v * value(j as usize))
+                    .sum();
+                os[i - lo] += sign * outside;
+            }
+        });
 }
 
 /// One backward sweep of [`gauss_seidel`], with the product `y = A x` after it, in one
@@ -1130,23 +1147,7 @@ pub(crate) fn gauss_seidel_back_with_product<A: TopOperator>(
         .for_each(|(k, (xs, ys))| sweep(k * GS_BLOCK, xs, ys, before));
     // The other blocks' changes, now known, on the rows that see them.
     let x: &[f64] = x;
-    y.par_chunks_mut(GS_BLOCK).enumerate().for_each(|(k, ys)| {
-        let lo = k * GS_BLOCK;
-        let hi = lo + ys.len();
-        let from = seams.partition_point(|&i| (i as usize) < lo);
-        let to = seams.partition_point(|&i| (i as usize) < hi);
-        for &i in &seams[from..to] {
-            let i = i as usize;
-            let (s, e) = (pat.row_ptr[i], pat.row_ptr[i + 1]);
-            let outside: f64 = pat.col[s..e]
-                .iter()
-                .zip(&a.val[s..e])
-                .filter(|(&j, _)| (j as usize) < lo || (j as usize) >= hi)
-                .map(|(&j, &v)| v * (x[j as usize] - before[j as usize]))
-                .sum();
-            ys[i - lo] += outside;
-        }
-    });
+    add_outside_blocks(a, seams, y, 1.0, |j| x[j] - before[j]);
     clear_held(y);
 }
 
