@@ -380,7 +380,8 @@ pub fn contact_forces(model: &Model, u: &[f64]) -> ContactForces {
     let r = model.residual(u);
     let Some(low) = &model.lower else {
         let up = r
-            .iter()
+            .par_iter()
+            .with_min_len(4096)
             .zip(&model.can_touch)
             .map(|(ri, &c)| if c { -ri } else { 0.0 })
             .collect();
@@ -619,8 +620,7 @@ mod tests {
         let e = evaluate(&m, &v);
         assert!((e.energy - m.energy(&v)).abs() <= 1e-13 * m.energy(&v).abs().max(1.0));
         // The scale is the largest force present.
-        let r = m.residual(&v);
-        let su: Vec<f64> = r.iter().zip(&m.d).map(|(r, d)| r + d).collect();
+        let su = m.s.mul(&v);
         let s = crate::sparse::norm_inf(&su).max(crate::sparse::norm_inf(&m.d));
         assert!(e.certificate.force_scale >= s);
         assert!(e.certificate.rounding_floor > 0.0 && e.certificate.rounding_floor < 1e-12);

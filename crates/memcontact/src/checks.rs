@@ -12,6 +12,7 @@ use crate::fem::{Coefficient, VertexTriangles};
 use crate::mesh::Mesh;
 use crate::model::{Extensions, FoundationMatrix, Model, ProblemData, Stiffness};
 use crate::results::{NodalFields, Totals};
+use crate::sparse::first_non_finite;
 use crate::{Error, Result};
 
 /// Assembles the model of `data` with the extensions `ext` on `mesh`
@@ -134,7 +135,7 @@ pub fn check_model(mesh: &Mesh, model: &Model) -> Result<()> {
                 .into(),
         ));
     }
-    if let Some(i) = model.phi.iter().position(|v| !v.is_finite()) {
+    if let Some(i) = first_non_finite(&model.phi) {
         let p = mesh.points[model.dofs.vertex[i] as usize];
         return Err(Error::Data(format!(
             "obstacle.shape φ is not finite at ({}, {})",
@@ -149,7 +150,7 @@ pub fn check_model(mesh: &Mesh, model: &Model) -> Result<()> {
                     .into(),
             ));
         }
-        if let Some(i) = low.phi.iter().position(|v| !v.is_finite()) {
+        if let Some(i) = first_non_finite(&low.phi) {
             let p = mesh.points[model.dofs.vertex[i] as usize];
             return Err(Error::Data(format!(
                 "lower.shape φ_low is not finite at ({}, {})",
@@ -157,7 +158,7 @@ pub fn check_model(mesh: &Mesh, model: &Model) -> Result<()> {
             )));
         }
     }
-    if let Some(i) = model.d.iter().position(|v| !v.is_finite()) {
+    if let Some(i) = first_non_finite(&model.d) {
         let p = mesh.points[model.dofs.vertex[i] as usize];
         return Err(Error::Data(format!(
             "the nodal load D = ∫f gᵢ overflows double precision near ({}, {}): \
@@ -188,7 +189,7 @@ pub fn check_model(mesh: &Mesh, model: &Model) -> Result<()> {
 fn matrix_finite(l: &FoundationMatrix) -> bool {
     match l {
         FoundationMatrix::Consistent(l) => l.is_finite(),
-        FoundationMatrix::Lumped(d) => d.iter().all(|v| v.is_finite()),
+        FoundationMatrix::Lumped(d) => first_non_finite(d).is_none(),
         FoundationMatrix::Rigid => true,
     }
 }
@@ -226,7 +227,7 @@ pub fn check_results(mesh: &Mesh, fields: &NodalFields, totals: &Totals) -> Resu
         ("the penetration", &fields.penetration),
     ];
     for (name, values) in vertex_fields {
-        if let Some(v) = values.iter().position(|x| !x.is_finite()) {
+        if let Some(v) = first_non_finite(values) {
             let p = mesh.points[v];
             return Err(Error::Data(format!(
                 "{name} is {} at the vertex ({}, {}): {OVERFLOW_HINT}",

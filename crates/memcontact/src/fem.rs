@@ -364,16 +364,106 @@ pub fn assemble_load(
 /// `∫_Ω c` over the whole mesh (the total load for c = f), by the same element integrals
 /// as [`assemble_load`] (`areas` is [`Mesh::areas`]).
 pub fn integrate(mesh: &Mesh, areas: &[f64], c: &dyn Coefficient) -> f64 {
-    (0..mesh.n_triangles())
-        .into_par_iter()
-        .with_min_len(4096)
-        .map(|k| match c.on_region(mesh.regions[k]) {
-            Some(v) => v * areas[k],
-            None => (0..3)
-                .map(|a| element_load(mesh, areas, k, c, a))
-                .sum::<f64>(),
+    let element = |k: usize| match c.on_region(mesh.regions[k]) {
+        Some(v) => v * areas[k],
+        None => (0..3)
+            .map(|a| element_load(mesh, areas, k, c, a))
+            .sum::<f64>(),
+    };
+    // Summed in fixed blocks: the same for any number of threads.
+    let parts = crate::sparse::map_blocks(mesh.n_triangles(), |r| r.map(element).sum::<f64>());
+    parts.iter().sum()
+}
+
+/// The one value of `c` on all the region tags `tags`, when it has one (assembly then
+/// scales the nodal areas instead of integrating element by element).
+pub fn uniform_value(c: &dyn Coefficient, tags: &[u32]) -> Option<f64> {
+    let (&first, rest) = tags.split_first()?;
+    let v = c.on_region(first)?;
+    rest.iter()
+        .all(|&t| c.on_region(t).is_some_and(|w| w.to_bits() == v.to_bits()))
+        .then_some(v)
+}
+
+/// The load-type integrals of one mesh ([`assemble_load`], [`integrate`]), with a fast
+/// path for a coefficient with one value c everywhere: `∫ c g_i = c ∫ g_i`, c times the
+/// nodal areas (found once, on first use, and shared by every such coefficient: the load
+/// f and the lumped foundation's h), and `∫_Ω c = c |Ω_n|`.
+pub struct Loads<'a> {
+    mesh: &'a Mesh,
+    dofs: &'a DofMap,
+    adj: &'a VertexTriangles,
+    areas: &'a [f64],
+    tags: Vec<u32>,
+    nodal: std::sync::OnceLock<Vec<f64>>,
+}
+
+impl<'a> Loads<'a> {
+    /// The integrals over `mesh` with the unknowns `dofs`, its vertex → triangles map
+    /// `adj` and its triangle areas `areas` ([`Mesh::areas`]).
+    pub fn new(
+        mesh: &'a Mesh,
+        dofs: &'a DofMap,
+        adj: &'a VertexTriangles,
+        areas: &'a [f64],
+    ) -> Loads<'a> {
+        Loads {
+            mesh,
+            dofs,
+            adj,
+            areas,
+            tags: mesh.region_tags(),
+            nodal: std::sync::OnceLock::new(),
+        }
+    }
+
+    /// The one value of `c` on every region of the mesh, when it has one.
+    pub fn uniform(&self, c: &dyn Coefficient) -> Option<f64> {
+        uniform_value(c, &self.tags)
+    }
+
+    /// `∫ g_i` over the unknowns: the sum of `|T| / 3` over the triangles around vertex i.
+    pub fn nodal_areas(&self) -> &[f64] {
+        self.nodal.get_or_init(|| {
+            self.dofs
+                .vertex
+                .par_iter()
+                .with_min_len(1024)
+                .map(|&v| {
+                    self.adj
+                        .of(v as usize)
+                        .iter()
+                        .map(|&k| self.areas[k as usize] / 3.0)
+                        .sum()
+                })
+                .collect()
         })
-        .sum()
+    }
+
+    /// `∫ c g_i` over the unknowns ([`assemble_load`]).
+    pub fn vector(&self, c: &dyn Coefficient) -> Vec<f64> {
+        match self.uniform(c) {
+            Some(v) => self
+                .nodal_areas()
+                .par_iter()
+                .with_min_len(4096)
+                .map(|a| v * a)
+                .collect(),
+            None => assemble_load(self.mesh, self.dofs, self.adj, self.areas, c),
+        }
+    }
+
+    /// `∫_Ω c` over the whole mesh ([`integrate`]).
+    pub fn integral(&self, c: &dyn Coefficient) -> f64 {
+        match self.uniform(c) {
+            Some(v) => {
+                let a = self.areas;
+                let parts = crate::sparse::map_blocks(a.len(), |r| a[r].iter().sum::<f64>());
+                v * parts.iter().sum::<f64>()
+            }
+            None => integrate(self.mesh, self.areas, c),
+        }
+    }
 }
 
 /// Fills a vector over unknowns: entry `i` sums `local(element, region, a)` over the
@@ -513,6 +603,62 @@ mod tests {
                 assert_eq!(row, expected.as_slice(), "row {i}");
             }
         }
+    }
+
+    #[test]
+    fn uniform_coefficients_scale_the_nodal_areas() {
+        /// A region table: one value on region 2, another elsewhere.
+        struct ByRegion(f64, f64);
+        impl Coefficient for ByRegion {
+            fn at(&self, _: Point, region: u32) -> f64 {
+                if region == 2 {
+                    self.1
+                } else {
+                    self.0
+                }
+            }
+            fn on_region(&self, region: u32) -> Option<f64> {
+                Some(self.at([0.0, 0.0], region))
+            }
+        }
+        let mut m = crate::mesh::generate::disk([0.0, 0.0], 1.0, 0.05).unwrap();
+        // Two regions: the triangles left of x = 0 are region 2.
+        m.regions = (0..m.n_triangles())
+            .map(|k| if m.corners(k)[0][0] < 0.0 { 2 } else { 0 })
+            .collect();
+        let adj = VertexTriangles::new(&m);
+        let dofs = DofMap::new(&m);
+        let areas = m.areas();
+        let loads = Loads::new(&m, &dofs, &adj, &areas);
+        let area: f64 = (0..m.n_triangles())
+            .map(|k| crate::mesh::signed_area(&m.points, &m.triangles[k]))
+            .sum();
+        // One value everywhere, given as a number or as a table: c times the nodal areas.
+        let same = ByRegion(2.5, 2.5);
+        for c in [&2.5 as &dyn Coefficient, &same] {
+            assert_eq!(loads.uniform(c), Some(2.5));
+            let fast = loads.vector(c);
+            let general = assemble_load(&m, &dofs, &adj, &areas, c);
+            for (x, y) in fast.iter().zip(&general) {
+                assert!((x - y).abs() <= 1e-15 * y.abs(), "{x} against {y}");
+            }
+            assert!((loads.integral(c) - 2.5 * area).abs() <= 1e-12 * area);
+            let (a1, a2) = (loads.integral(c), integrate(&m, &areas, c));
+            assert!((a1 - a2).abs() <= 1e-12 * area, "{a1} {a2} {area}");
+        }
+        // Two values, or a function of the point: element by element, as before.
+        let two = ByRegion(1.0, 3.0);
+        let x2 = FnCoefficient(|p: Point| p[0] * p[0]);
+        for c in [&two as &dyn Coefficient, &x2] {
+            assert_eq!(loads.uniform(c), None);
+            assert_eq!(loads.vector(c), assemble_load(&m, &dofs, &adj, &areas, c));
+            assert_eq!(loads.integral(c), integrate(&m, &areas, c));
+        }
+        // ∫ x² over the unit disc is π/4 (to the order of the polygon's gap, h²).
+        assert!((loads.integral(&x2) - std::f64::consts::FRAC_PI_4).abs() < 1e-2);
+        // ∫ over region 2 (the left half disc) counts 3, over the rest 1: 2π in all.
+        assert!((loads.integral(&two) - 2.0 * std::f64::consts::PI).abs() < 2e-2);
+        assert_eq!(uniform_value(&2.5, &[]), None);
     }
 
     #[test]

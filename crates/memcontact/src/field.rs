@@ -92,12 +92,7 @@ impl Field {
                     values.clone(),
                 )?))),
             }),
-            _ => {
-                let mut tags: Vec<u32> = mesh.regions.clone();
-                tags.sort_unstable();
-                tags.dedup();
-                self.bind(name, &mesh.region_names, &tags)
-            }
+            _ => self.bind(name, &mesh.region_names, &mesh.region_tags()),
         }
     }
 
@@ -487,19 +482,17 @@ impl Stiffness {
     /// Resolves the stiffness against `mesh` ([`Field::bind_to_mesh`] for the elastic
     /// part; the rigid entries of a mixed table name regions like any other key).
     pub fn bind_to_mesh(&self, name: &str, mesh: &Mesh) -> Result<BoundStiffness> {
-        let mut tags: Vec<u32> = mesh.regions.clone();
-        tags.sort_unstable();
-        tags.dedup();
         match self {
             Stiffness::Rigid => Ok(BoundStiffness {
                 elastic: None,
-                rigid_tags: tags,
+                rigid_tags: mesh.region_tags(),
             }),
             Stiffness::Elastic(h) => Ok(BoundStiffness {
                 elastic: Some(h.bind_to_mesh(name, mesh)?),
                 rigid_tags: Vec::new(),
             }),
             Stiffness::Mixed(table) => {
+                let tags = mesh.region_tags();
                 // Which regions are rigid: a marker table bound like the stiffness itself,
                 // so that names, tags and the default resolve with the same rules.
                 let marker = Field::Regions(

@@ -6,8 +6,7 @@
 pub use crate::certificate::Certificate;
 use crate::fem::assemble_lift;
 use crate::fem::{
-    assemble_load, assemble_stiffness_and_mass, integrate, unknowns_pattern, Coefficient,
-    VertexTriangles,
+    assemble_stiffness_and_mass, unknowns_pattern, Coefficient, Loads, VertexTriangles,
 };
 use crate::mesh::boundary::FixedBoundary;
 use crate::mesh::{DofMap, Mesh};
@@ -159,7 +158,8 @@ impl Body {
 
     /// `q = (φ_low − V)⁺` on the unknowns the body can touch (zero elsewhere).
     pub fn penetration(&self, v: &[f64]) -> Vec<f64> {
-        v.iter()
+        v.par_iter()
+            .with_min_len(4096)
             .zip(&self.phi)
             .zip(&self.can_touch)
             .map(|((vi, fi), &c)| if c { (fi - vi).max(0.0) } else { 0.0 })
@@ -304,9 +304,12 @@ impl Model {
                 "the mesh has no interior vertex: there is no unknown to solve for".into(),
             ));
         }
+        // The triangle areas, shared by every load-type integral below.
+        let areas = mesh.areas();
+        let loads = Loads::new(mesh, &dofs, adj, &areas);
         // Data checks: every value finite, h ≥ 0. f and h at the triangle centroids (their
         // quadrature), φ and h at the vertices (their samples).
-        check_centroids(mesh, "membrane.load f", data.load, false)?;
+        check_centroids(mesh, &loads, "membrane.load f", data.load, false)?;
         let upper = BodyData {
             shape: data.shape,
             stiffness: data.stiffness,
@@ -323,19 +326,17 @@ impl Model {
         };
         let (s, l_consistent) =
             assemble_stiffness_and_mass(mesh, &dofs, adj, &pattern, t, consistent_h);
-        // The triangle areas, shared by every load-type integral below.
-        let areas = mesh.areas();
-        let body = assemble_body(mesh, adj, &areas, &dofs, &upper, l_consistent, NAMES_UPPER)?;
+        let body = assemble_body(mesh, adj, &loads, &dofs, &upper, l_consistent, NAMES_UPPER)?;
         let load = data.load;
-        let mut d = assemble_load(mesh, &dofs, adj, &areas, load);
-        if let Some(i) = d.iter().position(|v| !v.is_finite()) {
+        let mut d = loads.vector(load);
+        if let Some(i) = crate::sparse::first_non_finite(&d) {
             let p = mesh.points[dofs.vertex[i] as usize];
             return Err(Error::Data(format!(
                 "membrane.load f is not finite near ({}, {})",
                 p[0], p[1]
             )));
         }
-        let total_load = integrate(mesh, &areas, load);
+        let total_load = loads.integral(load);
         // Boundary heights and the lifting S_fix G.
         let (boundary_values, lift) = match (&ext.boundary, &fixed) {
             (Some(b), Some(f)) => {
@@ -364,7 +365,7 @@ impl Model {
                 Some(assemble_body(
                     mesh,
                     adj,
-                    &areas,
+                    &loads,
                     &dofs,
                     low,
                     l_consistent,
@@ -459,7 +460,8 @@ impl Model {
 
     /// The penetration `p = (V − φ)⁺` (zero outside M).
     pub fn penetration(&self, v: &[f64]) -> Vec<f64> {
-        v.iter()
+        v.par_iter()
+            .with_min_len(4096)
             .zip(&self.phi)
             .zip(&self.can_touch)
             .map(|((vi, fi), &c)| if c { (vi - fi).max(0.0) } else { 0.0 })
@@ -567,9 +569,10 @@ impl Model {
     /// `r = S V − D`.
     pub fn residual(&self, v: &[f64]) -> Vec<f64> {
         let mut r = self.s.mul(v);
-        for (ri, di) in r.iter_mut().zip(&self.d) {
-            *ri -= di;
-        }
+        r.par_iter_mut()
+            .with_min_len(4096)
+            .zip(&self.d)
+            .for_each(|(ri, di)| *ri -= di);
         r
     }
 
@@ -645,7 +648,16 @@ impl Model {
 fn foundation_energy(l: &FoundationMatrix, p: &[f64]) -> f64 {
     match l {
         FoundationMatrix::Consistent(l) => 0.5 * l.quad_form(p),
-        FoundationMatrix::Lumped(d) => 0.5 * p.iter().zip(d).map(|(p, d)| d * p * p).sum::<f64>(),
+        FoundationMatrix::Lumped(d) => {
+            let parts = crate::sparse::map_blocks(p.len(), |r| {
+                p[r.clone()]
+                    .iter()
+                    .zip(&d[r])
+                    .map(|(p, d)| d * p * p)
+                    .sum::<f64>()
+            });
+            0.5 * parts.iter().sum::<f64>()
+        }
         FoundationMatrix::Rigid => 0.0,
     }
 }
@@ -724,7 +736,7 @@ impl Coefficient for Masked<'_> {
 fn assemble_body(
     mesh: &Mesh,
     adj: &VertexTriangles,
-    areas: &[f64],
+    loads: &Loads,
     dofs: &DofMap,
     data: &BodyData,
     l_consistent: Option<Csr>,
@@ -750,9 +762,16 @@ fn assemble_body(
             && mesh.regions.iter().all(|r| data.rigid_regions.contains(r)));
     let h_vertices = match masked.elastic() {
         Some(h) if !wholly_rigid => {
-            check_centroids(mesh, names.stiffness, h, true)?;
-            let mut hv = vertex_average(mesh, adj, h);
-            check_vertices(mesh, names.stiffness, &hv, true)?;
+            check_centroids(mesh, loads, names.stiffness, h, true)?;
+            // One value everywhere: it was checked, and it is every vertex's average.
+            let mut hv = match loads.uniform(h) {
+                Some(v) => vec_of(mesh.n_vertices(), v),
+                None => {
+                    let hv = vertex_average(mesh, adj, h);
+                    check_vertices(mesh, names.stiffness, &hv, true)?;
+                    hv
+                }
+            };
             if let Some(r) = &rigid_vertex {
                 for (h, &rv) in hv.iter_mut().zip(r) {
                     if rv {
@@ -762,12 +781,12 @@ fn assemble_body(
             }
             hv
         }
-        _ => vec![f64::INFINITY; mesh.n_vertices()],
+        _ => vec_of(mesh.n_vertices(), f64::INFINITY),
     };
     let l = match (masked.elastic(), l_consistent) {
         _ if wholly_rigid => FoundationMatrix::Rigid,
         (_, Some(l)) => FoundationMatrix::Consistent(l),
-        (Some(h), None) => FoundationMatrix::Lumped(assemble_load(mesh, dofs, adj, areas, h)),
+        (Some(h), None) => FoundationMatrix::Lumped(loads.vector(h)),
         (None, None) => FoundationMatrix::Rigid,
     };
     let rigid: Option<Vec<bool>> = match (&rigid_vertex, wholly_rigid) {
@@ -778,6 +797,8 @@ fn assemble_body(
         _ => None,
     };
     let can_touch: Vec<bool> = (0..dofs.len())
+        .into_par_iter()
+        .with_min_len(4096)
         .map(|i| l.is_rigid() || l.diag(i) > 0.0 || rigid.as_ref().is_some_and(|r| r[i]))
         .collect();
     let (phi_vertices, epsilon) = match data.sampling {
@@ -1018,9 +1039,21 @@ fn bad_value(name: &str, v: f64, p: [f64; 2]) -> Error {
 }
 
 /// Checks a coefficient at every triangle centroid: finite, and non-negative when asked
-/// (once per region where it is constant).
-fn check_centroids(mesh: &Mesh, name: &str, c: &dyn Coefficient, non_negative: bool) -> Result<()> {
+/// (once per region where it is constant, once in all where it has one value everywhere).
+fn check_centroids(
+    mesh: &Mesh,
+    loads: &Loads,
+    name: &str,
+    c: &dyn Coefficient,
+    non_negative: bool,
+) -> Result<()> {
     let bad = |v: f64| !v.is_finite() || (non_negative && v < 0.0);
+    // One value everywhere: checked once (a bad one is named at the first centroid).
+    if let Some(v) = loads.uniform(c) {
+        if !bad(v) {
+            return Ok(());
+        }
+    }
     let found = (0..mesh.n_triangles())
         .into_par_iter()
         .with_min_len(4096)
@@ -1043,11 +1076,21 @@ fn check_centroids(mesh: &Mesh, name: &str, c: &dyn Coefficient, non_negative: b
     }
 }
 
+/// `n` copies of `v`, written on all threads.
+fn vec_of(n: usize, v: f64) -> Vec<f64> {
+    (0..n)
+        .into_par_iter()
+        .with_min_len(4096)
+        .map(|_| v)
+        .collect()
+}
+
 /// Checks sampled vertex values: finite, and non-negative when asked.
 fn check_vertices(mesh: &Mesh, name: &str, values: &[f64], non_negative: bool) -> Result<()> {
     match values
-        .iter()
-        .position(|&v| !v.is_finite() || (non_negative && v < 0.0))
+        .par_iter()
+        .with_min_len(4096)
+        .position_first(|&v| !v.is_finite() || (non_negative && v < 0.0))
     {
         Some(i) => Err(bad_value(name, values[i], mesh.points[i])),
         None => Ok(()),

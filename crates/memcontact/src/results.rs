@@ -5,6 +5,7 @@
 use crate::mesh::Mesh;
 use crate::model::Model;
 use crate::solve::Solution;
+use crate::sparse::map_blocks;
 use rayon::prelude::*;
 
 /// Fields over all mesh vertices (u = g on the fixed boundary, 0 by default).
@@ -153,6 +154,11 @@ fn gather<T: Copy + Send + Sync>(
         .collect()
 }
 
+/// A copy of `x`, made on all threads.
+fn par_copy(x: &[f64]) -> Vec<f64> {
+    x.par_iter().with_min_len(4096).copied().collect()
+}
+
 /// Computes the vertex fields and totals of the iterate `u` (over the unknowns).
 pub fn derive_from(mesh: &Mesh, model: &Model, u_dofs: &[f64]) -> (NodalFields, Totals) {
     let nv = mesh.n_vertices();
@@ -176,20 +182,28 @@ pub fn derive_from(mesh: &Mesh, model: &Model, u_dofs: &[f64]) -> (NodalFields, 
     );
     let nodal_area = nodal_areas(mesh);
     let pressure_up = pressure(&model.h_vertices, &penetration, &contact_force, &nodal_area);
-    let count = |s: i8| states.iter().filter(|&&x| x == s).count();
-    // (An empty f64 sum is −0.)
-    let area_where = |pick: &dyn Fn(usize) -> bool| {
-        0.0 + (0..nv)
-            .filter(|&v| pick(v))
-            .map(|v| nodal_area[v])
+    let count = |s: i8| states.par_iter().filter(|&&x| x == s).count();
+    // Sums and extremes in fixed blocks, folded in block order (the same for any number of
+    // threads). (An empty f64 sum is −0.)
+    let area_where = |pick: &(dyn Fn(usize) -> bool + Sync)| {
+        let parts = map_blocks(nv, |r| r.filter(|&v| pick(v)).map(|v| nodal_area[v]).sum());
+        0.0 + parts.iter().sum::<f64>()
+    };
+    let fold = |x: &[f64], init: f64, f: fn(f64, f64) -> f64| {
+        let parts = map_blocks(x.len(), |r| x[r].iter().fold(init, |m, &v| f(m, v)));
+        parts.into_iter().fold(init, f)
+    };
+    let sum = |x: &[f64]| {
+        map_blocks(x.len(), |r| x[r].iter().sum())
+            .iter()
             .sum::<f64>()
     };
     let contact_area = area_where(&|v| state[v] >= 0);
-    let covered: Vec<bool> = model.h_vertices.iter().map(|&h| h > 0.0).collect();
+    let covered: Vec<bool> = model.h_vertices.par_iter().map(|&h| h > 0.0).collect();
     let liftoff_area = area_where(&|v| covered[v] && state[v] < 0 && !mesh_boundary(dofs, v));
-    let max_pressure = pressure_up.iter().cloned().fold(0.0f64, f64::max);
-    let max_u = u.iter().cloned().fold(f64::NEG_INFINITY, f64::max);
-    let min_u = u.iter().cloned().fold(f64::INFINITY, f64::min);
+    let max_pressure = fold(&pressure_up, 0.0, f64::max);
+    let max_u = fold(&u, f64::NEG_INFINITY, f64::max);
+    let min_u = fold(&u, f64::INFINITY, f64::min);
     let (lower, lower_totals) = match &model.lower {
         Some(low) => {
             let states_low = model.lower_states(u_dofs);
@@ -207,7 +221,7 @@ pub fn derive_from(mesh: &Mesh, model: &Model, u_dofs: &[f64]) -> (NodalFields, 
             );
             let force_low = dofs.to_vertices(&forces.low, 0.0);
             let pressure_low = pressure(&low.h_vertices, &penetration_low, &force_low, &nodal_area);
-            let covered_low: Vec<bool> = low.h_vertices.iter().map(|&h| h > 0.0).collect();
+            let covered_low: Vec<bool> = low.h_vertices.par_iter().map(|&h| h > 0.0).collect();
             let count_low = |s: i8| states_low.iter().filter(|&&x| x == s).count();
             let totals = LowerTotals {
                 can_touch_low_vertices: low.can_touch.iter().filter(|&&c| c).count(),
@@ -220,14 +234,14 @@ pub fn derive_from(mesh: &Mesh, model: &Model, u_dofs: &[f64]) -> (NodalFields, 
                     .filter(|(&a, &b)| a >= 0 && b >= 0)
                     .count(),
                 contact_area_low: area_where(&|v| state_low[v] >= 0),
-                total_contact_force_low: forces.low.iter().sum(),
-                max_pressure_low: pressure_low.iter().cloned().fold(0.0f64, f64::max),
+                total_contact_force_low: sum(&forces.low),
+                max_pressure_low: fold(&pressure_low, 0.0, f64::max),
                 liftoff_area_low: area_where(&|v| {
                     covered_low[v] && state_low[v] < 0 && !mesh_boundary(dofs, v)
                 }),
             };
             let fields = LowerFields {
-                phi: low.phi_vertices.clone(),
+                phi: par_copy(&low.phi_vertices),
                 penetration: penetration_low,
                 pressure: pressure_low,
                 contact_force: force_low,
@@ -247,7 +261,7 @@ pub fn derive_from(mesh: &Mesh, model: &Model, u_dofs: &[f64]) -> (NodalFields, 
         clear_vertices: count(-1),
         contact_area,
         total_load: model.total_load,
-        total_contact_force: forces.up.iter().sum(),
+        total_contact_force: sum(&forces.up),
         max_deflection: max_u.abs().max(min_u.abs()),
         min_u,
         max_u,
@@ -256,7 +270,7 @@ pub fn derive_from(mesh: &Mesh, model: &Model, u_dofs: &[f64]) -> (NodalFields, 
     (
         NodalFields {
             u,
-            phi: model.phi_vertices.clone(),
+            phi: par_copy(&model.phi_vertices),
             penetration,
             pressure: pressure_up,
             contact_force,

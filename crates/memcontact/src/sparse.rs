@@ -175,19 +175,10 @@ impl Csr {
     /// `xᵀ A x`, summed over fixed blocks of rows in block order (the same result for any
     /// number of threads).
     pub fn quad_form(&self, x: &[f64]) -> f64 {
-        const BLOCK: usize = 4096;
-        let block = |b: usize| -> f64 {
-            (b * BLOCK..((b + 1) * BLOCK).min(self.n()))
-                .map(|i| x[i] * self.row_dot(i, x))
-                .sum()
-        };
-        let blocks = self.n().div_ceil(BLOCK);
-        if self.n() >= PAR_ROWS {
-            let parts: Vec<f64> = (0..blocks).into_par_iter().map(block).collect();
-            parts.iter().sum()
-        } else {
-            (0..blocks).map(block).sum()
-        }
+        let parts = map_blocks(self.n(), |r| {
+            r.map(|i| x[i] * self.row_dot(i, x)).sum::<f64>()
+        });
+        parts.iter().sum()
     }
 
     /// `true` when every entry is finite.
@@ -278,14 +269,56 @@ impl Cholesky {
     }
 }
 
-/// Euclidean dot product.
+/// Indices per block of the fixed-block reductions ([`map_blocks`]).
+pub(crate) const REDUCE_BLOCK: usize = 4096;
+
+/// `f` on the ranges of [`REDUCE_BLOCK`] consecutive indices that cover `0..n` (in parallel
+/// for long ranges), the results in block order: a sum of them rounds the same for any
+/// number of threads.
+pub(crate) fn map_blocks<T: Send>(
+    n: usize,
+    f: impl Fn(std::ops::Range<usize>) -> T + Sync + Send,
+) -> Vec<T> {
+    let block = |b: usize| f(b * REDUCE_BLOCK..((b + 1) * REDUCE_BLOCK).min(n));
+    let blocks = n.div_ceil(REDUCE_BLOCK);
+    if n >= PAR_ROWS {
+        (0..blocks).into_par_iter().map(block).collect()
+    } else {
+        (0..blocks).map(block).collect()
+    }
+}
+
+/// Euclidean dot product, summed in fixed blocks ([`map_blocks`]: the same result for any
+/// number of threads).
 pub fn dot(a: &[f64], b: &[f64]) -> f64 {
-    a.iter().zip(b).map(|(x, y)| x * y).sum()
+    let parts = map_blocks(a.len().min(b.len()), |r| {
+        a[r.clone()]
+            .iter()
+            .zip(&b[r])
+            .map(|(x, y)| x * y)
+            .sum::<f64>()
+    });
+    parts.iter().sum()
 }
 
 /// Maximum norm.
 pub fn norm_inf(a: &[f64]) -> f64 {
-    a.iter().fold(0.0, |m, x| m.max(x.abs()))
+    let parts = map_blocks(a.len(), |r| {
+        a[r].iter().fold(0.0, |m: f64, x| m.max(x.abs()))
+    });
+    parts.into_iter().fold(0.0, f64::max)
+}
+
+/// The first index of `x` that holds a value that is not finite (on all threads for long
+/// vectors), for the data and result checks.
+pub fn first_non_finite(x: &[f64]) -> Option<usize> {
+    if x.len() >= PAR_ROWS {
+        x.par_iter()
+            .with_min_len(4096)
+            .position_first(|v| !v.is_finite())
+    } else {
+        x.iter().position(|v| !v.is_finite())
+    }
 }
 
 /// Groups the entries of items `0..m` by key, in compressed-row form: `entries(i)` gives
@@ -486,6 +519,49 @@ mod tests {
         assert!(b.is_finite());
         b.val[2 * PAR_ROWS] = f64::NAN;
         assert!(!b.is_finite());
+    }
+
+    #[test]
+    fn vector_reductions_ignore_the_thread_count() {
+        let n = 3 * PAR_ROWS + 17;
+        // Entries of mixed sizes, so that the order of the additions shows in the rounding.
+        let x: Vec<f64> = (0..n)
+            .map(|i| (i as f64 * 0.37).sin() * 1e3f64.powi(i as i32 % 5))
+            .collect();
+        let y: Vec<f64> = (0..n).map(|i| (i as f64 * 0.11).cos()).collect();
+        let run = |threads: usize| {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap();
+            pool.install(|| (dot(&x, &y), norm_inf(&x)))
+        };
+        let (d1, m1) = run(1);
+        assert_eq!((d1, m1), run(2));
+        assert_eq!((d1, m1), run(3));
+        // Against a sum in extended precision (pairs of f64: the Kahan–Babuška sum).
+        let (mut s, mut c) = (0.0f64, 0.0f64);
+        for (a, b) in x.iter().zip(&y) {
+            let p = a * b;
+            let t = s + p;
+            c += if s.abs() >= p.abs() {
+                (s - t) + p
+            } else {
+                (p - t) + s
+            };
+            s = t;
+        }
+        let exact = s + c;
+        let size: f64 = x.iter().zip(&y).map(|(a, b)| (a * b).abs()).sum();
+        assert!((d1 - exact).abs() <= 1e-14 * size, "{d1} against {exact}");
+        assert_eq!(m1, x.iter().fold(0.0f64, |m, v| m.max(v.abs())));
+        // The first non-finite entry, wherever it is.
+        let mut z = y.clone();
+        assert_eq!(first_non_finite(&z), None);
+        z[n - 3] = f64::INFINITY;
+        z[2 * PAR_ROWS + 5] = f64::NAN;
+        assert_eq!(first_non_finite(&z), Some(2 * PAR_ROWS + 5));
+        assert_eq!(first_non_finite(&z[..10]), None);
     }
 
     #[test]

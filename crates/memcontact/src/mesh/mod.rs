@@ -332,6 +332,32 @@ impl Mesh {
         self.triangles.len()
     }
 
+    /// The region tags of the triangles, sorted and without repetition (found on all
+    /// threads: fields are bound to them once per data item).
+    pub fn region_tags(&self) -> Vec<u32> {
+        use rayon::prelude::*;
+        let distinct = |c: &[u32]| {
+            let mut seen = std::collections::BTreeSet::new();
+            let mut last = None;
+            for &t in c {
+                if last != Some(t) {
+                    seen.insert(t);
+                    last = Some(t);
+                }
+            }
+            seen
+        };
+        let seen =
+            self.regions
+                .par_chunks(1 << 16)
+                .map(distinct)
+                .reduce(Default::default, |mut a, b| {
+                    a.extend(b);
+                    a
+                });
+        seen.into_iter().collect()
+    }
+
     /// The boundary edges ∂Ω_n: edges of exactly one triangle, as `(a, b)` in the
     /// triangle's (counter-clockwise) order, in triangle order. An edge `a → b` of a
     /// triangle is on the boundary when no other triangle around `a` contains `b`.
@@ -606,7 +632,12 @@ impl DofMap {
 
     /// A vector over all vertices restricted to the unknowns.
     pub fn to_unknowns(&self, x: &[f64]) -> Vec<f64> {
-        self.vertex.iter().map(|&v| x[v as usize]).collect()
+        use rayon::prelude::*;
+        self.vertex
+            .par_iter()
+            .with_min_len(4096)
+            .map(|&v| x[v as usize])
+            .collect()
     }
 }
 
@@ -684,6 +715,28 @@ mod tests {
                 assert_eq!(adj.of(v), &list[..], "vertex {v}, {threads} threads");
             }
         }
+    }
+
+    #[test]
+    fn region_tags_are_the_distinct_tags_sorted() {
+        let mut mesh = square();
+        assert_eq!(mesh.region_tags(), vec![0]);
+        // Many triangles with tags in runs and scattered, across several chunks.
+        let n: usize = 300_000;
+        mesh.regions = (0..n)
+            .map(|k| {
+                if k % 1000 < 900 {
+                    7
+                } else {
+                    (k * 7919 % 13) as u32 * 3
+                }
+            })
+            .collect();
+        let mut expected = mesh.regions.clone();
+        expected.sort_unstable();
+        expected.dedup();
+        assert_eq!(expected.len(), 14);
+        assert_eq!(mesh.region_tags(), expected);
     }
 
     #[test]

@@ -299,7 +299,7 @@ impl<'a> Multigrid<'a> {
         work.resize(n);
         let FcgWork { z, p, ap, az } = work;
         let r = b;
-        x.iter_mut().for_each(|v| *v = 0.0);
+        par_rows(x, |_, v| *v = 0.0);
         let mut pap_prev = 0.0;
         let mut steps = 0;
         // z with its held and non-finite entries taken as 0.
@@ -529,8 +529,8 @@ impl<'a> Multigrid<'a> {
         let [rc, v1, w1, _] = &mut self.krylov[k];
         v1.copy_from_slice(&self.x[k]);
         a.mul_into(v1, w1);
-        let rho1 = det_dot(v1, w1);
-        let alpha1 = det_dot(v1, rc);
+        let rho1 = crate::sparse::dot(v1, w1);
+        let alpha1 = crate::sparse::dot(v1, rc);
         if !(rho1 > 0.0 && rho1.is_finite()) {
             self.x[k].iter_mut().for_each(|v| *v = 0.0);
             return;
@@ -540,8 +540,8 @@ impl<'a> Multigrid<'a> {
         for ((bk, r), w) in self.b[k].iter_mut().zip(rc.iter()).zip(w1.iter()) {
             *bk = r - c1 * w;
         }
-        let norm_rc = det_dot(rc, rc).sqrt();
-        let norm_rt = det_dot(&self.b[k], &self.b[k]).sqrt();
+        let norm_rc = crate::sparse::dot(rc, rc).sqrt();
+        let norm_rt = crate::sparse::dot(&self.b[k], &self.b[k]).sqrt();
         if norm_rt <= ONE_STEP * norm_rc {
             for (x, v) in self.x[k].iter_mut().zip(v1.iter()) {
                 *x = c1 * v;
@@ -554,9 +554,9 @@ impl<'a> Multigrid<'a> {
         v2.copy_from_slice(&self.x[k]);
         let w2 = &mut self.r[k];
         a.mul_into(v2, w2);
-        let gamma = det_dot(v2, w1);
-        let beta = det_dot(v2, w2);
-        let alpha2 = det_dot(v2, &self.b[k]);
+        let gamma = crate::sparse::dot(v2, w1);
+        let beta = crate::sparse::dot(v2, w2);
+        let alpha2 = crate::sparse::dot(v2, &self.b[k]);
         let rho2 = beta - gamma * gamma / rho1;
         let (ca, cb) = if rho2 > 0.0 && rho2.is_finite() {
             (c1 - gamma * alpha2 / (rho1 * rho2), alpha2 / rho2)
@@ -777,26 +777,7 @@ impl FcgWork {
 }
 
 /// Rows per block of the reductions of the Krylov methods.
-const DOT_BLOCK: usize = 4096;
-
-/// `aᵀb`, summed in fixed blocks (the same result for any number of threads).
-fn det_dot(a: &[f64], b: &[f64]) -> f64 {
-    use rayon::prelude::*;
-    let block = |(x, y): (&[f64], &[f64])| -> f64 { x.iter().zip(y).map(|(p, q)| p * q).sum() };
-    if a.len() >= super::transfer::PAR_ROWS {
-        let parts: Vec<f64> = a
-            .par_chunks(DOT_BLOCK)
-            .zip(b.par_chunks(DOT_BLOCK))
-            .map(block)
-            .collect();
-        parts.iter().sum()
-    } else {
-        a.chunks(DOT_BLOCK)
-            .zip(b.chunks(DOT_BLOCK))
-            .map(block)
-            .sum()
-    }
-}
+const DOT_BLOCK: usize = crate::sparse::REDUCE_BLOCK;
 
 /// `f(first row, a's block, b's block)` on the blocks of [`DOT_BLOCK`] rows of `a` and
 /// `b` (in parallel for long vectors), the results in block order: one pass of several

@@ -49,6 +49,7 @@ use crate::model::{Certificate, FoundationMatrix, Model};
 use crate::sparse::Csr;
 use crate::Result;
 use std::time::Instant;
+use transfer::par_rows;
 
 /// Default iteration limit on each level.
 pub(crate) const MAX_ITERATIONS: usize = 300;
@@ -498,10 +499,8 @@ fn level_solve(ls: LevelSolve) -> Result<(usize, f64, Option<Certificate>)> {
             with_operator!(a, model, st, |op| mg.update(op, rows))
         })?;
         timer.time("v-cycle", || {
-            for x in g.iter_mut() {
-                *x = -*x;
-            }
-            delta.iter_mut().for_each(|d| *d = 0.0);
+            par_rows(&mut g, |_, x| *x = -*x);
+            par_rows(&mut delta, |_, d| *d = 0.0);
             if options.krylov_steps > 0 {
                 // Inexact Newton: the linear residual is driven below a forcing term, the
                 // square of the current scaled KKT residual (a quarter of the tolerance at
@@ -529,10 +528,11 @@ fn level_solve(ls: LevelSolve) -> Result<(usize, f64, Option<Certificate>)> {
                 }
             }
             let extended = model.is_extended();
-            for (i, d) in delta.iter_mut().enumerate() {
-                if st.truncated[i] || !d.is_finite() {
+            let (v, truncated): (&[f64], &[bool]) = (v, &st.truncated);
+            par_rows(&mut delta, |i, d| {
+                if truncated[i] || !d.is_finite() {
                     *d = 0.0;
-                    continue;
+                    return;
                 }
                 // Project onto the defect obstacles of the rigid bodies: V + δ ≤ φ (and
                 // V + δ ≥ φ_low).
@@ -540,7 +540,7 @@ fn level_solve(ls: LevelSolve) -> Result<(usize, f64, Option<Certificate>)> {
                     if model.is_rigid() && model.can_touch[i] {
                         *d = d.min(model.phi[i] - v[i]);
                     }
-                    continue;
+                    return;
                 }
                 if model.can_touch[i] && model.rigid_at(i) {
                     *d = d.min(model.phi[i] - v[i]);
@@ -550,7 +550,7 @@ fn level_solve(ls: LevelSolve) -> Result<(usize, f64, Option<Certificate>)> {
                         *d = d.max(low.phi[i] - v[i]);
                     }
                 }
-            }
+            });
         });
         timer.time("line search", || {
             let (g0, s2) = line_data(model, &delta, &r);
