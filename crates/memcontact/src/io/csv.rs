@@ -15,7 +15,6 @@
 use super::vtu::DataArray;
 use crate::{Error, Result};
 use rayon::prelude::*;
-use std::io::Write;
 use std::path::Path;
 
 /// Writes `columns` side by side: a header row with the names, then row `i` holding value
@@ -180,8 +179,24 @@ pub(crate) fn push_shortest(buf: &mut Vec<u8>, x: f64) {
     }
 }
 
-fn push_int(buf: &mut Vec<u8>, x: i64) {
-    let _ = write!(buf, "{x}");
+/// Appends the decimal digits of `x`, as `{x}` writes them, without the formatting
+/// machinery (state and region columns are a million integers and more).
+pub(crate) fn push_int(buf: &mut Vec<u8>, x: i64) {
+    if x < 0 {
+        buf.push(b'-');
+    }
+    let mut n = x.unsigned_abs();
+    let mut digits = [0u8; 20];
+    let mut k = digits.len();
+    loop {
+        k -= 1;
+        digits[k] = b'0' + (n % 10) as u8;
+        n /= 10;
+        if n == 0 {
+            break;
+        }
+    }
+    buf.extend_from_slice(&digits[k..]);
 }
 
 #[cfg(test)]
@@ -203,6 +218,18 @@ pub(crate) mod tests {
 
     fn same(x: f64, y: f64) -> bool {
         x.to_bits() == y.to_bits() || (x.is_nan() && y.is_nan())
+    }
+
+    #[test]
+    fn integers_are_written_as_rust_formats_them() {
+        let mut xs: Vec<i64> = (-1000..1000).collect();
+        xs.extend([i64::MIN, i64::MIN + 1, i64::MAX, 10, 99, 100, -10, 1 << 40]);
+        xs.extend((0..19).map(|k| 10i64.pow(k)));
+        for x in xs {
+            let mut buf = b"a".to_vec();
+            push_int(&mut buf, x);
+            assert_eq!(buf, format!("a{x}").into_bytes(), "{x}");
+        }
     }
 
     #[test]

@@ -17,6 +17,7 @@
 //!
 //! The file is written atomically ([`crate::io::write_atomic`]).
 
+use crate::io::csv::push_int;
 use crate::io::Written;
 use crate::mesh::Mesh;
 use crate::{Error, Result};
@@ -301,11 +302,6 @@ fn push_f64(buf: &mut Vec<u8>, x: f64) {
     } else {
         buf.extend_from_slice(b"-inf");
     }
-}
-
-fn push_int(buf: &mut Vec<u8>, x: i64) {
-    // Integer formatting is cheap next to floats; no need for a dedicated crate.
-    let _ = write!(buf, "{x}");
 }
 
 fn push_sep(buf: &mut Vec<u8>, i: usize, per_line: usize) {
