@@ -371,8 +371,7 @@ pub fn integrate(mesh: &Mesh, areas: &[f64], c: &dyn Coefficient) -> f64 {
             .sum::<f64>(),
     };
     // Summed in fixed blocks: the same for any number of threads.
-    let parts = crate::sparse::map_blocks(mesh.n_triangles(), |r| r.map(element).sum::<f64>());
-    parts.iter().sum()
+    crate::sparse::sum_blocks(mesh.n_triangles(), |r| r.map(element).sum::<f64>())
 }
 
 /// The one value of `c` on all the region tags `tags`, when it has one (assembly then
@@ -458,8 +457,7 @@ impl<'a> Loads<'a> {
         match self.uniform(c) {
             Some(v) => {
                 let a = self.areas;
-                let parts = crate::sparse::map_blocks(a.len(), |r| a[r].iter().sum::<f64>());
-                v * parts.iter().sum::<f64>()
+                v * crate::sparse::sum_blocks(a.len(), |r| a[r].iter().sum::<f64>())
             }
             None => integrate(self.mesh, self.areas, c),
         }

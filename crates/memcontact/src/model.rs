@@ -649,14 +649,13 @@ fn foundation_energy(l: &FoundationMatrix, p: &[f64]) -> f64 {
     match l {
         FoundationMatrix::Consistent(l) => 0.5 * l.quad_form(p),
         FoundationMatrix::Lumped(d) => {
-            let parts = crate::sparse::map_blocks(p.len(), |r| {
+            0.5 * crate::sparse::sum_blocks(p.len(), |r| {
                 p[r.clone()]
                     .iter()
                     .zip(&d[r])
                     .map(|(p, d)| d * p * p)
                     .sum::<f64>()
-            });
-            0.5 * parts.iter().sum::<f64>()
+            })
         }
         FoundationMatrix::Rigid => 0.0,
     }

@@ -237,7 +237,12 @@ pub fn write_files(
         outcome.discretization.model.is_rigid(),
     )?;
     let run_id = options.run_id.clone().unwrap_or_else(new_run_id);
-    let written = write_fields(dir, outcome, &fields, options.vtu, &run_id)?;
+    // The input's hash reads the mesh file again: alongside the writing, not after it.
+    let (written, hash) = rayon::join(
+        || write_fields(dir, outcome, &fields, options.vtu, &run_id),
+        || input_hash(case),
+    );
+    let written = written?;
     let names = extra(dir, &fields)?;
     let mut summary = Summary::new(
         &options.label,
@@ -246,7 +251,7 @@ pub fn write_files(
         &totals,
     );
     summary.run_id = run_id;
-    summary.input_hash = input_hash(case);
+    summary.input_hash = hash;
     summary.plot_options = options.plot_options.clone();
     // The fields' files were hashed as they were written; the extra files (pictures) are
     // read back, side by side.

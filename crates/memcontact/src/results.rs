@@ -5,7 +5,7 @@
 use crate::mesh::Mesh;
 use crate::model::Model;
 use crate::solve::Solution;
-use crate::sparse::map_blocks;
+use crate::sparse::{map_blocks, sum_blocks};
 use rayon::prelude::*;
 
 /// Fields over all mesh vertices (u = g on the fixed boundary, 0 by default).
@@ -186,18 +186,13 @@ pub fn derive_from(mesh: &Mesh, model: &Model, u_dofs: &[f64]) -> (NodalFields, 
     // Sums and extremes in fixed blocks, folded in block order (the same for any number of
     // threads). (An empty f64 sum is −0.)
     let area_where = |pick: &(dyn Fn(usize) -> bool + Sync)| {
-        let parts = map_blocks(nv, |r| r.filter(|&v| pick(v)).map(|v| nodal_area[v]).sum());
-        0.0 + parts.iter().sum::<f64>()
+        0.0 + sum_blocks(nv, |r| r.filter(|&v| pick(v)).map(|v| nodal_area[v]).sum())
     };
     let fold = |x: &[f64], init: f64, f: fn(f64, f64) -> f64| {
         let parts = map_blocks(x.len(), |r| x[r].iter().fold(init, |m, &v| f(m, v)));
         parts.into_iter().fold(init, f)
     };
-    let sum = |x: &[f64]| {
-        map_blocks(x.len(), |r| x[r].iter().sum())
-            .iter()
-            .sum::<f64>()
-    };
+    let sum = |x: &[f64]| sum_blocks(x.len(), |r| x[r].iter().sum());
     let contact_area = area_where(&|v| state[v] >= 0);
     let covered: Vec<bool> = model.h_vertices.par_iter().map(|&h| h > 0.0).collect();
     let liftoff_area = area_where(&|v| covered[v] && state[v] < 0 && !mesh_boundary(dofs, v));

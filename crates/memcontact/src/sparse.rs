@@ -175,10 +175,9 @@ impl Csr {
     /// `xᵀ A x`, summed over fixed blocks of rows in block order (the same result for any
     /// number of threads).
     pub fn quad_form(&self, x: &[f64]) -> f64 {
-        let parts = map_blocks(self.n(), |r| {
+        sum_blocks(self.n(), |r| {
             r.map(|i| x[i] * self.row_dot(i, x)).sum::<f64>()
-        });
-        parts.iter().sum()
+        })
     }
 
     /// `true` when every entry is finite.
@@ -288,17 +287,29 @@ pub(crate) fn map_blocks<T: Send>(
     }
 }
 
-/// Euclidean dot product, summed in fixed blocks ([`map_blocks`]: the same result for any
+/// The sum of `f` over the blocks of [`map_blocks`], added in block order (the same for
+/// any number of threads; short ranges are summed on the calling thread, without
+/// allocating).
+pub(crate) fn sum_blocks(n: usize, f: impl Fn(std::ops::Range<usize>) -> f64 + Sync + Send) -> f64 {
+    if n >= PAR_ROWS {
+        map_blocks(n, f).iter().sum()
+    } else {
+        (0..n.div_ceil(REDUCE_BLOCK))
+            .map(|b| f(b * REDUCE_BLOCK..((b + 1) * REDUCE_BLOCK).min(n)))
+            .sum()
+    }
+}
+
+/// Euclidean dot product, summed in fixed blocks ([`sum_blocks`]: the same result for any
 /// number of threads).
 pub fn dot(a: &[f64], b: &[f64]) -> f64 {
-    let parts = map_blocks(a.len().min(b.len()), |r| {
+    sum_blocks(a.len().min(b.len()), |r| {
         a[r.clone()]
             .iter()
             .zip(&b[r])
             .map(|(x, y)| x * y)
             .sum::<f64>()
-    });
-    parts.iter().sum()
+    })
 }
 
 /// Maximum norm.

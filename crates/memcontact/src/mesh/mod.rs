@@ -260,31 +260,16 @@ impl Mesh {
     fn check_edges(&self) -> Result<()> {
         use rayon::prelude::*;
         let n = self.points.len();
-        let mut ptr = vec![0u32; n + 1];
-        for t in &self.triangles {
-            for &a in t {
-                ptr[a as usize + 1] += 1;
-            }
-        }
-        for i in 0..n {
-            ptr[i + 1] += ptr[i];
-        }
-        // Out-edges a → b of every vertex a, with their triangle: (b, k).
-        let mut fill = ptr.clone();
-        let mut out = vec![(0u32, 0u32); 3 * self.triangles.len()];
-        for (k, t) in self.triangles.iter().enumerate() {
-            for e in 0..3 {
-                let a = t[e] as usize;
-                out[fill[a] as usize] = (t[(e + 1) % 3], k as u32);
-                fill[a] += 1;
-            }
-        }
-        drop(fill);
+        // Out-edges a → b of every vertex a, with their triangle: (b, k), in triangle order.
+        let (ptr, out) = crate::sparse::group_by_key(n, self.triangles.len(), |k| {
+            let t = self.triangles[k];
+            [0, 1, 2].map(|e| Some((t[e], (t[(e + 1) % 3], k as u32))))
+        });
         let repeated = (0..n)
             .into_par_iter()
             .with_min_len(4096)
             .filter_map(|a| {
-                let list = &out[ptr[a] as usize..ptr[a + 1] as usize];
+                let list = &out[ptr[a]..ptr[a + 1]];
                 let mut best: Option<(u32, u32, u32, u32)> = None;
                 for (i, &(b, k)) in list.iter().enumerate() {
                     if let Some(&(_, k2)) = list[i + 1..].iter().find(|e| e.0 == b) {
@@ -303,7 +288,7 @@ impl Mesh {
         let users: Vec<u32> = [(a, b), (b, a)]
             .iter()
             .flat_map(|&(p, q)| {
-                out[ptr[p as usize] as usize..ptr[p as usize + 1] as usize]
+                out[ptr[p as usize]..ptr[p as usize + 1]]
                     .iter()
                     .filter(move |e| e.0 == q)
                     .map(|e| e.1)

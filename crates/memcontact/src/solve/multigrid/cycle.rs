@@ -523,35 +523,36 @@ impl<'a> Multigrid<'a> {
         }
         /// Accept one step when it reduces the residual's norm by this factor.
         const ONE_STEP: f64 = 0.25;
-        self.krylov[k][0].copy_from_slice(&self.b[k]);
+        let bk: &[f64] = &self.b[k];
+        par_rows(&mut self.krylov[k][0], |i, r| *r = bk[i]);
         self.coarse_k_cycle(k);
         let a = &self.coarse[k];
         let [rc, v1, w1, _] = &mut self.krylov[k];
-        v1.copy_from_slice(&self.x[k]);
+        let xk: &[f64] = &self.x[k];
+        par_rows(v1, |i, v| *v = xk[i]);
         a.mul_into(v1, w1);
         let rho1 = crate::sparse::dot(v1, w1);
         let alpha1 = crate::sparse::dot(v1, rc);
         if !(rho1 > 0.0 && rho1.is_finite()) {
-            self.x[k].iter_mut().for_each(|v| *v = 0.0);
+            par_rows(&mut self.x[k], |_, v| *v = 0.0);
             return;
         }
         // r̃ = rc − (α₁/ρ₁) w₁, into b[k] (the right-hand side of the second cycle).
         let c1 = alpha1 / rho1;
-        for ((bk, r), w) in self.b[k].iter_mut().zip(rc.iter()).zip(w1.iter()) {
-            *bk = r - c1 * w;
-        }
+        let (rc, w1): (&[f64], &[f64]) = (rc, w1);
+        par_rows(&mut self.b[k], |i, b| *b = rc[i] - c1 * w1[i]);
         let norm_rc = crate::sparse::dot(rc, rc).sqrt();
         let norm_rt = crate::sparse::dot(&self.b[k], &self.b[k]).sqrt();
         if norm_rt <= ONE_STEP * norm_rc {
-            for (x, v) in self.x[k].iter_mut().zip(v1.iter()) {
-                *x = c1 * v;
-            }
+            let v1: &[f64] = v1;
+            par_rows(&mut self.x[k], |i, x| *x = c1 * v1[i]);
             return;
         }
         self.coarse_k_cycle(k);
         let a = &self.coarse[k];
         let [_, v1, w1, v2] = &mut self.krylov[k];
-        v2.copy_from_slice(&self.x[k]);
+        let xk: &[f64] = &self.x[k];
+        par_rows(v2, |i, v| *v = xk[i]);
         let w2 = &mut self.r[k];
         a.mul_into(v2, w2);
         let gamma = crate::sparse::dot(v2, w1);
@@ -563,9 +564,8 @@ impl<'a> Multigrid<'a> {
         } else {
             (c1, 0.0)
         };
-        for ((x, p), q) in self.x[k].iter_mut().zip(v1.iter()).zip(v2.iter()) {
-            *x = ca * p + cb * q;
-        }
+        let (v1, v2): (&[f64], &[f64]) = (v1, v2);
+        par_rows(&mut self.x[k], |i, x| *x = ca * v1[i] + cb * v2[i]);
     }
 
     /// On coarse level `k ≥ 1`: `x[k] = 0`, `ν₁` Gauss-Seidel sweeps on `A_k x[k] = b[k]`,
