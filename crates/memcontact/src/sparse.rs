@@ -7,6 +7,8 @@ use std::sync::Arc;
 
 /// Below this many rows, matrix-vector products run serially (threads cost more).
 const PAR_ROWS: usize = 20_000;
+/// Stored entries from which a product runs in parallel whatever the number of rows.
+const PAR_ENTRIES: usize = 1 << 16;
 
 /// A sparsity pattern: sorted column indices per row. Shared by S, L and the Newton
 /// matrices, so that it is built once (assemble once, keep the pattern).
@@ -153,7 +155,9 @@ impl Csr {
     /// `y = A x` (parallel for large matrices; the result does not depend on the thread
     /// count because every row is summed in the same order).
     pub fn mul_into(&self, x: &[f64], y: &mut [f64]) {
-        if self.n() >= PAR_ROWS {
+        // Split by work: the coarse levels of an algebraic hierarchy have few rows but
+        // long ones.
+        if self.n() >= PAR_ROWS || self.val.len() >= PAR_ENTRIES {
             y.par_iter_mut()
                 .enumerate()
                 .with_min_len(4096)
