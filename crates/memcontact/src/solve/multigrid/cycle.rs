@@ -858,6 +858,18 @@ fn shift_term<A: TopOperator>(op: &A, i: usize, xi: f64) -> f64 {
 /// size alone, so the result does not depend on the number of threads.
 pub(crate) const GS_BLOCK: usize = 32_768;
 
+/// The smoothing blocks' size for a level of `n` rows: [`GS_BLOCK`], or a quarter of it up
+/// to four blocks of [`GS_BLOCK`], so that the smaller levels (visited most often by the
+/// K-cycle) are smoothed on all threads too. A function of `n` alone.
+#[inline]
+pub(crate) fn gs_block(n: usize) -> usize {
+    if n > 4 * GS_BLOCK {
+        GS_BLOCK
+    } else {
+        GS_BLOCK / 4
+    }
+}
+
 /// `Σ_k vals[k] x(cols[k])` with two partial sums (a shorter dependency chain).
 #[inline(always)]
 fn row_sum(cols: &[u32], vals: &[f64], x: impl Fn(usize) -> f64) -> f64 {
@@ -875,8 +887,8 @@ fn row_sum(cols: &[u32], vals: &[f64], x: impl Fn(usize) -> f64) -> f64 {
 }
 
 /// One Gauss-Seidel sweep for `A x = b` (rows with `inv_diag = 0` skipped), forward or
-/// backward. Up to [`GS_BLOCK`] unknowns it is the classical sweep; beyond, the rows are cut
-/// into blocks of [`GS_BLOCK`] that are swept in parallel, each by Gauss-Seidel inside the
+/// backward. Up to one block ([`gs_block`]) of unknowns it is the classical sweep; beyond, the rows are cut
+/// into such blocks that are swept in parallel, each by Gauss-Seidel inside the
 /// block and with the values of the other blocks from before the sweep (hybrid
 /// Gauss-Seidel, kept in `snapshot`). `x` is zero on held unknowns, and stays so.
 pub(crate) fn gauss_seidel<A: TopOperator>(
@@ -914,33 +926,35 @@ pub(crate) fn gauss_seidel<A: TopOperator>(
             (lo..hi).for_each(&mut relax);
         }
     };
-    if n <= GS_BLOCK {
+    let block = gs_block(n);
+    if n <= block {
         sweep(0, x, &[]);
         return;
     }
     snapshot.copy_from_slice(x);
     let outside: &[f64] = snapshot;
-    x.par_chunks_mut(GS_BLOCK)
+    x.par_chunks_mut(block)
         .enumerate()
-        .for_each(|(k, xs)| sweep(k * GS_BLOCK, xs, outside));
+        .for_each(|(k, xs)| sweep(k * block, xs, outside));
 }
 
-/// The rows of `pattern` that couple to another block of [`GS_BLOCK`] rows (none up to
-/// one block): the rows whose residual [`gauss_seidel_from_zero`] completes at the end.
+/// The rows of `pattern` that couple to another smoothing block ([`gs_block`] rows; none
+/// up to one block): the rows whose residual [`gauss_seidel_from_zero`] completes at the end.
 pub(crate) fn seam_rows(pattern: &Pattern) -> Vec<u32> {
     use rayon::prelude::*;
     let n = pattern.n();
-    if n <= GS_BLOCK {
+    let block = gs_block(n);
+    if n <= block {
         return Vec::new();
     }
     (0..n)
         .into_par_iter()
         .with_min_len(4096)
         .filter(|&i| {
-            let block = i / GS_BLOCK;
+            let own = i / block;
             pattern.col[pattern.row_ptr[i]..pattern.row_ptr[i + 1]]
                 .iter()
-                .any(|&j| j as usize / GS_BLOCK != block)
+                .any(|&j| j as usize / block != own)
         })
         .map(|i| i as u32)
         .collect()
@@ -1002,23 +1016,24 @@ pub(crate) fn gauss_seidel_from_zero<A: TopOperator>(
             });
         }
     };
-    if n <= GS_BLOCK {
+    let block = gs_block(n);
+    if n <= block {
         sweep(0, x, r);
         restore_held(r);
         return;
     }
-    x.par_chunks_mut(GS_BLOCK)
-        .zip(r.par_chunks_mut(GS_BLOCK))
+    x.par_chunks_mut(block)
+        .zip(r.par_chunks_mut(block))
         .enumerate()
-        .for_each(|(k, (xs, rs))| sweep(k * GS_BLOCK, xs, rs));
+        .for_each(|(k, (xs, rs))| sweep(k * block, xs, rs));
     // The other blocks' unknowns, now known, on the rows that see them.
     let x: &[f64] = x;
     add_outside_blocks(a, seams, r, -1.0, |j| x[j]);
     restore_held(r);
 }
 
-/// `out_i += sign · Σ_j a_ij value(j)` over the columns j outside row i's block of
-/// [`GS_BLOCK`] rows, for the rows of `seams` ([`seam_rows`] of A's pattern): the hybrid
+/// `out_i += sign · Σ_j a_ij value(j)` over the columns j outside row i's smoothing block
+/// ([`gs_block`] rows), for the rows of `seams` ([`seam_rows`] of A's pattern): the hybrid
 /// sweeps' contribution of the other blocks, added once they are done.
 fn add_outside_blocks(
     a: &Csr,
@@ -1029,25 +1044,24 @@ fn add_outside_blocks(
 ) {
     use rayon::prelude::*;
     let pat = &a.pattern;
-    out.par_chunks_mut(GS_BLOCK)
-        .enumerate()
-        .for_each(|(k, os)| {
-            let lo = k * GS_BLOCK;
-            let hi = lo + os.len();
-            let from = seams.partition_point(|&i| (i as usize) < lo);
-            let to = seams.partition_point(|&i| (i as usize) < hi);
-            for &i in &seams[from..to] {
-                let i = i as usize;
-                let (s, e) = (pat.row_ptr[i], pat.row_ptr[i + 1]);
-                let outside: f64 = pat.col[s..e]
-                    .iter()
-                    .zip(&a.val[s..e])
-                    .filter(|(&j, _)| (j as usize) < lo || (j as usize) >= hi)
-                    .map(|(&j, &v)| v * value(j as usize))
-                    .sum();
-                os[i - lo] += sign * outside;
-            }
-        });
+    let block = gs_block(out.len());
+    out.par_chunks_mut(block).enumerate().for_each(|(k, os)| {
+        let lo = k * block;
+        let hi = lo + os.len();
+        let from = seams.partition_point(|&i| (i as usize) < lo);
+        let to = seams.partition_point(|&i| (i as usize) < hi);
+        for &i in &seams[from..to] {
+            let i = i as usize;
+            let (s, e) = (pat.row_ptr[i], pat.row_ptr[i + 1]);
+            let outside: f64 = pat.col[s..e]
+                .iter()
+                .zip(&a.val[s..e])
+                .filter(|(&j, _)| (j as usize) < lo || (j as usize) >= hi)
+                .map(|(&j, &v)| v * value(j as usize))
+                .sum();
+            os[i - lo] += sign * outside;
+        }
+    });
 }
 
 /// One backward sweep of [`gauss_seidel`], with the product `y = A x` after it, in one
@@ -1115,17 +1129,18 @@ pub(crate) fn gauss_seidel_back_with_product<A: TopOperator>(
             });
         }
     };
-    if n <= GS_BLOCK {
+    let block = gs_block(n);
+    if n <= block {
         sweep(0, x, y, &[]);
         clear_held(y);
         return;
     }
     snapshot.copy_from_slice(x);
     let before: &[f64] = snapshot;
-    x.par_chunks_mut(GS_BLOCK)
-        .zip(y.par_chunks_mut(GS_BLOCK))
+    x.par_chunks_mut(block)
+        .zip(y.par_chunks_mut(block))
         .enumerate()
-        .for_each(|(k, (xs, ys))| sweep(k * GS_BLOCK, xs, ys, before));
+        .for_each(|(k, (xs, ys))| sweep(k * block, xs, ys, before));
     // The other blocks' changes, now known, on the rows that see them.
     let x: &[f64] = x;
     add_outside_blocks(a, seams, y, 1.0, |j| x[j] - before[j]);

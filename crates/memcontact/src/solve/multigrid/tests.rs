@@ -376,7 +376,7 @@ fn fused_sweep_from_zero_is_the_sweep_and_its_residual() {
         let mut r_ref = vec![0.0; n];
         cycle::residual(&a, &x_ref, &b, &mut r_ref);
         let seams = cycle::seam_rows(&a.pattern);
-        assert_eq!(seams.is_empty(), n <= cycle::GS_BLOCK);
+        assert_eq!(seams.is_empty(), n <= cycle::gs_block(n));
         let fused = |threads: usize| {
             let pool = rayon::ThreadPoolBuilder::new()
                 .num_threads(threads)
