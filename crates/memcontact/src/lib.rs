@@ -38,3 +38,14 @@ pub use problem::{Case, Problem};
 pub use run::{run, Discretization, Outcome, Report};
 pub use solve::{Method, Observer, Settings, Status};
 pub use summary::Summary;
+
+/// Runs `f` on a pool of `threads` worker threads (tests that check a result does not
+/// depend on the number of threads).
+#[cfg(test)]
+pub(crate) fn on_threads<R: Send>(threads: usize, f: impl FnOnce() -> R + Send) -> R {
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .expect("a thread pool")
+        .install(f)
+}

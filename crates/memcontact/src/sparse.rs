@@ -489,11 +489,7 @@ mod tests {
             }
         }
         for threads in [1, 2, 3] {
-            let pool = rayon::ThreadPoolBuilder::new()
-                .num_threads(threads)
-                .build()
-                .unwrap();
-            let (ptr, values) = pool.install(|| group_by_key(n_keys, m, entries));
+            let (ptr, values) = crate::on_threads(threads, || group_by_key(n_keys, m, entries));
             assert_eq!(ptr.len(), n_keys + 1);
             for (k, list) in lists.iter().enumerate() {
                 assert_eq!(
@@ -512,11 +508,9 @@ mod tests {
         let a = lap1d(n);
         let x: Vec<f64> = (0..n).map(|i| (i as f64 * 0.37).sin()).collect();
         let run = |threads: usize| {
-            let pool = rayon::ThreadPoolBuilder::new()
-                .num_threads(threads)
-                .build()
-                .unwrap();
-            pool.install(|| (a.quad_form(&x), a.diag(), a.pattern.diagonal_positions()))
+            crate::on_threads(threads, || {
+                (a.quad_form(&x), a.diag(), a.pattern.diagonal_positions())
+            })
         };
         let (q1, d1, p1) = run(1);
         assert_eq!((q1, d1.clone(), p1.clone()), run(3));
@@ -544,13 +538,7 @@ mod tests {
             .map(|i| (i as f64 * 0.37).sin() * 1e3f64.powi(i as i32 % 5))
             .collect();
         let y: Vec<f64> = (0..n).map(|i| (i as f64 * 0.11).cos()).collect();
-        let run = |threads: usize| {
-            let pool = rayon::ThreadPoolBuilder::new()
-                .num_threads(threads)
-                .build()
-                .unwrap();
-            pool.install(|| (dot(&x, &y), norm_inf(&x)))
-        };
+        let run = |threads: usize| crate::on_threads(threads, || (dot(&x, &y), norm_inf(&x)));
         let (d1, m1) = run(1);
         assert_eq!((d1, m1), run(2));
         assert_eq!((d1, m1), run(3));

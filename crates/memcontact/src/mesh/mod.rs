@@ -691,11 +691,7 @@ mod tests {
             }
         }
         for threads in [1, 2, 3] {
-            let pool = rayon::ThreadPoolBuilder::new()
-                .num_threads(threads)
-                .build()
-                .unwrap();
-            let adj = pool.install(|| VertexTriangles::new(&mesh));
+            let adj = crate::on_threads(threads, || VertexTriangles::new(&mesh));
             for (v, list) in lists.iter().enumerate() {
                 assert_eq!(adj.of(v), &list[..], "vertex {v}, {threads} threads");
             }

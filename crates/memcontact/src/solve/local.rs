@@ -458,12 +458,8 @@ mod tests {
                 assert!(e < energy, "J rose from {energy} to {e}");
                 energy = e;
             }
-            let one = rayon::ThreadPoolBuilder::new()
-                .num_threads(1)
-                .build()
-                .unwrap();
             let mut serial = start.clone();
-            one.install(|| {
+            crate::on_threads(1, || {
                 for _ in 0..3 {
                     sweep_forward(model, &mut serial);
                 }

@@ -310,11 +310,7 @@ mod tests {
         let a = lap2d(400);
         assert!(a.n() >= 2 * MATCH_BLOCK);
         let many = pairwise(&a);
-        let one = rayon::ThreadPoolBuilder::new()
-            .num_threads(1)
-            .build()
-            .unwrap()
-            .install(|| pairwise(&a));
+        let one = crate::on_threads(1, || pairwise(&a));
         assert_eq!(many, one);
     }
 

@@ -419,10 +419,8 @@ impl<'a> Multigrid<'a> {
             return false;
         }
         self.presmooth_top(fine, x, b, true);
-        match self.levels.kind {
-            Kind::Geometric => self.v_cycle_below(fine, x, b, product),
-            Kind::Algebraic => self.k_cycle_below(fine, x, b, product),
-        }
+        let krylov = self.levels.kind == Kind::Algebraic;
+        self.cycle_below(fine, x, b, product, krylov)
     }
 
     /// Whether `fine`'s pattern is the top level's own, so that the fused kernels may use
@@ -472,21 +470,7 @@ impl<'a> Multigrid<'a> {
             return self.v_cycle(fine, x, b);
         }
         self.presmooth_top(fine, x, b, false);
-        self.k_cycle_below(fine, x, b, None);
-    }
-
-    /// The K-cycle after the top level's pre-smoothing (its residual is in `r[top]`).
-    fn k_cycle_below<A: TopOperator>(
-        &mut self,
-        fine: &A,
-        x: &mut [f64],
-        b: &[f64],
-        product: Option<&mut [f64]>,
-    ) -> bool {
-        let top = self.top;
-        self.levels.transfers[top - 1].restrict(&self.r[top], &mut self.b[top - 1]);
-        self.krylov_correction(top - 1);
-        self.prolongate_and_postsmooth_top(fine, x, b, product)
+        self.cycle_below(fine, x, b, None, true);
     }
 
     /// On the top level: the correction of the level below prolongated into `x` (zero on
@@ -705,28 +689,35 @@ impl<'a> Multigrid<'a> {
         }
         // Down: smooth, restrict the residual.
         self.presmooth_top(fine, x, b, false);
-        self.v_cycle_below(fine, x, b, None);
+        self.cycle_below(fine, x, b, None, false);
     }
 
-    /// The V-cycle after the top level's pre-smoothing (its residual is in `r[top]`); with
-    /// a `product`, see [`Multigrid::prolongate_and_postsmooth_top`].
-    fn v_cycle_below<A: TopOperator>(
+    /// The cycle after the top level's pre-smoothing (its residual is in `r[top]`): the
+    /// residual restricted, the correction of the levels below (the K-cycle's Krylov
+    /// correction when `krylov`, else the V-cycle's descent and ascent), the top level's
+    /// post-smoothing; with a `product`, see [`Multigrid::prolongate_and_postsmooth_top`].
+    fn cycle_below<A: TopOperator>(
         &mut self,
         fine: &A,
         x: &mut [f64],
         b: &[f64],
         product: Option<&mut [f64]>,
+        krylov: bool,
     ) -> bool {
         let top = self.top;
         self.levels.transfers[top - 1].restrict(&self.r[top], &mut self.b[top - 1]);
-        for k in (1..top).rev() {
-            self.presmooth_and_restrict(k);
-        }
-        // Bottom: the direct solve.
-        self.solve_coarsest_in_place(Some(0));
-        // Up: prolongate the correction, smooth.
-        for k in 1..top {
-            self.prolongate_and_postsmooth(k);
+        if krylov {
+            self.krylov_correction(top - 1);
+        } else {
+            for k in (1..top).rev() {
+                self.presmooth_and_restrict(k);
+            }
+            // Bottom: the direct solve.
+            self.solve_coarsest_in_place(Some(0));
+            // Up: prolongate the correction, smooth.
+            for k in 1..top {
+                self.prolongate_and_postsmooth(k);
+            }
         }
         self.prolongate_and_postsmooth_top(fine, x, b, product)
     }

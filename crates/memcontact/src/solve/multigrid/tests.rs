@@ -334,11 +334,7 @@ fn block_gauss_seidel_keeps_the_rate_and_ignores_the_thread_count() {
     let model = bench_model(h.finest(), Some(0.0), Foundation::Lumped);
     assert!(model.n() > cycle::GS_BLOCK);
     let run = |threads: usize| {
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .unwrap();
-        pool.install(|| {
+        crate::on_threads(threads, || {
             poisson_solve(&model.s, &model.d, &h, &model.dofs, 1e-10, None, 50).unwrap()
         })
     };
@@ -378,13 +374,11 @@ fn fused_sweep_from_zero_is_the_sweep_and_its_residual() {
         let seams = cycle::seam_rows(&a.pattern);
         assert_eq!(seams.is_empty(), n <= cycle::gs_block(n));
         let fused = |threads: usize| {
-            let pool = rayon::ThreadPoolBuilder::new()
-                .num_threads(threads)
-                .build()
-                .unwrap();
             // Whatever x holds on entry is ignored.
             let (mut x, mut r) = (vec![1.0; n], vec![f64::NAN; n]);
-            pool.install(|| cycle::gauss_seidel_from_zero(&a, &inv, &mut x, &b, &mut r, &seams));
+            crate::on_threads(threads, || {
+                cycle::gauss_seidel_from_zero(&a, &inv, &mut x, &b, &mut r, &seams)
+            });
             (x, r)
         };
         let (x, r) = fused(1);
@@ -468,12 +462,8 @@ fn backward_sweep_with_product_is_the_sweep_and_its_product() {
             (x, y)
         };
         let fused = |threads: usize| {
-            let pool = rayon::ThreadPoolBuilder::new()
-                .num_threads(threads)
-                .build()
-                .unwrap();
             let (mut x, mut snap, mut y) = (x0.clone(), vec![0.0; n], vec![f64::NAN; n]);
-            pool.install(|| {
+            crate::on_threads(threads, || {
                 cycle::gauss_seidel_back_with_product(
                     &op, &inv, &mut x, &b, &mut snap, &mut y, &seams,
                 )
@@ -502,12 +492,8 @@ fn backward_sweep_with_product_is_the_sweep_and_its_product() {
             (x, y)
         };
         let fused = |threads: usize| {
-            let pool = rayon::ThreadPoolBuilder::new()
-                .num_threads(threads)
-                .build()
-                .unwrap();
             let (mut x, mut snap, mut y) = (x1.clone(), vec![0.0; n], vec![f64::NAN; n]);
-            pool.install(|| {
+            crate::on_threads(threads, || {
                 cycle::gauss_seidel_back_with_product(
                     &a, &inv, &mut x, &b, &mut snap, &mut y, &seams,
                 )
