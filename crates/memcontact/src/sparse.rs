@@ -41,16 +41,9 @@ impl Pattern {
 
     /// The position of every diagonal entry (all must be stored).
     pub fn diagonal_positions(&self) -> Vec<usize> {
-        let at = |i: usize| self.find(i, i).expect("the pattern stores the diagonal");
-        if self.n() >= PAR_ROWS {
-            (0..self.n())
-                .into_par_iter()
-                .with_min_len(4096)
-                .map(at)
-                .collect()
-        } else {
-            (0..self.n()).map(at).collect()
-        }
+        map_rows(self.n(), |i| {
+            self.find(i, i).expect("the pattern stores the diagonal")
+        })
     }
 }
 
@@ -127,15 +120,7 @@ impl Csr {
 
     /// The diagonal.
     pub fn diag(&self) -> Vec<f64> {
-        if self.n() >= PAR_ROWS {
-            (0..self.n())
-                .into_par_iter()
-                .with_min_len(4096)
-                .map(|i| self.get(i, i))
-                .collect()
-        } else {
-            (0..self.n()).map(|i| self.get(i, i)).collect()
-        }
+        map_rows(self.n(), |i| self.get(i, i))
     }
 
     /// Row `i` as (columns, values).
@@ -282,12 +267,26 @@ pub(crate) fn map_blocks<T: Send>(
     n: usize,
     f: impl Fn(std::ops::Range<usize>) -> T + Sync + Send,
 ) -> Vec<T> {
-    let block = |b: usize| f(b * REDUCE_BLOCK..((b + 1) * REDUCE_BLOCK).min(n));
+    let block = |b: usize| f(block_range(b, n));
     let blocks = n.div_ceil(REDUCE_BLOCK);
     if n >= PAR_ROWS {
         (0..blocks).into_par_iter().map(block).collect()
     } else {
         (0..blocks).map(block).collect()
+    }
+}
+
+/// Block `b` of [`REDUCE_BLOCK`] indices of `0..n`.
+fn block_range(b: usize, n: usize) -> std::ops::Range<usize> {
+    b * REDUCE_BLOCK..((b + 1) * REDUCE_BLOCK).min(n)
+}
+
+/// `f(i)` for every row `i < n`, on all threads for many rows.
+fn map_rows<T: Send>(n: usize, f: impl Fn(usize) -> T + Sync + Send) -> Vec<T> {
+    if n >= PAR_ROWS {
+        (0..n).into_par_iter().with_min_len(4096).map(f).collect()
+    } else {
+        (0..n).map(f).collect()
     }
 }
 
@@ -299,7 +298,7 @@ pub(crate) fn sum_blocks(n: usize, f: impl Fn(std::ops::Range<usize>) -> f64 + S
         map_blocks(n, f).iter().sum()
     } else {
         (0..n.div_ceil(REDUCE_BLOCK))
-            .map(|b| f(b * REDUCE_BLOCK..((b + 1) * REDUCE_BLOCK).min(n)))
+            .map(|b| f(block_range(b, n)))
             .sum()
     }
 }

@@ -316,7 +316,7 @@ impl<'a> Multigrid<'a> {
             // zᵀ A p of the previous direction, and whether z is finite: the held rows'
             // entries leave A z as it is (their rows and columns of A are zero), a
             // non-finite one does not, and A p is then formed by a product.
-            let [zap, bad] = sum_blocks(per_block(p, ap, |lo, _, apc| {
+            let [zap, bad] = sum_block_parts(per_block(p, ap, |lo, _, apc| {
                 let mut s = [0.0, 0.0];
                 for (j, apj) in apc.iter().enumerate() {
                     s[0] += masked(z, lo + j) * apj;
@@ -329,7 +329,7 @@ impl<'a> Multigrid<'a> {
             // A z + β A p when the cycle gave A z, else one product. Then pᵀ A p and pᵀ r.
             let first = steps == 0;
             let [pap, pr] = if known && bad == 0.0 {
-                sum_blocks(per_block(p, ap, |lo, pc, apc| {
+                sum_block_parts(per_block(p, ap, |lo, pc, apc| {
                     let mut s = [0.0, 0.0];
                     for (j, (pj, apj)) in pc.iter_mut().zip(apc.iter_mut()).enumerate() {
                         let i = lo + j;
@@ -353,7 +353,7 @@ impl<'a> Multigrid<'a> {
                     }
                 });
                 apply(a, p, ap);
-                sum_blocks(per_block(p, ap, |lo, pc, apc| {
+                sum_block_parts(per_block(p, ap, |lo, pc, apc| {
                     let mut s = [0.0, 0.0];
                     for (j, (pj, apj)) in pc.iter().zip(apc.iter()).enumerate() {
                         s[0] += pj * apj;
@@ -795,7 +795,7 @@ fn per_block<const K: usize>(
 }
 
 /// The sums of per-block results in block order (the same for any number of threads).
-fn sum_blocks<const K: usize>(parts: Vec<[f64; K]>) -> [f64; K] {
+fn sum_block_parts<const K: usize>(parts: Vec<[f64; K]>) -> [f64; K] {
     parts.iter().fold([0.0; K], |mut acc, v| {
         for (a, x) in acc.iter_mut().zip(v) {
             *a += x;
