@@ -239,9 +239,9 @@ pub struct Multigrid<'a> {
     chol: Option<Cholesky>,
     /// Pre- and post-smoothing steps per level.
     pub smoothing: (usize, usize),
-    /// Work vectors of the K-cycle's Krylov steps per level (`[rc, v1, w1, v2]`; empty on
+    /// Work vectors of the K-cycle's Krylov steps per level (`[v1, w1, w2]`; empty on
     /// geometric hierarchies, which use the V-cycle).
-    krylov: Vec<[Vec<f64>; 4]>,
+    krylov: Vec<[Vec<f64>; 3]>,
 }
 
 impl<'a> Multigrid<'a> {
@@ -267,7 +267,7 @@ impl<'a> Multigrid<'a> {
             krylov: (0..top)
                 .map(|k| {
                     if levels.kind == Kind::Algebraic && k > 0 {
-                        [zeros(k), zeros(k), zeros(k), zeros(k)]
+                        [zeros(k), zeros(k), zeros(k)]
                     } else {
                         Default::default()
                     }
@@ -499,7 +499,10 @@ impl<'a> Multigrid<'a> {
     }
 
     /// `x[k] ≈ A_k⁻¹ b[k]` for a coarse level `k < top`: the direct solve on level 0, else
-    /// two flexible CG steps preconditioned by [`Multigrid::coarse_k_cycle`].
+    /// two flexible CG steps preconditioned by [`Multigrid::coarse_k_cycle`] (`b[k]` is
+    /// overwritten by the residual after the first step). Each cycle's last smoothing sweep
+    /// forms the product `A_k v` of its result on the way, and the step's reductions share
+    /// one pass over the vectors.
     fn krylov_correction(&mut self, k: usize) {
         if k == 0 {
             self.solve_coarsest_in_place(Some(0));
@@ -507,49 +510,49 @@ impl<'a> Multigrid<'a> {
         }
         /// Accept one step when it reduces the residual's norm by this factor.
         const ONE_STEP: f64 = 0.25;
-        let bk: &[f64] = &self.b[k];
-        par_rows(&mut self.krylov[k][0], |i, r| *r = bk[i]);
-        self.coarse_k_cycle(k);
-        let a = &self.coarse[k];
-        let [rc, v1, w1, _] = &mut self.krylov[k];
-        let xk: &[f64] = &self.x[k];
-        par_rows(v1, |i, v| *v = xk[i]);
-        a.mul_into(v1, w1);
-        let rho1 = crate::sparse::dot(v1, w1);
-        let alpha1 = crate::sparse::dot(v1, rc);
+        let [mut v1, mut w1, mut w2] = std::mem::take(&mut self.krylov[k]);
+        // v₁ = the cycle's result, w₁ = A v₁; ρ₁ = v₁ᵀw₁, α₁ = v₁ᵀr, ‖r‖².
+        self.coarse_k_cycle(k, &mut w1);
+        std::mem::swap(&mut self.x[k], &mut v1);
+        let [rho1, alpha1, rr] = {
+            let (v1, w1, r) = (&v1, &w1, &self.b[k]);
+            sums(v1.len(), |i| [v1[i] * w1[i], v1[i] * r[i], r[i] * r[i]])
+        };
         if !(rho1 > 0.0 && rho1.is_finite()) {
             par_rows(&mut self.x[k], |_, v| *v = 0.0);
-            return;
-        }
-        // r̃ = rc − (α₁/ρ₁) w₁, into b[k] (the right-hand side of the second cycle).
-        let c1 = alpha1 / rho1;
-        let (rc, w1): (&[f64], &[f64]) = (rc, w1);
-        par_rows(&mut self.b[k], |i, b| *b = rc[i] - c1 * w1[i]);
-        let norm_rc = crate::sparse::dot(rc, rc).sqrt();
-        let norm_rt = crate::sparse::dot(&self.b[k], &self.b[k]).sqrt();
-        if norm_rt <= ONE_STEP * norm_rc {
-            let v1: &[f64] = v1;
-            par_rows(&mut self.x[k], |i, x| *x = c1 * v1[i]);
-            return;
-        }
-        self.coarse_k_cycle(k);
-        let a = &self.coarse[k];
-        let [_, v1, w1, v2] = &mut self.krylov[k];
-        let xk: &[f64] = &self.x[k];
-        par_rows(v2, |i, v| *v = xk[i]);
-        let w2 = &mut self.r[k];
-        a.mul_into(v2, w2);
-        let gamma = crate::sparse::dot(v2, w1);
-        let beta = crate::sparse::dot(v2, w2);
-        let alpha2 = crate::sparse::dot(v2, &self.b[k]);
-        let rho2 = beta - gamma * gamma / rho1;
-        let (ca, cb) = if rho2 > 0.0 && rho2.is_finite() {
-            (c1 - gamma * alpha2 / (rho1 * rho2), alpha2 / rho2)
         } else {
-            (c1, 0.0)
-        };
-        let (v1, v2): (&[f64], &[f64]) = (v1, v2);
-        par_rows(&mut self.x[k], |i, x| *x = ca * v1[i] + cb * v2[i]);
+            // r̃ = r − (α₁/ρ₁) w₁ in b[k] (the right-hand side of the second cycle).
+            let c1 = alpha1 / rho1;
+            let [rt] = sum_block_parts(per_block(&mut self.b[k], &mut w1, |_, bc, wc| {
+                let mut m = 0.0;
+                for (b, w) in bc.iter_mut().zip(wc.iter()) {
+                    *b -= c1 * w;
+                    m += *b * *b;
+                }
+                [m]
+            }));
+            if rt.sqrt() <= ONE_STEP * rr.sqrt() {
+                let v1: &[f64] = &v1;
+                par_rows(&mut self.x[k], |i, x| *x = c1 * v1[i]);
+            } else {
+                // v₂ = the second cycle's result (in x[k]), w₂ = A v₂; v₂ is made
+                // A-orthogonal to v₁ and the pair's minimiser of the quadratic is taken.
+                self.coarse_k_cycle(k, &mut w2);
+                let [gamma, beta, alpha2] = {
+                    let (v2, w1, w2, r) = (&self.x[k], &w1, &w2, &self.b[k]);
+                    sums(v2.len(), |i| [v2[i] * w1[i], v2[i] * w2[i], v2[i] * r[i]])
+                };
+                let rho2 = beta - gamma * gamma / rho1;
+                let (ca, cb) = if rho2 > 0.0 && rho2.is_finite() {
+                    (c1 - gamma * alpha2 / (rho1 * rho2), alpha2 / rho2)
+                } else {
+                    (c1, 0.0)
+                };
+                let v1: &[f64] = &v1;
+                par_rows(&mut self.x[k], |i, x| *x = ca * v1[i] + cb * *x);
+            }
+        }
+        self.krylov[k] = [v1, w1, w2];
     }
 
     /// On coarse level `k ≥ 1`: `x[k] = 0`, `ν₁` Gauss-Seidel sweeps on `A_k x[k] = b[k]`,
@@ -571,27 +574,35 @@ impl<'a> Multigrid<'a> {
     }
 
     /// On coarse level `k ≥ 1`: the correction of level `k − 1` prolongated into `x[k]`,
-    /// then `ν₂` Gauss-Seidel sweeps (in reverse order) on `A_k x[k] = b[k]`.
-    fn prolongate_and_postsmooth(&mut self, k: usize) {
+    /// then `ν₂` Gauss-Seidel sweeps (in reverse order) on `A_k x[k] = b[k]`; with a
+    /// `product`, `A_k x[k]` into it (formed by the sweep when it is a single one).
+    fn prolongate_and_postsmooth(&mut self, k: usize, mut product: Option<&mut [f64]>) {
         let (xl, xu) = self.x.split_at_mut(k);
         self.levels.transfers[k - 1].prolongate_add(&xl[k - 1], &mut xu[0]);
+        let (a, inv, b, r) = (
+            &self.coarse[k],
+            &self.inv_diag[k],
+            &self.b[k],
+            &mut self.r[k],
+        );
+        if let Some(y) = product.as_deref_mut().filter(|_| self.smoothing.1 == 1) {
+            gauss_seidel_back_with_product(a, inv, &mut xu[0], b, r, y, &self.seams[k]);
+            return;
+        }
         for _ in 0..self.smoothing.1 {
-            gauss_seidel(
-                &self.coarse[k],
-                &self.inv_diag[k],
-                &mut xu[0],
-                &self.b[k],
-                &mut self.r[k],
-                true,
-            );
+            gauss_seidel(a, inv, &mut xu[0], b, r, true);
+        }
+        if let Some(y) = product {
+            a.mul_into(&xu[0], y);
         }
     }
 
-    /// One K-cycle on coarse level `k ≥ 1` for `A_k x[k] = b[k]`, from `x[k] = 0`.
-    fn coarse_k_cycle(&mut self, k: usize) {
+    /// One K-cycle on coarse level `k ≥ 1` for `A_k x[k] = b[k]`, from `x[k] = 0`, with
+    /// `A_k x[k]` after it into `product`.
+    fn coarse_k_cycle(&mut self, k: usize, product: &mut [f64]) {
         self.presmooth_and_restrict(k);
         self.krylov_correction(k - 1);
-        self.prolongate_and_postsmooth(k);
+        self.prolongate_and_postsmooth(k, Some(product));
     }
 
     /// Number of levels used.
@@ -716,7 +727,7 @@ impl<'a> Multigrid<'a> {
             self.solve_coarsest_in_place(Some(0));
             // Up: prolongate the correction, smooth.
             for k in 1..top {
-                self.prolongate_and_postsmooth(k);
+                self.prolongate_and_postsmooth(k, None);
             }
         }
         self.prolongate_and_postsmooth_top(fine, x, b, product)
@@ -792,6 +803,20 @@ fn per_block<const K: usize>(
             .map(|(k, (x, y))| f(k * DOT_BLOCK, x, y))
             .collect()
     }
+}
+
+/// `Σ_i f(i)` over `0..n` for `K` sums at once, in blocks of [`DOT_BLOCK`] rows added in
+/// block order (the same for any number of threads): several reductions in one pass.
+fn sums<const K: usize>(n: usize, f: impl Fn(usize) -> [f64; K] + Sync + Send) -> [f64; K] {
+    sum_block_parts(crate::sparse::map_blocks(n, |rows| {
+        let mut s = [0.0; K];
+        for i in rows {
+            for (a, x) in s.iter_mut().zip(f(i)) {
+                *a += x;
+            }
+        }
+        s
+    }))
 }
 
 /// The sums of per-block results in block order (the same for any number of threads).
