@@ -349,20 +349,22 @@ impl<'a> Cursor<'a> {
         self.pos = (self.pos + 1).min(self.buf.len());
     }
 
-    fn bytes<const N: usize>(&mut self, what: &str) -> Parse<[u8; N]> {
-        let end = self.pos + N;
+    /// The next `len` bytes of binary data (`what` names them in the error).
+    fn take(&mut self, len: usize, what: &str) -> Parse<&'a [u8]> {
+        let end = self.pos.saturating_add(len);
         if end > self.buf.len() {
             return Err(format!(
                 "unexpected end of file in the binary data of {} (byte {}): expected {what}",
                 self.section, self.pos
             ));
         }
-        let mut b: [u8; N] = self.buf[self.pos..end].try_into().expect("length N");
-        if self.swap {
-            b.reverse();
-        }
+        let b = &self.buf[self.pos..end];
         self.pos = end;
         Ok(b)
+    }
+
+    fn bytes<const N: usize>(&mut self, what: &str) -> Parse<[u8; N]> {
+        Ok(Binary::of(self).array(self.take(N, what)?))
     }
 
     fn int(&mut self, what: &str) -> Parse<i32> {
@@ -374,11 +376,8 @@ impl<'a> Cursor<'a> {
     }
 
     fn size(&mut self, what: &str) -> Parse<u64> {
-        if self.size_t == 4 {
-            Ok(u32::from_ne_bytes(self.bytes::<4>(what)?) as u64)
-        } else {
-            Ok(u64::from_ne_bytes(self.bytes::<8>(what)?))
-        }
+        let b = Binary::of(self);
+        Ok(b.size(self.take(b.size_t, what)?))
     }
 
     /// A count the rest of the file can hold, each item taking at least `min_bytes` bytes
@@ -395,6 +394,51 @@ impl<'a> Cursor<'a> {
         Ok(n as usize)
     }
 }
+
+/// How binary numbers are stored: byte order and the size of `size_t`. Decodes numbers
+/// from slices, so that the fixed-size records of a block can be read in parallel.
+#[derive(Clone, Copy)]
+struct Binary {
+    swap: bool,
+    size_t: usize,
+}
+
+impl Binary {
+    fn of(c: &Cursor) -> Binary {
+        Binary {
+            swap: c.swap,
+            size_t: c.size_t,
+        }
+    }
+
+    /// The `N` bytes of `b` (exactly `N` long) in native order.
+    #[inline(always)]
+    fn array<const N: usize>(self, b: &[u8]) -> [u8; N] {
+        let mut a: [u8; N] = b.try_into().expect("length N");
+        if self.swap {
+            a.reverse();
+        }
+        a
+    }
+
+    /// A `size_t` from its `size_t` bytes.
+    #[inline(always)]
+    fn size(self, b: &[u8]) -> u64 {
+        if self.size_t == 4 {
+            u32::from_ne_bytes(self.array(b)) as u64
+        } else {
+            u64::from_ne_bytes(self.array(b))
+        }
+    }
+
+    #[inline(always)]
+    fn double(self, b: &[u8]) -> f64 {
+        f64::from_ne_bytes(self.array(b))
+    }
+}
+
+/// Records per task when the records of a binary block are decoded in parallel.
+const RECORDS_PER_TASK: usize = 8192;
 
 /// The MSH flavour named by `$MeshFormat`.
 #[derive(Clone, Copy, PartialEq)]
@@ -730,6 +774,24 @@ fn read_nodes_v4(c: &mut Cursor, binary: bool, raw: &mut Raw) -> Parse<()> {
         } else {
             0
         };
+        if binary {
+            // Fixed-size records: the tags, then the coordinates (and parametric ones).
+            use rayon::prelude::*;
+            let bin = Binary::of(c);
+            let tags = c.take(n * bin.size_t, "the node tags of a block")?;
+            let rec = (3 + params) * 8;
+            let coords = c.take(n * rec, "the node coordinates of a block")?;
+            raw.nodes.par_extend(
+                tags.par_chunks_exact(bin.size_t)
+                    .zip(coords.par_chunks_exact(rec))
+                    .with_min_len(RECORDS_PER_TASK)
+                    .map(|(t, x)| {
+                        let p = [0, 1, 2].map(|k| bin.double(&x[8 * k..8 * k + 8]));
+                        (bin.size(t), p)
+                    }),
+            );
+            continue;
+        }
         let first = raw.nodes.len();
         for _ in 0..n {
             let tag = if binary {
@@ -924,6 +986,26 @@ fn read_elements_v4(
             continue;
         }
         let nodes = known.map_or(0, |k| k.0);
+        let triangle_phys = u32::try_from(phys).ok().filter(|_| ty == 2);
+        if let (Some(phys), true) = (triangle_phys, binary) {
+            // Fixed-size records (a tag and three nodes), decoded in parallel.
+            use rayon::prelude::*;
+            let bin = Binary::of(c);
+            let st = bin.size_t;
+            let data = c.take(n * 4 * st, "the triangles of a block")?;
+            raw.triangles.par_extend(
+                data.par_chunks_exact(4 * st)
+                    .with_min_len(RECORDS_PER_TASK)
+                    .map(|r| {
+                        let v = [1, 2, 3].map(|k| bin.size(&r[k * st..(k + 1) * st]));
+                        (bin.size(&r[..st]), v, phys)
+                    }),
+            );
+            continue;
+        }
+        if ty == 2 {
+            raw.triangles.reserve(n);
+        }
         for _ in 0..n {
             let tag = if binary {
                 c.size("an element tag")?
@@ -1410,6 +1492,67 @@ $EndElements
             assert_eq!(back.points, mesh.points, "{name}");
             assert_eq!(canonical(&back), canonical(&mesh), "{name}");
             assert_eq!(back.region_names, mesh.region_names, "{name}");
+        }
+    }
+
+    #[test]
+    fn large_binary_blocks_keep_the_file_order() {
+        // Blocks of many records are decoded in parallel: vertices, triangles and regions
+        // must come back in file order, as the ASCII reader (record by record) gives them
+        // (the writer groups the triangles by region: one block per region).
+        let mut mesh = crate::mesh::generate::rectangle(&crate::mesh::generate::RectangleSpec {
+            x0: 0.0,
+            y0: 0.0,
+            x1: 1.0,
+            y1: 1.0,
+            nx: 130,
+            ny: 170,
+            diagonal: crate::mesh::generate::Diagonal::Right,
+        })
+        .unwrap()
+        .finest()
+        .clone();
+        assert!(mesh.points.len() > 2 * RECORDS_PER_TASK);
+        for (k, r) in mesh.regions.iter_mut().enumerate() {
+            *r = 1 + (k / 1000 % 3) as u32;
+        }
+        for t in 1..=3 {
+            mesh.region_names.insert(t, format!("part{t}"));
+        }
+        let p = temp("large41b.msh");
+        write_msh(&p, &mesh, MshVersion::V41Binary).unwrap();
+        let (binary, _) = read_msh(&p).unwrap();
+        let q = temp("large41a.msh");
+        write_msh(&q, &mesh, MshVersion::V41Ascii).unwrap();
+        let (ascii, _) = read_msh(&q).unwrap();
+        assert!(binary.points == ascii.points && binary.points == mesh.points);
+        assert!(binary.triangles == ascii.triangles && binary.regions == ascii.regions);
+        assert!(canonical(&binary) == canonical(&mesh));
+    }
+
+    #[test]
+    fn binary_numbers_decode_in_either_byte_order() {
+        let v: u64 = 0x0102_0304_0506_0708;
+        let x = -1.25e-7f64;
+        for swap in [false, true] {
+            let order = |b: Vec<u8>| {
+                if swap {
+                    b.into_iter().rev().collect()
+                } else {
+                    b
+                }
+            };
+            let b8 = Binary { swap, size_t: 8 };
+            assert_eq!(b8.size(&order(v.to_ne_bytes().to_vec())), v);
+            assert_eq!(
+                b8.double(&order(x.to_ne_bytes().to_vec())).to_bits(),
+                x.to_bits()
+            );
+            let b4 = Binary { swap, size_t: 4 };
+            assert_eq!(
+                b4.size(&order(0x0a0b_0c0du32.to_ne_bytes().to_vec())),
+                0x0a0b_0c0d
+            );
         }
     }
 
