@@ -138,7 +138,21 @@ enum Command {
     },
 }
 
+/// Transparent huge pages off for this process (Linux). A run touches all its memory once,
+/// fresh from the kernel; a fresh 2 MiB page costs the kernel (and a virtual machine's
+/// host) far more than 512 small ones. Measured on a 2-core virtual machine, whole runs:
+/// the square at N = 1024 in 1.2 s instead of 1.5-1.7 s, at N = 2048 in 4.7-4.9 s instead
+/// of 5.9-6.0 s, the same at N = 4096; the compute itself is 2-4 % slower without them.
+fn small_pages_only() {
+    #[cfg(target_os = "linux")]
+    // SAFETY: PR_SET_THP_DISABLE takes plain integers and touches no memory of ours.
+    unsafe {
+        libc::prctl(libc::PR_SET_THP_DISABLE, 1, 0, 0, 0);
+    }
+}
+
 fn main() -> ExitCode {
+    small_pages_only();
     let cli = Cli::parse();
     if let Some(n) = cli.threads {
         let pool = rayon::ThreadPoolBuilder::new()
