@@ -62,7 +62,7 @@ impl Csr {
         let nnz = pattern.nnz();
         Csr {
             pattern,
-            val: vec![0.0; nnz],
+            val: zeroed(nnz),
         }
     }
 
@@ -274,6 +274,23 @@ pub(crate) fn map_blocks<T: Send>(
     } else {
         (0..blocks).map(block).collect()
     }
+}
+
+/// `n` zeros written out (on all threads for long vectors), for arrays whose first use
+/// reads them (`+=` in assembly, Galerkin products). The allocator hands out fresh pages
+/// that are zero without being touched; the first read would then map the kernel's shared
+/// zero page and the first write replace it, a second fault that also flushes the other
+/// cores' TLBs. Written first, each page faults once, as a write, on whichever core
+/// writes it.
+pub fn zeroed(n: usize) -> Vec<f64> {
+    // From uninitialised capacity, so that the writes cannot be elided as redundant.
+    let mut v = Vec::with_capacity(n);
+    if n >= PAR_ROWS {
+        v.par_extend(rayon::iter::repeat_n(0.0, n).with_min_len(REDUCE_BLOCK));
+    } else {
+        v.resize(n, 0.0);
+    }
+    v
 }
 
 /// Block `b` of [`REDUCE_BLOCK`] indices of `0..n`.
@@ -527,6 +544,15 @@ mod tests {
         assert!(b.is_finite());
         b.val[2 * PAR_ROWS] = f64::NAN;
         assert!(!b.is_finite());
+    }
+
+    #[test]
+    fn zeroed_vectors_are_zeros_of_the_length_asked() {
+        for n in [0, 1, PAR_ROWS - 1, PAR_ROWS, 3 * PAR_ROWS + 7] {
+            let v = zeroed(n);
+            assert_eq!(v.len(), n);
+            assert!(v.iter().all(|&x| x.to_bits() == 0), "n = {n}");
+        }
     }
 
     #[test]
