@@ -773,7 +773,10 @@ pub struct FcgWork {
 impl FcgWork {
     fn resize(&mut self, n: usize) {
         for v in [&mut self.z, &mut self.p, &mut self.ap, &mut self.az] {
-            v.resize(n, 0.0);
+            if v.len() != n {
+                // Written on all threads (the first use of fresh pages).
+                *v = crate::sparse::zeroed(n);
+            }
         }
     }
 }
@@ -947,7 +950,10 @@ pub(crate) fn gauss_seidel<A: TopOperator>(
         sweep(0, x, &[]);
         return;
     }
-    snapshot.copy_from_slice(x);
+    {
+        let x: &[f64] = x;
+        par_rows(snapshot, |i, s| *s = x[i]);
+    }
     let outside: &[f64] = snapshot;
     x.par_chunks_mut(block)
         .enumerate()
@@ -1151,7 +1157,10 @@ pub(crate) fn gauss_seidel_back_with_product<A: TopOperator>(
         clear_held(y);
         return;
     }
-    snapshot.copy_from_slice(x);
+    {
+        let x: &[f64] = x;
+        par_rows(snapshot, |i, s| *s = x[i]);
+    }
     let before: &[f64] = snapshot;
     x.par_chunks_mut(block)
         .zip(y.par_chunks_mut(block))
