@@ -264,8 +264,15 @@ pub const LOCAL_SPAN: f64 = 4.0;
 /// along it too (by centroid); the identity when the mesh's own order is already local
 /// ([`LOCAL_SPAN`]).
 pub fn locality_order(mesh: &Mesh) -> Reordering {
+    renumbering_for_locality(mesh)
+        .unwrap_or_else(|| Reordering::identity(mesh.n_vertices(), mesh.n_triangles()))
+}
+
+/// [`locality_order`], or `None` when the mesh's own order is already local (no identity
+/// permutations built: a structured mesh of millions of vertices needs none).
+pub fn renumbering_for_locality(mesh: &Mesh) -> Option<Reordering> {
     if edge_span(mesh) <= LOCAL_SPAN {
-        return Reordering::identity(mesh.n_vertices(), mesh.n_triangles());
+        return None;
     }
     let vertices = Permutation::from_order(curve_order(&mesh.points));
     let centroids: Vec<Point> = mesh
@@ -283,30 +290,29 @@ pub fn locality_order(mesh: &Mesh) -> Reordering {
         })
         .collect();
     let triangles = Permutation::from_order(curve_order(&centroids));
-    Reordering {
+    Some(Reordering {
         vertices,
         triangles,
-    }
+    })
 }
 
 impl Hierarchy {
-    /// Every level renumbered for locality ([`locality_order`]), with the refinement
-    /// relations renumbered to match; returns the reorderings, coarsest level first.
-    pub fn reordered(self) -> (Hierarchy, Vec<Reordering>) {
-        let orders: Vec<Reordering> = self.levels.iter().map(locality_order).collect();
-        if orders.iter().all(Reordering::is_identity) {
+    /// Every level renumbered for locality ([`renumbering_for_locality`]), with the
+    /// refinement relations renumbered to match; returns the renumberings, coarsest level
+    /// first (`None` for a level kept in its order).
+    pub fn reordered(self) -> (Hierarchy, Vec<Option<Reordering>>) {
+        let orders: Vec<Option<Reordering>> =
+            self.levels.iter().map(renumbering_for_locality).collect();
+        if orders.iter().all(Option::is_none) {
             return (self, orders);
         }
         let levels: Vec<Mesh> = self
             .levels
             .iter()
             .zip(&orders)
-            .map(|(m, r)| {
-                if r.is_identity() {
-                    m.clone()
-                } else {
-                    r.apply(m)
-                }
+            .map(|(m, r)| match r {
+                Some(r) => r.apply(m),
+                None => m.clone(),
             })
             .collect();
         let refinements = self
@@ -315,13 +321,19 @@ impl Hierarchy {
             .enumerate()
             .map(|(k, rf)| {
                 let (coarse, fine) = (&orders[k], &orders[k + 1]);
-                let parents = fine
-                    .vertices
-                    .old_of_new
-                    .par_iter()
+                let new_coarse = |c: u32| {
+                    coarse
+                        .as_ref()
+                        .map_or(c, |r| r.vertices.new_of_old[c as usize])
+                };
+                let parents = (0..rf.parents.len())
+                    .into_par_iter()
                     .with_min_len(8192)
-                    .map(|&v| {
-                        rf.parents[v as usize].map(|c| coarse.vertices.new_of_old[c as usize])
+                    .map(|v| {
+                        let old = fine
+                            .as_ref()
+                            .map_or(v, |r| r.vertices.old_of_new[v] as usize);
+                        rf.parents[old].map(new_coarse)
                     })
                     .collect();
                 super::refine::Refinement { parents }
@@ -392,6 +404,7 @@ mod tests {
         // A structured order is kept.
         let grid = crate::solve::tests::square(32);
         assert!(locality_order(&grid).is_identity());
+        assert!(renumbering_for_locality(&grid).is_none());
     }
 
     #[test]
