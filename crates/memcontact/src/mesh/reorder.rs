@@ -261,15 +261,9 @@ pub fn edge_span(mesh: &Mesh) -> f64 {
 pub const LOCAL_SPAN: f64 = 4.0;
 
 /// The renumbering of `mesh` for locality: vertices along the Hilbert curve, triangles
-/// along it too (by centroid); the identity when the mesh's own order is already local
-/// ([`LOCAL_SPAN`]).
-pub fn locality_order(mesh: &Mesh) -> Reordering {
-    renumbering_for_locality(mesh)
-        .unwrap_or_else(|| Reordering::identity(mesh.n_vertices(), mesh.n_triangles()))
-}
-
-/// [`locality_order`], or `None` when the mesh's own order is already local (no identity
-/// permutations built: a structured mesh of millions of vertices needs none).
+/// along it too (by centroid); `None` when the mesh's own order is already local
+/// ([`LOCAL_SPAN`]: nothing is built, a structured mesh of millions of vertices needs no
+/// identity permutations).
 pub fn renumbering_for_locality(mesh: &Mesh) -> Option<Reordering> {
     if edge_span(mesh) <= LOCAL_SPAN {
         return None;
@@ -390,7 +384,7 @@ mod tests {
         }
         .apply(&m);
         assert!(edge_span(&user) > 10.0, "{}", edge_span(&user));
-        let r = locality_order(&user);
+        let r = renumbering_for_locality(&user).expect("a scrambled order is renumbered");
         let internal = r.apply(&user);
         assert!(edge_span(&internal) < 3.0, "{}", edge_span(&internal));
         // The same triangles (as point sets) with the same regions, and undone exactly.
@@ -403,7 +397,6 @@ mod tests {
         assert_eq!((a.l_n, a.s_n, a.unknowns), (b.l_n, b.s_n, b.unknowns));
         // A structured order is kept.
         let grid = crate::solve::tests::square(32);
-        assert!(locality_order(&grid).is_identity());
         assert!(renumbering_for_locality(&grid).is_none());
     }
 

@@ -19,7 +19,7 @@
 //!   replaced by the identity.
 
 use super::operator::{apply, values_into, zero_held, TopOperator};
-use super::transfer::{galerkin_patterns, par_rows, Transfer};
+use super::transfer::{galerkin_patterns, par_copy_from, par_rows, Transfer};
 use crate::mesh::refine::{Hierarchy, Refinement};
 use crate::mesh::{DofMap, Mesh};
 use crate::sparse::{Cholesky, Csr, Pattern};
@@ -950,10 +950,7 @@ pub(crate) fn gauss_seidel<A: TopOperator>(
         sweep(0, x, &[]);
         return;
     }
-    {
-        let x: &[f64] = x;
-        par_rows(snapshot, |i, s| *s = x[i]);
-    }
+    par_copy_from(snapshot, x);
     let outside: &[f64] = snapshot;
     x.par_chunks_mut(block)
         .enumerate()
@@ -1157,10 +1154,7 @@ pub(crate) fn gauss_seidel_back_with_product<A: TopOperator>(
         clear_held(y);
         return;
     }
-    {
-        let x: &[f64] = x;
-        par_rows(snapshot, |i, s| *s = x[i]);
-    }
+    par_copy_from(snapshot, x);
     let before: &[f64] = snapshot;
     x.par_chunks_mut(block)
         .zip(y.par_chunks_mut(block))

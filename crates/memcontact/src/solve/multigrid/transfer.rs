@@ -332,6 +332,11 @@ pub(crate) fn par_rows<T: Send>(x: &mut [T], f: impl Fn(usize, &mut T) + Sync + 
     }
 }
 
+/// `dst = src`, on all threads for long vectors.
+pub(crate) fn par_copy_from(dst: &mut [f64], src: &[f64]) {
+    par_rows(dst, |i, d| *d = src[i]);
+}
+
 /// The Galerkin patterns of a chain of transfers, coarsest first, ending with `finest`.
 pub fn galerkin_patterns(transfers: &[Transfer], finest: Arc<Pattern>) -> Vec<Arc<Pattern>> {
     let mut pats = vec![finest];
