@@ -212,31 +212,7 @@ pub fn unknowns_pattern(
             (lengths, cols)
         })
         .collect();
-    // The blocks' rows and columns into place, in parallel (the arrays are large and
-    // fresh: their first touch is shared by the threads).
-    let mut row_ptr = vec![0usize; n + 1];
-    let mut col = vec![0u32; blocks.iter().map(|(_, c)| c.len()).sum()];
-    let mut pieces = Vec::with_capacity(blocks.len());
-    let (mut ptr_rest, mut col_rest) = (&mut row_ptr[1..], &mut col[..]);
-    let mut start = 0;
-    for (lengths, cols) in &blocks {
-        let (p, pr) = ptr_rest.split_at_mut(lengths.len());
-        let (c, cr) = col_rest.split_at_mut(cols.len());
-        pieces.push((start, lengths, cols, p, c));
-        (ptr_rest, col_rest) = (pr, cr);
-        start += cols.len();
-    }
-    pieces
-        .into_par_iter()
-        .for_each(|(start, lengths, cols, p, c)| {
-            let mut end = start;
-            for (slot, &l) in p.iter_mut().zip(lengths) {
-                end += l as usize;
-                *slot = end;
-            }
-            c.copy_from_slice(cols);
-        });
-    Pattern { row_ptr, col }
+    Pattern::from_blocks(&blocks)
 }
 
 /// The position of column `j` in the sorted, distinct columns `cols` of a row that holds

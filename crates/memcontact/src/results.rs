@@ -2,10 +2,10 @@
 //! sampled obstacle, penetration, contact pressure, nodal contact forces X₁, vertex states,
 //! and the totals an engineer checks (load, reaction, contact area, largest deflection).
 
-use crate::mesh::Mesh;
+use crate::mesh::{signed_area, Mesh};
 use crate::model::Model;
 use crate::solve::Solution;
-use crate::sparse::{map_blocks, sum_blocks};
+use crate::sparse::{map_blocks, sum_blocks, zeroed};
 use rayon::prelude::*;
 
 /// Fields over all mesh vertices (u = g on the fixed boundary, 0 by default).
@@ -109,11 +109,12 @@ pub fn derive(mesh: &Mesh, model: &Model, solution: &Solution) -> (NodalFields, 
     derive_from(mesh, model, &solution.u)
 }
 
-/// Nodal areas |Q_i| / 3 of every vertex.
+/// Nodal areas |Q_i| / 3 of every vertex (summed over the triangles in mesh order; the
+/// array is first written on all threads, the areas are not stored).
 fn nodal_areas(mesh: &Mesh) -> Vec<f64> {
-    let mut nodal_area = vec![0.0; mesh.n_vertices()];
-    for (t, area) in mesh.triangles.iter().zip(mesh.areas()) {
-        let a = area / 3.0;
+    let mut nodal_area = zeroed(mesh.n_vertices());
+    for t in &mesh.triangles {
+        let a = signed_area(&mesh.points, t) / 3.0;
         for &v in t {
             nodal_area[v as usize] += a;
         }

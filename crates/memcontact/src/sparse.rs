@@ -39,6 +39,36 @@ impl Pattern {
             .map(|k| self.row_ptr[i] + k)
     }
 
+    /// The pattern of consecutive blocks of rows, each given as its rows' lengths and their
+    /// columns concatenated. The blocks are put into place on all threads: the arrays are
+    /// large and fresh, and their first touch is shared by the threads.
+    pub fn from_blocks(blocks: &[(Vec<u32>, Vec<u32>)]) -> Pattern {
+        let n: usize = blocks.iter().map(|(lengths, _)| lengths.len()).sum();
+        let mut row_ptr = filled(n + 1, 0usize);
+        let mut col = filled(blocks.iter().map(|(_, c)| c.len()).sum(), 0u32);
+        let mut pieces = Vec::with_capacity(blocks.len());
+        let (mut ptr_rest, mut col_rest) = (&mut row_ptr[1..], &mut col[..]);
+        let mut start = 0;
+        for (lengths, cols) in blocks {
+            let (p, pr) = ptr_rest.split_at_mut(lengths.len());
+            let (c, cr) = col_rest.split_at_mut(cols.len());
+            pieces.push((start, lengths, cols, p, c));
+            (ptr_rest, col_rest) = (pr, cr);
+            start += cols.len();
+        }
+        pieces
+            .into_par_iter()
+            .for_each(|(start, lengths, cols, p, c)| {
+                let mut end = start;
+                for (slot, &l) in p.iter_mut().zip(lengths) {
+                    end += l as usize;
+                    *slot = end;
+                }
+                c.copy_from_slice(cols);
+            });
+        Pattern { row_ptr, col }
+    }
+
     /// The position of every diagonal entry (all must be stored).
     pub fn diagonal_positions(&self) -> Vec<usize> {
         map_rows(self.n(), |i| {
@@ -283,12 +313,20 @@ pub(crate) fn map_blocks<T: Send>(
 /// cores' TLBs. Written first, each page faults once, as a write, on whichever core
 /// writes it.
 pub fn zeroed(n: usize) -> Vec<f64> {
+    filled(n, 0.0)
+}
+
+/// `n` copies of `value` written out, on all threads for long vectors. For the large
+/// arrays of the solver's setup: `vec![value; n]` fills on one thread (or, for zeros, on
+/// memory the allocator reuses), and on fresh memory that fill is mostly page faults,
+/// which cost as much as the arithmetic of an iteration and share out over the cores.
+pub fn filled<T: Copy + Send + Sync>(n: usize, value: T) -> Vec<T> {
     // From uninitialised capacity, so that the writes cannot be elided as redundant.
     let mut v = Vec::with_capacity(n);
     if n >= PAR_ROWS {
-        v.par_extend(rayon::iter::repeat_n(0.0, n).with_min_len(REDUCE_BLOCK));
+        v.par_extend(rayon::iter::repeat_n(value, n).with_min_len(REDUCE_BLOCK));
     } else {
-        v.resize(n, 0.0);
+        v.resize(n, value);
     }
     v
 }
@@ -375,7 +413,7 @@ where
     };
     let bounds: Vec<usize> = (0..=parts).map(|p| p * n_keys / parts).collect();
     // Counts of each range's keys, then their running sums within the range.
-    let mut ptr = vec![0usize; n_keys + 1];
+    let mut ptr = filled(n_keys + 1, 0usize);
     let mut ranges = Vec::with_capacity(parts);
     let mut rest = &mut ptr[1..];
     for w in bounds.windows(2) {
@@ -416,7 +454,7 @@ where
         offset += total;
     }
     // Each range fills its own part of the values, in item order.
-    let mut values = vec![T::default(); offset];
+    let mut values = filled(offset, T::default());
     let mut pieces = Vec::with_capacity(parts);
     let mut rest = &mut values[..];
     for w in bounds.windows(2) {
@@ -553,6 +591,56 @@ mod tests {
             assert_eq!(v.len(), n);
             assert!(v.iter().all(|&x| x.to_bits() == 0), "n = {n}");
         }
+    }
+
+    #[test]
+    fn filled_vectors_hold_the_value_asked() {
+        for n in [0, 1, PAR_ROWS - 1, PAR_ROWS, 3 * PAR_ROWS + 7] {
+            let b = filled(n, true);
+            assert_eq!(b.len(), n);
+            assert!(b.iter().all(|&x| x), "n = {n}");
+            let m = filled(n, u32::MAX);
+            assert_eq!(m.len(), n);
+            assert!(m.iter().all(|&x| x == u32::MAX), "n = {n}");
+        }
+    }
+
+    #[test]
+    fn a_pattern_from_blocks_is_their_rows_in_order() {
+        // Rows i of n: columns i - 1, i, i + 1 within 0..n, cut into blocks of uneven sizes
+        // (one empty), against the same rows laid out by hand.
+        let n = 2 * PAR_ROWS + 5;
+        let row = |i: usize| -> Vec<u32> {
+            (i.saturating_sub(1)..(i + 2).min(n))
+                .map(|j| j as u32)
+                .collect()
+        };
+        let cuts = [0, 7, 7, PAR_ROWS, PAR_ROWS + 1, n];
+        let blocks: Vec<(Vec<u32>, Vec<u32>)> = cuts
+            .windows(2)
+            .map(|w| {
+                let rows: Vec<Vec<u32>> = (w[0]..w[1]).map(row).collect();
+                (rows.iter().map(|r| r.len() as u32).collect(), rows.concat())
+            })
+            .collect();
+        let p = Pattern::from_blocks(&blocks);
+        assert_eq!(p.n(), n);
+        assert_eq!(p.row_ptr[0], 0);
+        for i in 0..n {
+            assert_eq!(
+                &p.col[p.row_ptr[i]..p.row_ptr[i + 1]],
+                &row(i)[..],
+                "row {i}"
+            );
+        }
+        assert_eq!(p.nnz(), 3 * n - 2);
+        assert_eq!(
+            Pattern::from_blocks(&[]),
+            Pattern {
+                row_ptr: vec![0],
+                col: vec![]
+            }
+        );
     }
 
     #[test]

@@ -15,7 +15,7 @@
 use super::multigrid::transfer::{par_rows, PAR_ROWS};
 use crate::model::{FoundationMatrix, Model};
 use crate::sparse::row_chunks;
-use crate::sparse::{Csr, Pattern};
+use crate::sparse::{filled, Csr, Pattern};
 use rayon::prelude::*;
 
 /// The states of the truncated Newton step at V: which vertices are held (touching, or at
@@ -48,10 +48,10 @@ impl NewtonStates {
         let n = model.n();
         let low = if model.lower.is_some() { n } else { 0 };
         NewtonStates {
-            truncated: vec![false; n],
-            penetrating: vec![false; n],
-            penetrating_low: vec![false; low],
-            at_lower: vec![false; low],
+            truncated: filled(n, false),
+            penetrating: filled(n, false),
+            penetrating_low: filled(low, false),
+            at_lower: filled(low, false),
         }
     }
 
@@ -138,7 +138,7 @@ impl NewtonMatrix {
         if consistent(&model.l) || model.lower.as_ref().is_some_and(|b| consistent(&b.l)) {
             NewtonMatrix::Assembled(Csr::zeros(model.s.pattern.clone()))
         } else {
-            NewtonMatrix::Diagonal(vec![0.0; model.n()])
+            NewtonMatrix::Diagonal(crate::sparse::zeroed(model.n()))
         }
     }
 

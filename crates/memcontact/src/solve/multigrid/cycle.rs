@@ -22,7 +22,7 @@ use super::operator::{apply, values_into, zero_held, TopOperator};
 use super::transfer::{galerkin_patterns, par_copy_from, par_rows, Transfer};
 use crate::mesh::refine::{Hierarchy, Refinement};
 use crate::mesh::{DofMap, Mesh};
-use crate::sparse::{Cholesky, Csr, Pattern};
+use crate::sparse::{filled, Cholesky, Csr, Pattern};
 use crate::{Error, Result};
 use std::sync::Arc;
 
@@ -250,7 +250,7 @@ impl<'a> Multigrid<'a> {
         let coarse: Vec<Csr> = (0..top)
             .map(|k| Csr::zeros(levels.patterns[k].clone()))
             .collect();
-        let zeros = |k: usize| vec![0.0; levels.n(k)];
+        let zeros = |k: usize| crate::sparse::zeroed(levels.n(k));
         Multigrid {
             levels,
             top,
@@ -260,7 +260,7 @@ impl<'a> Multigrid<'a> {
             b: (0..top).map(zeros).collect(),
             r: (0..=top).map(zeros).collect(),
             seams: (0..=top).map(|k| seam_rows(&levels.patterns[k])).collect(),
-            dirty: (0..top).map(|k| vec![true; levels.n(k)]).collect(),
+            dirty: (0..top).map(|k| filled(levels.n(k), true)).collect(),
             coarsest: Csr::zeros(levels.patterns[0].clone()),
             chol: None,
             smoothing: (1, 1),

@@ -46,7 +46,7 @@ use super::newton::{mark_dirty, newton_system, NewtonMatrix, NewtonStates};
 use super::{IterationRecord, Method, Observer, PhaseTimer, Settings, Solution};
 use crate::mesh::refine::Hierarchy;
 use crate::model::{Certificate, FoundationMatrix, Model};
-use crate::sparse::Csr;
+use crate::sparse::{filled, zeroed, Csr};
 use crate::Result;
 use std::time::Instant;
 use transfer::par_rows;
@@ -239,7 +239,7 @@ pub fn solve_with(
         let coarse = if k < top { models.next() } else { None };
         let m = coarse.as_ref().unwrap_or(model);
         if k > first {
-            let mut next = vec![0.0; m.n()];
+            let mut next = zeroed(m.n());
             levels.transfers[k - 1].prolongate(&v, &mut next);
             m.project(&mut next);
             v = next;
@@ -315,7 +315,7 @@ fn coarse_model(fine: &Model, t: &Transfer, levels: &Levels, k: usize) -> Model 
         c
     };
     let restrict = |x: &[f64]| {
-        let mut y = vec![0.0; t.n_coarse];
+        let mut y = zeroed(t.n_coarse);
         t.restrict(x, &mut y);
         y
     };
@@ -438,12 +438,12 @@ fn level_solve(ls: LevelSolve) -> Result<(usize, f64, Option<Certificate>)> {
     let mut a = NewtonMatrix::for_model(model);
     let mut mg = Multigrid::new(levels, top);
     mg.smoothing = options.smoothing;
-    let mut delta = vec![0.0; n];
-    let mut g = vec![0.0; n];
-    let mut r = vec![0.0; n];
+    let mut delta = zeroed(n);
+    let mut g = zeroed(n);
+    let mut r = zeroed(n);
     let mut prev: Option<NewtonStates> = None;
-    let mut changed = vec![false; n];
-    let mut dirty = vec![false; n];
+    let mut changed = filled(n, false);
+    let mut dirty = filled(n, false);
     let mut iterations = 0;
     let mut stalled = 0;
     let mut certificate = None;

@@ -189,7 +189,7 @@ impl Transfer {
         let n_coarse = self.n_coarse;
         // Per block of coarse rows: the row lengths and the concatenated sorted columns.
         // `seen[j] == i` marks column j as already in row i (no sort of duplicates).
-        let block = |seen: &mut Vec<u32>, b: usize| -> (Vec<usize>, Vec<u32>) {
+        let block = |seen: &mut Vec<u32>, b: usize| -> (Vec<u32>, Vec<u32>) {
             let (lo, hi) = (b * ROWS, ((b + 1) * ROWS).min(n_coarse));
             let mut lens = Vec::with_capacity(hi - lo);
             let mut cols = Vec::with_capacity((hi - lo) * 9);
@@ -211,13 +211,13 @@ impl Transfer {
                     }
                 }
                 r.sort_unstable();
-                lens.push(r.len());
+                lens.push(r.len() as u32);
                 cols.extend_from_slice(&r);
             }
             (lens, cols)
         };
         let nb = n_coarse.div_ceil(ROWS);
-        let blocks: Vec<(Vec<usize>, Vec<u32>)> = if n_coarse >= PAR_ROWS {
+        let blocks: Vec<(Vec<u32>, Vec<u32>)> = if n_coarse >= PAR_ROWS {
             (0..nb)
                 .into_par_iter()
                 .map_init(|| vec![u32::MAX; n_coarse], block)
@@ -226,17 +226,7 @@ impl Transfer {
             let mut seen = vec![u32::MAX; n_coarse];
             (0..nb).map(|b| block(&mut seen, b)).collect()
         };
-        let total: usize = blocks.iter().map(|b| b.1.len()).sum();
-        let mut row_ptr = Vec::with_capacity(n_coarse + 1);
-        row_ptr.push(0);
-        let mut col = Vec::with_capacity(total);
-        for (lens, cols) in blocks {
-            for l in lens {
-                row_ptr.push(row_ptr.last().copied().unwrap_or(0) + l);
-            }
-            col.extend_from_slice(&cols);
-        }
-        Pattern { row_ptr, col }
+        Pattern::from_blocks(&blocks)
     }
 
     /// The numeric Galerkin product: fills the rows of `coarse` (on
