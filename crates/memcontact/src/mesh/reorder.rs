@@ -104,7 +104,12 @@ impl Reordering {
     /// `mesh` (in the user's numbering) renumbered; the result records the renumbering in
     /// [`Mesh::numbering`].
     pub fn apply(&self, mesh: &Mesh) -> Mesh {
-        let mut m = self.map(mesh, &self.vertices.new_of_old, &self.triangles.old_of_new);
+        let v = &self.vertices;
+        let mut m = self.map(
+            mesh,
+            (&v.new_of_old, &v.old_of_new),
+            &self.triangles.old_of_new,
+        );
         m.numbering = Some(std::sync::Arc::new(self.clone()));
         m
     }
@@ -112,20 +117,28 @@ impl Reordering {
     /// The inverse of [`Reordering::apply`]: the mesh in the user's numbering from the
     /// renumbered one.
     pub fn undo(&self, internal: &Mesh) -> Mesh {
+        let v = &self.vertices;
         self.map(
             internal,
-            &self.vertices.old_of_new,
+            (&v.old_of_new, &v.new_of_old),
             &self.triangles.new_of_old,
         )
     }
 
-    /// `mesh` with vertex `v` moved to `vertex_to[v]` and the triangle now at position `k`
-    /// taken from position `triangle_from[k]`.
-    fn map(&self, mesh: &Mesh, vertex_to: &[u32], triangle_from: &[u32]) -> Mesh {
-        let mut points: Vec<Point> = vec![[0.0; 2]; mesh.points.len()];
-        for (v, p) in mesh.points.iter().enumerate() {
-            points[vertex_to[v] as usize] = *p;
-        }
+    /// `mesh` with vertex `v` moved to `vertex_to[v]` (the vertex now at `i` taken from
+    /// `vertex_from[i]`, the inverse) and the triangle now at position `k` taken from
+    /// position `triangle_from[k]`.
+    fn map(
+        &self,
+        mesh: &Mesh,
+        (vertex_to, vertex_from): (&[u32], &[u32]),
+        triangle_from: &[u32],
+    ) -> Mesh {
+        let points: Vec<Point> = vertex_from
+            .par_iter()
+            .with_min_len(8192)
+            .map(|&v| mesh.points[v as usize])
+            .collect();
         let triangles: Vec<[u32; 3]> = triangle_from
             .par_iter()
             .with_min_len(8192)
@@ -212,31 +225,85 @@ pub fn hilbert_index(mut x: u32, mut y: u32) -> u32 {
 /// The order of `points` along the Hilbert curve of their bounding square (ties by
 /// index: deterministic).
 fn curve_order(points: &[Point]) -> Vec<u32> {
-    let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
-    for p in points {
-        for d in 0..2 {
-            lo[d] = lo[d].min(p[d]);
-            hi[d] = hi[d].max(p[d]);
-        }
-    }
+    let (lo, hi) = points
+        .par_iter()
+        .with_min_len(8192)
+        .fold(
+            || ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]),
+            |(lo, hi), p| {
+                (
+                    [lo[0].min(p[0]), lo[1].min(p[1])],
+                    [hi[0].max(p[0]), hi[1].max(p[1])],
+                )
+            },
+        )
+        .reduce(
+            || ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]),
+            |(a, b), (c, d)| {
+                (
+                    [a[0].min(c[0]), a[1].min(c[1])],
+                    [b[0].max(d[0]), b[1].max(d[1])],
+                )
+            },
+        );
     let extent = (hi[0] - lo[0]).max(hi[1] - lo[1]);
     let scale = if extent > 0.0 && extent.is_finite() {
         ((1u32 << BITS) - 1) as f64 / extent
     } else {
         0.0
     };
-    let mut keys: Vec<u64> = points
+    let keys: Vec<u32> = points
         .par_iter()
-        .enumerate()
         .with_min_len(8192)
-        .map(|(i, p)| {
+        .map(|p| {
             let q = |d: usize| ((p[d] - lo[d]) * scale).clamp(0.0, ((1u32 << BITS) - 1) as f64);
-            let h = hilbert_index(q(0) as u32, q(1) as u32);
-            (u64::from(h) << 32) | i as u64
+            hilbert_index(q(0) as u32, q(1) as u32)
         })
         .collect();
-    keys.par_sort_unstable();
-    keys.into_iter().map(|k| k as u32).collect()
+    order_by_key(&keys)
+}
+
+/// Bits of the key sorted per pass of [`order_by_key`].
+const RADIX_BITS: u32 = 11;
+
+/// The indices `0..keys.len()` ordered by `keys[i]`, ties by index: a least-significant-
+/// digit radix sort (stable counting passes of [`RADIX_BITS`] from the identity order), in
+/// time linear in the number of keys, and skipping the digits that all keys share.
+fn order_by_key(keys: &[u32]) -> Vec<u32> {
+    let n = keys.len();
+    // Key and index in one word, so that every pass reads its input in order.
+    let mut items: Vec<u64> = keys
+        .iter()
+        .enumerate()
+        .map(|(i, &k)| (u64::from(k) << 32) | i as u64)
+        .collect();
+    let mut next = vec![0u64; n];
+    let buckets = 1usize << RADIX_BITS;
+    let mut count = vec![0usize; buckets];
+    let mut shift = 32;
+    while shift < u64::BITS {
+        let digit = |x: u64| (x >> shift) as usize & (buckets - 1);
+        count.iter_mut().for_each(|c| *c = 0);
+        for &x in &items {
+            count[digit(x)] += 1;
+        }
+        if count.contains(&n) {
+            shift += RADIX_BITS;
+            continue;
+        }
+        let mut start = 0;
+        for c in count.iter_mut() {
+            (*c, start) = (start, start + *c);
+        }
+        for &x in &items {
+            let d = digit(x);
+            next[count[d]] = x;
+            count[d] += 1;
+        }
+        std::mem::swap(&mut items, &mut next);
+        shift += RADIX_BITS;
+    }
+    items.into_iter().map(|x| x as u32).collect()
 }
 
 /// The mean distance `|i − j|` between the numbers of the two ends of an edge, in units of
@@ -347,6 +414,31 @@ impl Hierarchy {
 mod tests {
     use super::*;
     use crate::mesh::generate::disk;
+
+    #[test]
+    fn keys_are_ordered_as_by_a_comparison_sort() {
+        // Pseudo-random keys with many ties, over the full range and over a narrow one
+        // (digits shared by every key are skipped), against a sort by (key, index).
+        let mut state = 0x2545_f491_4f6c_dd1du64;
+        let mut next = || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            state
+        };
+        for (n, mask, base) in [
+            (0, 0, 0),
+            (1, u32::MAX, 0),
+            (5000, u32::MAX, 0),
+            (5000, 0x3f, 0),
+            (70_000, 0xffff, 0x7000_0000),
+        ] {
+            let keys: Vec<u32> = (0..n).map(|_| base | (next() as u32 & mask)).collect();
+            let mut expected: Vec<u32> = (0..n as u32).collect();
+            expected.sort_by_key(|&i| (keys[i as usize], i));
+            assert_eq!(order_by_key(&keys), expected, "n = {n}, mask = {mask:#x}");
+        }
+    }
 
     #[test]
     fn hilbert_curve_visits_neighbouring_cells_in_turn() {
