@@ -98,6 +98,49 @@ impl Element {
         }
     }
 
+    /// The element matrix `∫_T c λ_a λ_b` by degree-5 quadrature, with c evaluated once
+    /// per quadrature point for the whole matrix: the entries (a, b) with a ≤ b, in the
+    /// order of [`sym_index`] (the matrix is exactly symmetric).
+    pub fn weighted_mass_matrix(&self, c: &dyn Coefficient, region: u32) -> [f64; 6] {
+        let values = DEGREE5.map(|(l, _)| c.at(map(&self.corners, &l), region));
+        let entry = |a: usize, b: usize| {
+            self.area
+                * DEGREE5
+                    .iter()
+                    .zip(&values)
+                    .map(|((l, w), cv)| w * cv * l[a] * l[b])
+                    .sum::<f64>()
+        };
+        [
+            entry(0, 0),
+            entry(0, 1),
+            entry(0, 2),
+            entry(1, 1),
+            entry(1, 2),
+            entry(2, 2),
+        ]
+    }
+
+    /// `∫_T c λ_a` for a = 0, 1, 2: [`Element::weighted_load`] of the three corners, with c
+    /// evaluated once per quadrature point (the same sums, term by term).
+    #[inline]
+    pub fn weighted_load_row(&self, c: &dyn Coefficient, region: u32) -> [f64; 3] {
+        match c.on_region(region) {
+            Some(_) => [0, 1, 2].map(|a| self.weighted_load(c, region, a)),
+            None => {
+                let values = DEGREE5.map(|(l, _)| c.at(map(&self.corners, &l), region));
+                [0, 1, 2].map(|a| {
+                    self.area
+                        * DEGREE5
+                            .iter()
+                            .zip(&values)
+                            .map(|((l, w), cv)| w * cv * l[a])
+                            .sum::<f64>()
+                })
+            }
+        }
+    }
+
     /// `∫_T c λ_a` (exact for constant c, degree-5 quadrature otherwise).
     #[inline]
     pub fn weighted_load(&self, c: &dyn Coefficient, region: u32, a: usize) -> f64 {
@@ -112,6 +155,14 @@ impl Element {
             }
         }
     }
+}
+
+/// The position of entry (a, b) of a symmetric 3 × 3 element matrix stored as its upper
+/// triangle by rows: (0,0), (0,1), (0,2), (1,1), (1,2), (2,2).
+#[inline]
+pub fn sym_index(a: usize, b: usize) -> usize {
+    const INDEX: [[usize; 3]; 3] = [[0, 1, 2], [1, 3, 4], [2, 4, 5]];
+    INDEX[a][b]
 }
 
 /// Collects into `buf` the unknowns sharing a triangle with vertex `v`, sorted and unique.
@@ -239,6 +290,23 @@ pub fn assemble_stiffness_and_mass(
     h: Option<&dyn Coefficient>,
 ) -> (Csr, Option<Csr>) {
     let n = pattern.n();
+    // Where h varies on a triangle's region: its element matrix, computed once (every
+    // corner's row reads it), with h evaluated once per quadrature point.
+    let masses: Vec<[f64; 6]> = match h {
+        Some(h) if mesh.regions.par_iter().any(|&r| h.on_region(r).is_none()) => (0..mesh
+            .n_triangles())
+            .into_par_iter()
+            .with_min_len(1024)
+            .map(|k| {
+                let region = mesh.regions[k];
+                match h.on_region(region) {
+                    Some(_) => [0.0; 6],
+                    None => Element::of(mesh, k).weighted_mass_matrix(h, region),
+                }
+            })
+            .collect(),
+        _ => Vec::new(),
+    };
     let mut s = Csr::zeros(pattern.clone());
     let mut l = h.map(|_| Csr::zeros(pattern.clone()));
     let s_blocks = row_chunks(pattern, &mut s.val, ROW_BLOCK);
@@ -283,14 +351,14 @@ pub fn assemble_stiffness_and_mass(
                         let pos = position(cols, j);
                         s_block[range.start + pos] +=
                             scale * (e[a][0] * e[b][0] + e[a][1] * e[b][1]);
-                        if let (Some(lb), Some(h)) = (l_block.as_deref_mut(), h) {
+                        if let (Some(lb), Some(_)) = (l_block.as_deref_mut(), h) {
                             lb[range.start + pos] += match h_const {
                                 Some(hc) => {
                                     hc * 0.5
                                         * two_area
                                         * if a == b { 1.0 / 6.0 } else { 1.0 / 12.0 }
                                 }
-                                None => Element::new(c).weighted_mass(h, region, a, b),
+                                None => masses[k as usize][sym_index(a, b)],
                             };
                         }
                     }
@@ -300,20 +368,22 @@ pub fn assemble_stiffness_and_mass(
     (s, l)
 }
 
-/// `∫_T c λ_a` for corner a of triangle `k`, with `c` constant on the triangle's region
-/// (`|T| c / 3`, from the triangle's entry of `areas` ([`Mesh::areas`])) or by quadrature.
+/// `∫_T c λ_a` for the corners a = 0, 1, 2 of triangle `k`: `|T| c / 3` where c is constant
+/// on the triangle's region (from the triangle's entry of `areas` ([`Mesh::areas`])), else
+/// by quadrature with c evaluated once per point for the three corners.
 #[inline]
-fn element_load(mesh: &Mesh, areas: &[f64], k: usize, c: &dyn Coefficient, a: usize) -> f64 {
+fn element_loads(mesh: &Mesh, areas: &[f64], k: usize, c: &dyn Coefficient) -> [f64; 3] {
     let region = mesh.regions[k];
     match c.on_region(region) {
-        Some(v) => v * areas[k] / 3.0,
-        None => Element::of(mesh, k).weighted_load(c, region, a),
+        Some(v) => [v * areas[k] / 3.0; 3],
+        None => Element::of(mesh, k).weighted_load_row(c, region),
     }
 }
 
 /// The load-type vector `∫ c g_i` over unknowns (the paper's D for c = f, the lumped
 /// foundation diagonal for c = h): element areas (`areas`, [`Mesh::areas`]) only where c
-/// is constant on a region.
+/// is constant on a region. The element integrals are computed once per triangle (c
+/// evaluated once per quadrature point), then summed around each vertex.
 pub fn assemble_load(
     mesh: &Mesh,
     dofs: &DofMap,
@@ -321,17 +391,32 @@ pub fn assemble_load(
     areas: &[f64],
     c: &dyn Coefficient,
 ) -> Vec<f64> {
+    sum_around_vertices(mesh, dofs, adj, &element_rows(mesh, areas, c))
+}
+
+/// [`element_loads`] of every triangle.
+fn element_rows(mesh: &Mesh, areas: &[f64], c: &dyn Coefficient) -> Vec<[f64; 3]> {
+    (0..mesh.n_triangles())
+        .into_par_iter()
+        .with_min_len(1024)
+        .map(|k| element_loads(mesh, areas, k, c))
+        .collect()
+}
+
+/// Per unknown, the sum of its corner's entry of `rows` over the triangles around it.
+fn sum_around_vertices(
+    mesh: &Mesh,
+    dofs: &DofMap,
+    adj: &VertexTriangles,
+    rows: &[[f64; 3]],
+) -> Vec<f64> {
     dofs.vertex
         .par_iter()
         .with_min_len(1024)
         .map(|&v| {
             adj.of(v as usize)
                 .iter()
-                .map(|&k| {
-                    let t = mesh.triangles[k as usize];
-                    let a = corner(t, v);
-                    element_load(mesh, areas, k as usize, c, a)
-                })
+                .map(|&k| rows[k as usize][corner(mesh.triangles[k as usize], v)])
                 .sum()
         })
         .collect()
@@ -340,11 +425,20 @@ pub fn assemble_load(
 /// `∫_Ω c` over the whole mesh (the total load for c = f), by the same element integrals
 /// as [`assemble_load`] (`areas` is [`Mesh::areas`]).
 pub fn integrate(mesh: &Mesh, areas: &[f64], c: &dyn Coefficient) -> f64 {
+    integrate_with(mesh, areas, c, |k| element_loads(mesh, areas, k, c))
+}
+
+/// [`integrate`] with the element integrals of triangle k (where c varies on its region)
+/// from `row(k)`.
+fn integrate_with(
+    mesh: &Mesh,
+    areas: &[f64],
+    c: &dyn Coefficient,
+    row: impl Fn(usize) -> [f64; 3] + Sync + Send,
+) -> f64 {
     let element = |k: usize| match c.on_region(mesh.regions[k]) {
         Some(v) => v * areas[k],
-        None => (0..3)
-            .map(|a| element_load(mesh, areas, k, c, a))
-            .sum::<f64>(),
+        None => row(k).into_iter().sum::<f64>(),
     };
     // Summed in fixed blocks: the same for any number of threads.
     crate::sparse::sum_blocks(mesh.n_triangles(), |r| r.map(element).sum::<f64>())
@@ -426,6 +520,18 @@ impl<'a> Loads<'a> {
                 .collect(),
             None => assemble_load(self.mesh, self.dofs, self.adj, self.areas, c),
         }
+    }
+
+    /// [`Loads::vector`] and [`Loads::integral`] of one coefficient, from the same element
+    /// integrals (computed once where c varies).
+    pub fn vector_and_integral(&self, c: &dyn Coefficient) -> (Vec<f64>, f64) {
+        if self.uniform(c).is_some() {
+            return (self.vector(c), self.integral(c));
+        }
+        let rows = element_rows(self.mesh, self.areas, c);
+        let vector = sum_around_vertices(self.mesh, self.dofs, self.adj, &rows);
+        let integral = integrate_with(self.mesh, self.areas, c, |k| rows[k]);
+        (vector, integral)
     }
 
     /// `∫_Ω c` over the whole mesh ([`integrate`]).
@@ -628,11 +734,63 @@ mod tests {
             assert_eq!(loads.vector(c), assemble_load(&m, &dofs, &adj, &areas, c));
             assert_eq!(loads.integral(c), integrate(&m, &areas, c));
         }
+        // D and the total from one set of element integrals: the same numbers as apart.
+        for c in [&2.5 as &dyn Coefficient, &same, &two, &x2] {
+            assert_eq!(
+                loads.vector_and_integral(c),
+                (loads.vector(c), loads.integral(c))
+            );
+        }
+        // The total of x² against the degree-5 rule applied to whole triangles (no split
+        // into corners): equal to rounding.
+        let direct: f64 = (0..m.n_triangles())
+            .map(|k| {
+                let e = Element::of(&m, k);
+                e.area
+                    * DEGREE5
+                        .iter()
+                        .map(|(l, w)| w * map(&e.corners, l)[0].powi(2))
+                        .sum::<f64>()
+            })
+            .sum();
+        assert!((loads.integral(&x2) - direct).abs() <= 1e-13 * direct);
         // ∫ x² over the unit disc is π/4 (to the order of the polygon's gap, h²).
         assert!((loads.integral(&x2) - std::f64::consts::FRAC_PI_4).abs() < 1e-2);
         // ∫ over region 2 (the left half disc) counts 3, over the rest 1: 2π in all.
         assert!((loads.integral(&two) - 2.0 * std::f64::consts::PI).abs() < 2e-2);
         assert_eq!(uniform_value(&2.5, &[]), None);
+    }
+
+    #[test]
+    fn element_mass_matrix_integrates_a_linear_weight_exactly() {
+        // c = Σ_k c_k λ_k (linear): ∫_T λ_a λ_b λ_k is |T|/10, |T|/30 or |T|/60 as a, b, k
+        // are all equal, two equal or all different.
+        let e = Element::new([[0.2, 0.1], [1.3, 0.4], [0.5, 1.7]]);
+        let c = FnCoefficient(|p: Point| 1.0 + 2.0 * p[0] - 0.5 * p[1]);
+        let ck = e.corners.map(|p| 1.0 + 2.0 * p[0] - 0.5 * p[1]);
+        let m = e.weighted_mass_matrix(&c, 0);
+        for a in 0..3 {
+            for b in 0..3 {
+                let exact: f64 = (0..3)
+                    .map(|k| {
+                        let same = (a == b) as usize + (b == k) as usize + (a == k) as usize;
+                        let w = match same {
+                            3 => 1.0 / 10.0,
+                            1 => 1.0 / 30.0,
+                            _ => 1.0 / 60.0,
+                        };
+                        ck[k] * w * e.area
+                    })
+                    .sum();
+                let got = m[sym_index(a, b)];
+                assert!(
+                    (got - exact).abs() <= 1e-14 * exact.abs(),
+                    "({a},{b}): {got} {exact}"
+                );
+                assert!((got - e.weighted_mass(&c, 0, a, b)).abs() <= 1e-15 * exact.abs());
+                assert_eq!(sym_index(a, b), sym_index(b, a));
+            }
+        }
     }
 
     #[test]

@@ -328,7 +328,7 @@ impl Model {
             assemble_stiffness_and_mass(mesh, &dofs, adj, &pattern, t, consistent_h);
         let body = assemble_body(mesh, adj, &loads, &dofs, &upper, l_consistent, NAMES_UPPER)?;
         let load = data.load;
-        let mut d = loads.vector(load);
+        let (mut d, total_load) = loads.vector_and_integral(load);
         if let Some(i) = crate::sparse::first_non_finite(&d) {
             let p = mesh.points[dofs.vertex[i] as usize];
             return Err(Error::Data(format!(
@@ -336,7 +336,6 @@ impl Model {
                 p[0], p[1]
             )));
         }
-        let total_load = loads.integral(load);
         // Boundary heights and the lifting S_fix G.
         let (boundary_values, lift) = match (&ext.boundary, &fixed) {
             (Some(b), Some(f)) => {
