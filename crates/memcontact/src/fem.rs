@@ -83,26 +83,25 @@ impl Element {
         self.area * (self.grad[a][0] * self.grad[b][0] + self.grad[a][1] * self.grad[b][1])
     }
 
-    /// `∫_T c λ_a λ_b` (exact for constant c on the region, degree-5 quadrature otherwise).
+    /// `∫_T c λ_a λ_b` (exact for constant c on the region, degree-5 quadrature otherwise):
+    /// entry (a, b) of [`Element::weighted_mass_matrix`].
     #[inline]
     pub fn weighted_mass(&self, c: &dyn Coefficient, region: u32, a: usize, b: usize) -> f64 {
-        match c.on_region(region) {
-            Some(v) => v * self.area * if a == b { 1.0 / 6.0 } else { 1.0 / 12.0 },
-            None => {
-                self.area
-                    * DEGREE5
-                        .iter()
-                        .map(|(l, w)| w * c.at(map(&self.corners, l), region) * l[a] * l[b])
-                        .sum::<f64>()
-            }
-        }
+        self.weighted_mass_matrix(c, region)[sym_index(a, b)]
     }
 
-    /// The element matrix `∫_T c λ_a λ_b` by degree-5 quadrature, with c evaluated once
-    /// per quadrature point for the whole matrix: the entries (a, b) with a ≤ b, in the
-    /// order of [`sym_index`] (the matrix is exactly symmetric).
+    /// The element matrix `∫_T c λ_a λ_b`: the entries (a, b) with a ≤ b, in the order of
+    /// [`sym_index`] (the matrix is exactly symmetric). Exact for c constant on the region
+    /// (`|T| c / 6` on the diagonal, `|T| c / 12` off it), else degree-5 quadrature with c
+    /// evaluated once per point for the whole matrix.
     pub fn weighted_mass_matrix(&self, c: &dyn Coefficient, region: u32) -> [f64; 6] {
-        let values = DEGREE5.map(|(l, _)| c.at(map(&self.corners, &l), region));
+        let values = match c.on_region(region) {
+            Some(v) => {
+                let (d, o) = (v * self.area * (1.0 / 6.0), v * self.area * (1.0 / 12.0));
+                return [d, o, o, d, o, d];
+            }
+            None => self.quadrature_values(c, region),
+        };
         let entry = |a: usize, b: usize| {
             self.area
                 * DEGREE5
@@ -121,14 +120,14 @@ impl Element {
         ]
     }
 
-    /// `∫_T c λ_a` for a = 0, 1, 2: [`Element::weighted_load`] of the three corners, with c
-    /// evaluated once per quadrature point (the same sums, term by term).
+    /// `∫_T c λ_a` for a = 0, 1, 2: `|T| c / 3` for c constant on the region, else
+    /// degree-5 quadrature with c evaluated once per point for the three corners.
     #[inline]
     pub fn weighted_load_row(&self, c: &dyn Coefficient, region: u32) -> [f64; 3] {
         match c.on_region(region) {
-            Some(_) => [0, 1, 2].map(|a| self.weighted_load(c, region, a)),
+            Some(v) => [v * self.area / 3.0; 3],
             None => {
-                let values = DEGREE5.map(|(l, _)| c.at(map(&self.corners, &l), region));
+                let values = self.quadrature_values(c, region);
                 [0, 1, 2].map(|a| {
                     self.area
                         * DEGREE5
@@ -141,19 +140,16 @@ impl Element {
         }
     }
 
-    /// `∫_T c λ_a` (exact for constant c, degree-5 quadrature otherwise).
+    /// `∫_T c λ_a`: corner a of [`Element::weighted_load_row`].
     #[inline]
     pub fn weighted_load(&self, c: &dyn Coefficient, region: u32, a: usize) -> f64 {
-        match c.on_region(region) {
-            Some(v) => v * self.area / 3.0,
-            None => {
-                self.area
-                    * DEGREE5
-                        .iter()
-                        .map(|(l, w)| w * c.at(map(&self.corners, l), region) * l[a])
-                        .sum::<f64>()
-            }
-        }
+        self.weighted_load_row(c, region)[a]
+    }
+
+    /// c at the points of the degree-5 rule ([`DEGREE5`]) on this triangle.
+    #[inline]
+    fn quadrature_values(&self, c: &dyn Coefficient, region: u32) -> [f64; 7] {
+        DEGREE5.map(|(l, _)| c.at(map(&self.corners, &l), region))
     }
 }
 
