@@ -580,6 +580,15 @@ impl DofMap {
         DofMap::with_adjacency(mesh, &VertexTriangles::new(mesh))
     }
 
+    /// `n` unknowns on `n` vertices, all interior: the unknowns of a level that is no mesh
+    /// (an aggregation level of algebraic multigrid).
+    pub fn all(n: usize) -> DofMap {
+        DofMap {
+            vertex: (0..n as u32).collect(),
+            dof: (0..n as u32).map(Some).collect(),
+        }
+    }
+
     /// [`DofMap::new`] with a prebuilt vertex → triangles adjacency.
     pub fn with_adjacency(mesh: &Mesh, adj: &VertexTriangles) -> DofMap {
         let boundary = mesh.boundary_vertices_with(adj);

@@ -221,6 +221,18 @@ pub fn hierarchy(a: &Csr, coarsest: usize) -> (Vec<Transfer>, Vec<usize>, Vec<Ar
     (transfers, sizes, patterns)
 }
 
+/// The factor by which nested iteration scales the Galerkin stiffness `PᵀSP` of an
+/// aggregation step from `n_fine` to `n_coarse` unknowns. A piecewise-constant function on
+/// aggregates m vertices across carries its slope in jumps one element wide, so its energy
+/// is about m times that of the smooth function it stands for, and the coarse minimiser
+/// would deflect m times too little; m ≈ √(n_fine / n_coarse). The foundation and load
+/// terms hold no derivative and need no factor. (The same overestimate is why plain
+/// aggregation needs over-corrected or Krylov-accelerated cycles: D. Braess, "Towards
+/// algebraic multigrid for elliptic problems of second order", Computing 55 (1995).)
+pub fn stiffness_scale(n_fine: usize, n_coarse: usize) -> f64 {
+    (n_coarse as f64 / n_fine as f64).sqrt()
+}
+
 /// `PᵀAP` on its own pattern.
 fn galerkin(a: &Csr, t: &Transfer) -> Csr {
     let pattern: Pattern = t.galerkin_pattern(&a.pattern);

@@ -24,7 +24,11 @@
 //! refinement. **Nested iteration**: the problem is first solved on the coarser levels,
 //! with the Galerkin restriction of the model (`S_c = PᵀSP`, `L_c = PᵀLP` or `l_c = Pᵀl`,
 //! `D_c = PᵀD`: exactly the coarse discretisation for nested meshes; φ injected at the
-//! coarse vertices), and each solution prolongated as the start of the next level.
+//! coarse vertices), and each solution prolongated as the start of the next level. On
+//! algebraic levels the aggregates play the coarse vertices (φ taken at one vertex of
+//! each) and `S_c` is scaled for the energy that piecewise constants overstate
+//! ([`aggregation::stiffness_scale`]); the coarse answers are only starts, so the finest
+//! level, where the model itself is solved and certified, is unchanged by either choice.
 
 pub mod aggregation;
 pub mod cycle;
@@ -73,7 +77,8 @@ pub struct Options {
     pub krylov_steps: usize,
     /// (pre, post) Gauss-Seidel steps per level inside a V-cycle.
     pub smoothing: (usize, usize),
-    /// Solve the coarser levels first and start from the prolongated solution.
+    /// Solve the coarser levels (geometric or algebraic) first and start from the
+    /// prolongated solution.
     pub nested: bool,
     /// Scaled KKT residual to which the coarser levels are solved in nested iteration
     /// (never below `settings.tolerance`). A start only needs the accuracy the prolongation
@@ -187,8 +192,8 @@ fn setup_matrix(model: &Model) -> Csr {
     a
 }
 
-/// [`solve`] with explicit options, also returning the per-level report. Nested iteration
-/// runs on geometric hierarchies only (aggregates are no meshes to restrict φ to).
+/// [`solve`] with explicit options, also returning the per-level report (one entry per
+/// level solved: all of them with nested iteration).
 pub fn solve_with(
     model: &Model,
     coarsening: Coarsening,
@@ -208,7 +213,7 @@ pub fn solve_with(
     let mut history = Vec::new();
 
     // Nested iteration: the Galerkin models of the coarser levels, coarsest first.
-    let first = if options.nested && start.is_none() && levels.kind == Kind::Geometric {
+    let first = if options.nested && start.is_none() {
         0
     } else {
         top
@@ -306,7 +311,8 @@ pub fn solve_with(
 }
 
 /// The Galerkin restriction of `fine` to level `k` of `levels` (`t` prolongates level `k`
-/// to the fine one): the coarse discretisation of the same problem for nested meshes.
+/// to the fine one): the coarse discretisation of the same problem for nested meshes; on
+/// aggregates, the piecewise-constant restriction with the stiffness scaled.
 fn coarse_model(fine: &Model, t: &Transfer, levels: &Levels, k: usize) -> Model {
     let pattern = levels.patterns[k].clone();
     let galerkin = |a: &Csr| {
@@ -319,10 +325,14 @@ fn coarse_model(fine: &Model, t: &Transfer, levels: &Levels, k: usize) -> Model 
         t.restrict(x, &mut y);
         y
     };
-    let s = galerkin(&fine.s);
+    let mut s = galerkin(&fine.s);
+    if levels.kind == Kind::Algebraic {
+        let factor = aggregation::stiffness_scale(t.n_fine(), t.n_coarse);
+        par_rows(&mut s.val, |_, x| *x *= factor);
+    }
     let inject = t.injection();
     // One body's Galerkin restriction: L_c = PᵀLP (or l_c = Pᵀl), φ and the rigid flags
-    // injected at the coarse vertices.
+    // injected at the coarse vertices (on aggregates: at the first vertex of weight 1).
     let body = |l: &FoundationMatrix, phi: &[f64], rigid: Option<&Vec<bool>>| {
         let l = match l {
             FoundationMatrix::Consistent(l) => FoundationMatrix::Consistent(galerkin(l)),
@@ -351,7 +361,10 @@ fn coarse_model(fine: &Model, t: &Transfer, levels: &Levels, k: usize) -> Model 
             epsilon: low.epsilon,
         }
     });
-    let dofs = levels.dofs[k].clone();
+    let dofs = match levels.kind {
+        Kind::Geometric => levels.dofs[k].clone(),
+        Kind::Algebraic => crate::mesh::DofMap::all(t.n_coarse),
+    };
     let phi_vertices = dofs.to_vertices(&phi, 0.0);
     Model {
         d: restrict(&fine.d),
