@@ -72,8 +72,8 @@ pub struct Options {
     /// Once the vertex states (nearly) repeat from one iteration to the next, up to this
     /// many flexible CG steps preconditioned by the cycle per Newton correction. The
     /// correction is inexact Newton: its linear residual is driven below the square of the
-    /// current scaled KKT residual (a quarter of the tolerance at the end). 0: `cycles`
-    /// plain cycles, always.
+    /// current scaled KKT residual, or a quarter of the tolerance once that square comes
+    /// near it (see [`forcing`]). 0: `cycles` plain cycles, always.
     pub krylov_steps: usize,
     /// (pre, post) Gauss-Seidel steps per level inside a V-cycle.
     pub smoothing: (usize, usize),
@@ -387,6 +387,25 @@ fn coarse_model(fine: &Model, t: &Transfer, levels: &Levels, k: usize) -> Model 
     }
 }
 
+/// Within this factor of the tolerance, the square of the scaled KKT residual (what the next
+/// Newton iteration would reach) sends the Newton correction straight to the tolerance.
+const FINISH_FACTOR: f64 = 1e3;
+
+/// The inexact Newton forcing term, in scaled KKT units, once the vertex states repeat: the
+/// linear residual is driven below the square of the current KKT residual (quadratic
+/// convergence without oversolving), and below a quarter of the tolerance once that square
+/// is within [`FINISH_FACTOR`] of it. On the answer's piece of J the Newton step is then the
+/// answer, and the iteration that would only have finished the linear solve is saved; off
+/// it, the extra accuracy costs a few Krylov steps (at most a factor 4·10³ more reduction).
+fn forcing(kkt: f64, tolerance: f64) -> f64 {
+    let quadratic = kkt.min(0.5).powi(2);
+    if quadratic <= FINISH_FACTOR * tolerance {
+        0.25 * tolerance
+    } else {
+        quadratic
+    }
+}
+
 /// Evaluates `$body` with `$op` bound to the Newton matrix `$a` ([`NewtonMatrix`]) of
 /// `$model` at the states `$st`, as a multigrid top-level operator of its own type (the
 /// kernels are compiled for each form).
@@ -515,14 +534,10 @@ fn level_solve(ls: LevelSolve) -> Result<(usize, f64, Option<Certificate>)> {
             par_rows(&mut g, |_, x| *x = -*x);
             par_rows(&mut delta, |_, d| *d = 0.0);
             if options.krylov_steps > 0 {
-                // Inexact Newton: the linear residual is driven below a forcing term, the
-                // square of the current scaled KKT residual (a quarter of the tolerance at
-                // the end); until the states repeat, a few steps only.
+                // Inexact Newton once the states repeat ([`forcing`]); until then, a few
+                // steps only.
                 let (eta, steps) = if settled {
-                    (
-                        kkt.min(0.5).powi(2).max(0.25 * tolerance),
-                        options.krylov_steps,
-                    )
+                    (forcing(kkt, tolerance), options.krylov_steps)
                 } else {
                     (0.0, options.cycles)
                 };
