@@ -97,8 +97,8 @@ impl Element {
     pub fn weighted_mass_matrix(&self, c: &dyn Coefficient, region: u32) -> [f64; 6] {
         let values = match c.on_region(region) {
             Some(v) => {
-                let (d, o) = (v * self.area * (1.0 / 6.0), v * self.area * (1.0 / 12.0));
-                return [d, o, o, d, o, d];
+                let (d, o) = (mass_fraction(0, 0), mass_fraction(0, 1));
+                return [d, o, o, d, o, d].map(|f| v * self.area * f);
             }
             None => self.quadrature_values(c, region),
         };
@@ -150,6 +150,16 @@ impl Element {
     #[inline]
     fn quadrature_values(&self, c: &dyn Coefficient, region: u32) -> [f64; 7] {
         DEGREE5.map(|(l, _)| c.at(map(&self.corners, &l), region))
+    }
+}
+
+/// `∫_T λ_a λ_b / |T|`: 1/6 on the diagonal, 1/12 off it (the P1 mass matrix).
+#[inline]
+fn mass_fraction(a: usize, b: usize) -> f64 {
+    if a == b {
+        1.0 / 6.0
+    } else {
+        1.0 / 12.0
     }
 }
 
@@ -347,13 +357,9 @@ pub fn assemble_stiffness_and_mass(
                         let pos = position(cols, j);
                         s_block[range.start + pos] +=
                             scale * (e[a][0] * e[b][0] + e[a][1] * e[b][1]);
-                        if let (Some(lb), Some(_)) = (l_block.as_deref_mut(), h) {
+                        if let Some(lb) = l_block.as_deref_mut() {
                             lb[range.start + pos] += match h_const {
-                                Some(hc) => {
-                                    hc * 0.5
-                                        * two_area
-                                        * if a == b { 1.0 / 6.0 } else { 1.0 / 12.0 }
-                                }
+                                Some(hc) => hc * 0.5 * two_area * mass_fraction(a, b),
                                 None => masses[k as usize][sym_index(a, b)],
                             };
                         }

@@ -15,7 +15,7 @@
 use super::multigrid::transfer::{par_rows, PAR_ROWS};
 use crate::model::{FoundationMatrix, Model};
 use crate::sparse::row_chunks;
-use crate::sparse::{filled, Csr, Pattern};
+use crate::sparse::{filled, zeroed, Csr, Pattern};
 use rayon::prelude::*;
 
 /// The states of the truncated Newton step at V: which vertices are held (touching, or at
@@ -138,7 +138,7 @@ impl NewtonMatrix {
         if consistent(&model.l) || model.lower.as_ref().is_some_and(|b| consistent(&b.l)) {
             NewtonMatrix::Assembled(Csr::zeros(model.s.pattern.clone()))
         } else {
-            NewtonMatrix::Diagonal(crate::sparse::zeroed(model.n()))
+            NewtonMatrix::Diagonal(zeroed(model.n()))
         }
     }
 

@@ -22,7 +22,7 @@ use super::operator::{apply, values_into, zero_held, TopOperator};
 use super::transfer::{galerkin_patterns, par_copy_from, par_rows, Transfer};
 use crate::mesh::refine::{Hierarchy, Refinement};
 use crate::mesh::{DofMap, Mesh};
-use crate::sparse::{filled, Cholesky, Csr, Pattern};
+use crate::sparse::{filled, zeroed, Cholesky, Csr, Pattern};
 use crate::{Error, Result};
 use std::sync::Arc;
 
@@ -250,7 +250,7 @@ impl<'a> Multigrid<'a> {
         let coarse: Vec<Csr> = (0..top)
             .map(|k| Csr::zeros(levels.patterns[k].clone()))
             .collect();
-        let zeros = |k: usize| crate::sparse::zeroed(levels.n(k));
+        let zeros = |k: usize| zeroed(levels.n(k));
         Multigrid {
             levels,
             top,
@@ -775,7 +775,7 @@ impl FcgWork {
         for v in [&mut self.z, &mut self.p, &mut self.ap, &mut self.az] {
             if v.len() != n {
                 // Written on all threads (the first use of fresh pages).
-                *v = crate::sparse::zeroed(n);
+                *v = zeroed(n);
             }
         }
     }
