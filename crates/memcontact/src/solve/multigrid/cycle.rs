@@ -905,6 +905,42 @@ fn row_sum(cols: &[u32], vals: &[f64], x: impl Fn(usize) -> f64) -> f64 {
     s0 + s1
 }
 
+/// Whether the sorted columns `cols` all lie in `lo..hi` (a row of a smoothing block that
+/// does not couple to another block: the hybrid sweeps need not look where its columns are).
+#[inline(always)]
+fn within(cols: &[u32], lo: usize, hi: usize) -> bool {
+    match (cols.first(), cols.last()) {
+        (Some(&f), Some(&l)) => f as usize >= lo && (l as usize) < hi,
+        _ => true,
+    }
+}
+
+/// Row `cols`/`vals` times the current iterate of a hybrid sweep over the block starting at
+/// `lo`: the block's own values `xs`, and `outside` elsewhere (not looked at when the row
+/// is `inside` its block, [`within`]).
+#[inline(always)]
+fn block_row_sum(
+    cols: &[u32],
+    vals: &[f64],
+    lo: usize,
+    xs: &[f64],
+    outside: &[f64],
+    inside: bool,
+) -> f64 {
+    if inside {
+        row_sum(cols, vals, |j| xs[j - lo])
+    } else {
+        let hi = lo + xs.len();
+        row_sum(cols, vals, |j| {
+            if j >= lo && j < hi {
+                xs[j - lo]
+            } else {
+                outside[j]
+            }
+        })
+    }
+}
+
 /// One Gauss-Seidel sweep for `A x = b` (rows with `inv_diag = 0` skipped), forward or
 /// backward. Up to one block ([`gs_block`]) of unknowns it is the classical sweep; beyond, the rows are cut
 /// into such blocks that are swept in parallel, each by Gauss-Seidel inside the
@@ -930,13 +966,10 @@ pub(crate) fn gauss_seidel<A: TopOperator>(
                 return;
             }
             let (s, e) = (pat.row_ptr[i], pat.row_ptr[i + 1]);
-            let ax = row_sum(&pat.col[s..e], &a.val[s..e], |j| {
-                if j >= lo && j < hi {
-                    xs[j - lo]
-                } else {
-                    outside[j]
-                }
-            }) + shift_term(op, i, xs[i - lo]);
+            let (cols, vals) = (&pat.col[s..e], &a.val[s..e]);
+            let inside = within(cols, lo, hi);
+            let ax =
+                block_row_sum(cols, vals, lo, xs, outside, inside) + shift_term(op, i, xs[i - lo]);
             xs[i - lo] += (b[i] - ax) * d;
         };
         if backward {
@@ -1000,13 +1033,22 @@ pub(crate) fn gauss_seidel_from_zero<A: TopOperator>(
     let pat = &a.pattern;
     let n = x.len();
     let sweep = |lo: usize, xs: &mut [f64], rs: &mut [f64]| {
-        for (k, i) in (lo..lo + xs.len()).enumerate() {
+        let hi = lo + xs.len();
+        for (k, i) in (lo..hi).enumerate() {
             let (s, e) = (pat.row_ptr[i], pat.row_ptr[i + 1]);
             let (cols, vals) = (&pat.col[s..e], &a.val[s..e]);
             // Columns are sorted: those of the block before i are `first..diag` (the ones
             // before the block, and i's later neighbours, are still 0 in this sweep).
-            let first: usize = cols.iter().map(|&c| ((c as usize) < lo) as usize).sum();
-            let diag: usize = cols.iter().map(|&c| ((c as usize) < i) as usize).sum();
+            let first: usize = if within(cols, lo, hi) {
+                0
+            } else {
+                cols.iter().map(|&c| ((c as usize) < lo) as usize).sum()
+            };
+            let diag = first
+                + cols[first..]
+                    .iter()
+                    .take_while(|&&c| (c as usize) < i)
+                    .count();
             let (lc, lv) = (&cols[first..diag], &vals[first..diag]);
             let lower: f64 = lc
                 .iter()
@@ -1110,13 +1152,8 @@ pub(crate) fn gauss_seidel_back_with_product<A: TopOperator>(
             let i = lo + k;
             let (s, e) = (pat.row_ptr[i], pat.row_ptr[i + 1]);
             let (cols, vals) = (&pat.col[s..e], &a.val[s..e]);
-            let ax = row_sum(cols, vals, |j| {
-                if j >= lo && j < hi {
-                    xs[j - lo]
-                } else {
-                    outside[j]
-                }
-            }) + shift_term(op, i, xs[k]);
+            let inside = within(cols, lo, hi);
+            let ax = block_row_sum(cols, vals, lo, xs, outside, inside) + shift_term(op, i, xs[k]);
             let d = inv[i];
             if d == 0.0 {
                 ys[k] = ax;
@@ -1125,8 +1162,12 @@ pub(crate) fn gauss_seidel_back_with_product<A: TopOperator>(
             let dx = (b[i] - ax) * d;
             xs[k] += dx;
             // Columns are sorted: i's later neighbours in the block are `diag + 1..last`.
-            let diag: usize = cols.iter().map(|&c| ((c as usize) < i) as usize).sum();
-            let last: usize = cols.iter().map(|&c| ((c as usize) < hi) as usize).sum();
+            let diag = cols.iter().take_while(|&&c| (c as usize) < i).count();
+            let last: usize = if inside {
+                cols.len()
+            } else {
+                cols.iter().map(|&c| ((c as usize) < hi) as usize).sum()
+            };
             let aii = match cols.get(diag) {
                 Some(&c) if c as usize == i => vals[diag] + shift_term(op, i, 1.0),
                 _ => 0.0,

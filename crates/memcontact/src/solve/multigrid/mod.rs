@@ -679,7 +679,17 @@ pub fn kernel_timings(
     time("gauss-seidel sweep", &mut || {
         cycle::gauss_seidel(&a, &inv, &mut delta, &rhs, &mut snap, false)
     });
+    let seams = cycle::seam_rows(&a.pattern);
     let mut res = vec![0.0; n];
+    time("sweep from zero + residual", &mut || {
+        cycle::gauss_seidel_from_zero(&a, &inv, &mut delta, &rhs, &mut res, &seams)
+    });
+    let mut prod = vec![0.0; n];
+    time("backward sweep + product", &mut || {
+        cycle::gauss_seidel_back_with_product(
+            &a, &inv, &mut delta, &rhs, &mut snap, &mut prod, &seams,
+        )
+    });
     time("residual", &mut || {
         cycle::residual(&a, &delta, &rhs, &mut res)
     });
