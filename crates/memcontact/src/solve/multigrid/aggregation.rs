@@ -326,6 +326,40 @@ mod tests {
         assert_eq!(many, one);
     }
 
+    /// The Galerkin product of an aggregation (one parent per unknown, read without the
+    /// second) is `(PᵀAP)_IJ = Σ a_vw` over v in aggregate I and w in J, rows left to the
+    /// smoother taking no part.
+    #[test]
+    fn aggregation_galerkin_sums_the_couplings_between_aggregates() {
+        let mut a = lap2d(30);
+        let k = a.pattern.find(7, 7).unwrap();
+        a.val[k] = 1e6;
+        let (agg, n) = pairwise(&a);
+        assert_eq!(agg[7], NONE);
+        let t = Transfer::aggregation(&agg, n);
+        assert!(t.single_parent);
+        let c = galerkin(&a, &t);
+        let mut expected = vec![vec![0.0; n]; n];
+        for v in 0..a.n() {
+            let (cols, vals) = a.row(v);
+            for (&w, &x) in cols.iter().zip(vals) {
+                let (i, j) = (agg[v], agg[w as usize]);
+                if i != NONE && j != NONE {
+                    expected[i as usize][j as usize] += x;
+                }
+            }
+        }
+        for (i, row) in expected.iter().enumerate() {
+            for (j, &e) in row.iter().enumerate() {
+                assert!(
+                    (c.get(i, j) - e).abs() <= 1e-12,
+                    "({i}, {j}): {} vs {e}",
+                    c.get(i, j)
+                );
+            }
+        }
+    }
+
     #[test]
     fn dominant_rows_are_left_to_the_smoother() {
         let mut a = lap2d(10);

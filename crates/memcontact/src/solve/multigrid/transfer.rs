@@ -39,6 +39,9 @@ pub struct Transfer {
     pub children: Vec<u32>,
     /// `P[child, I]` for every entry of `children` (exact in single precision).
     pub child_weights: Vec<f32>,
+    /// Every fine unknown has at most one parent (an aggregation): the second parents
+    /// need not be visited.
+    pub single_parent: bool,
 }
 
 impl Transfer {
@@ -119,6 +122,7 @@ impl Transfer {
         });
         let children = entries.par_iter().with_min_len(4096).map(|e| e.0).collect();
         let child_weights = entries.par_iter().with_min_len(4096).map(|e| e.1).collect();
+        let single_parent = weights.par_iter().with_min_len(4096).all(|w| w[1] == 0.0);
         Transfer {
             n_coarse,
             parents,
@@ -126,6 +130,7 @@ impl Transfer {
             child_ptr,
             children,
             child_weights,
+            single_parent,
         }
     }
 
@@ -268,7 +273,9 @@ impl Transfer {
                     if w0 != 0.0 {
                         vals[marker[p0 as usize] as usize] += a * w0;
                         // A dropped second parent repeats the first with weight 0.
-                        vals[marker[p1 as usize] as usize] += a * w1;
+                        if !self.single_parent {
+                            vals[marker[p1 as usize] as usize] += a * w1;
+                        }
                     }
                 }
             }
