@@ -331,9 +331,7 @@ mod tests {
     /// smoother taking no part.
     #[test]
     fn aggregation_galerkin_sums_the_couplings_between_aggregates() {
-        let mut a = lap2d(30);
-        let k = a.pattern.find(7, 7).unwrap();
-        a.val[k] = 1e6;
+        let a = lap2d_with_stiff_row(30, 7);
         let (agg, n) = pairwise(&a);
         assert_eq!(agg[7], NONE);
         let t = Transfer::aggregation(&agg, n);
@@ -360,12 +358,17 @@ mod tests {
         }
     }
 
+    /// [`lap2d`] with a huge diagonal in `row` (a stiff foundation there).
+    fn lap2d_with_stiff_row(m: usize, row: usize) -> Csr {
+        let mut a = lap2d(m);
+        let k = a.pattern.find(row, row).unwrap();
+        a.val[k] = 1e6;
+        a
+    }
+
     #[test]
     fn dominant_rows_are_left_to_the_smoother() {
-        let mut a = lap2d(10);
-        // Row 0 gets a huge diagonal (a stiff foundation).
-        let k = a.pattern.find(0, 0).unwrap();
-        a.val[k] = 1e6;
+        let a = lap2d_with_stiff_row(10, 0);
         let (agg, n) = pairwise(&a);
         assert_eq!(agg[0], NONE);
         assert!(agg[1..].iter().all(|&g| (g as usize) < n));
