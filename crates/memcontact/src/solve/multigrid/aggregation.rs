@@ -176,7 +176,25 @@ fn pairwise_range(a: &Csr, lo: usize, hi: usize) -> (Vec<u32>, usize) {
         }
         count += 1;
     }
+    number_in_row_order(&mut agg, count as usize);
     (agg, count as usize)
+}
+
+/// Renumbers the aggregates `agg` (`NONE` for none) by their first row, so that the coarse
+/// unknowns follow the fine rows' order: the matching numbers them in the order the bucket
+/// queue visits them, scattered over the rows, and the coarse levels would lose the
+/// fine level's locality (in the Galerkin products, the transfers and the smoothing sweeps).
+fn number_in_row_order(agg: &mut [u32], count: usize) {
+    let mut new = vec![NONE; count];
+    let mut next = 0u32;
+    for g in agg.iter_mut().filter(|g| **g != NONE) {
+        let slot = &mut new[*g as usize];
+        if *slot == NONE {
+            *slot = next;
+            next += 1;
+        }
+        *g = *slot;
+    }
 }
 
 /// The transfers of an aggregation hierarchy for the operator `a` (finest level), coarsest
@@ -313,6 +331,28 @@ mod tests {
             for &v in m {
                 assert!(m.len() == 1 || m.iter().any(|&u| u != v && a.get(u, v) != 0.0));
             }
+        }
+    }
+
+    /// Aggregates are numbered in the order of their first rows (the coarse unknowns keep
+    /// the fine rows' locality), in one matching and by blocks.
+    #[test]
+    fn aggregates_are_numbered_in_row_order() {
+        for m in [60, 400] {
+            let a = lap2d_with_stiff_row(m, 3);
+            let (agg, n) = pairwise(&a);
+            let firsts: Vec<u32> =
+                agg.iter()
+                    .copied()
+                    .filter(|&g| g != NONE)
+                    .fold(Vec::new(), |mut seen, g| {
+                        if g as usize >= seen.len() {
+                            seen.push(g);
+                        }
+                        seen
+                    });
+            // Each aggregate first met is the next number.
+            assert_eq!(firsts, (0..n as u32).collect::<Vec<_>>());
         }
     }
 
