@@ -152,29 +152,32 @@ impl Raw {
         // by sorting (node tags may be sparse and unordered).
         let lookup = TagLookup::new(&nodes).map_err(ParseOrMesh::Parse)?;
         let mut new_index = vec![u32::MAX; nodes.len()];
-        let resolved: Vec<std::result::Result<[u32; 3], String>> = {
+        let resolve = |t: &[u64; 3]| -> Option<[u32; 3]> {
+            Some([lookup.find(t[0])?, lookup.find(t[1])?, lookup.find(t[2])?])
+        };
+        // Straight into the triangle array on all threads; a missing node is then named
+        // by a scan in file order (the first triangle that references one).
+        let resolved: Option<Vec<[u32; 3]>> = {
             use rayon::prelude::*;
             triangles
                 .par_iter()
                 .with_min_len(8192)
-                .map(|(etag, t, _)| {
-                    let mut out = [0u32; 3];
-                    for (o, &n) in out.iter_mut().zip(t) {
-                        *o = lookup.find(n).ok_or_else(|| {
-                            format!(
-                                "$Elements: triangle {etag} references node {n}, which is not \
-                                 in $Nodes"
-                            )
-                        })?;
-                    }
-                    Ok(out)
-                })
+                .map(|(_, t, _)| resolve(t))
                 .collect()
         };
-        let mut tris = Vec::with_capacity(triangles.len());
-        for r in resolved {
-            tris.push(r.map_err(ParseOrMesh::Parse)?);
-        }
+        let Some(mut tris) = resolved else {
+            let (etag, n) = triangles
+                .iter()
+                .find_map(|(etag, t, _)| {
+                    t.iter()
+                        .find(|&&n| lookup.find(n).is_none())
+                        .map(|&n| (*etag, n))
+                })
+                .expect("a triangle references a missing node");
+            return Err(ParseOrMesh::Parse(format!(
+                "$Elements: triangle {etag} references node {n}, which is not in $Nodes"
+            )));
+        };
         let regions: Vec<u32> = triangles.iter().map(|t| t.2).collect();
         drop(triangles);
         // Keep the used nodes, in file order (usually all of them: then nothing moves).

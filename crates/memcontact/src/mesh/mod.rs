@@ -260,49 +260,43 @@ impl Mesh {
     fn check_edges(&self) -> Result<()> {
         use rayon::prelude::*;
         let n = self.points.len();
-        // Out-edges a → b of every vertex a, with their triangle: (b, k), in triangle order.
+        // Out-edges a → b of every vertex a (the head b alone: the triangles of an edge
+        // found wrong are looked up afterwards).
         let (ptr, out) = crate::sparse::group_by_key(n, self.triangles.len(), |k| {
             let t = self.triangles[k];
-            [0, 1, 2].map(|e| Some((t[e], (t[(e + 1) % 3], k as u32))))
+            [0, 1, 2].map(|e| Some((t[e], t[(e + 1) % 3])))
         });
         let repeated = (0..n)
             .into_par_iter()
             .with_min_len(4096)
             .filter_map(|a| {
                 let list = &out[ptr[a]..ptr[a + 1]];
-                let mut best: Option<(u32, u32, u32, u32)> = None;
-                for (i, &(b, k)) in list.iter().enumerate() {
-                    if let Some(&(_, k2)) = list[i + 1..].iter().find(|e| e.0 == b) {
-                        let key = (a as u32).min(b);
-                        let cand = (key, (a as u32).max(b), k.min(k2), k.max(k2));
-                        best = Some(best.map_or(cand, |c| c.min(cand)));
-                    }
-                }
-                best
+                let a = a as u32;
+                list.iter()
+                    .enumerate()
+                    .filter(|&(i, b)| list[i + 1..].contains(b))
+                    .map(|(_, &b)| (a.min(b), a.max(b)))
+                    .min()
             })
             .min();
-        let Some((a, b, k1, k2)) = repeated else {
+        let Some((a, b)) = repeated else {
             return Ok(());
         };
         // All the triangles on the edge: three or more is non-manifold, else a fold.
-        let users: Vec<u32> = [(a, b), (b, a)]
-            .iter()
-            .flat_map(|&(p, q)| {
-                out[ptr[p as usize]..ptr[p as usize + 1]]
-                    .iter()
-                    .filter(move |e| e.0 == q)
-                    .map(|e| e.1)
+        let users: Vec<u32> = (0..self.triangles.len() as u32)
+            .filter(|&k| {
+                let t = self.triangles[k as usize];
+                t.contains(&a) && t.contains(&b)
             })
             .collect();
         if users.len() > 2 {
-            let mut users = users;
-            users.sort_unstable();
             Err(Error::Mesh(format!(
                 "edge ({a}, {b}) is non-manifold: shared by triangles {users:?}"
             )))
         } else {
             Err(Error::Mesh(format!(
-                "triangles {k1} and {k2} overlap across edge ({a}, {b})"
+                "triangles {} and {} overlap across edge ({a}, {b})",
+                users[0], users[1]
             )))
         }
     }
@@ -918,9 +912,16 @@ mod tests {
             BTreeMap::new(),
         )
         .unwrap_err();
-        assert!(
-            e.to_string().contains("non-manifold") || e.to_string().contains("overlap"),
-            "{e}"
+        assert_eq!(
+            e.to_string(),
+            "mesh: edge (0, 1) is non-manifold: shared by triangles [0, 1, 2]"
+        );
+        // A fold: two triangles on the same side of an edge, traversing it alike.
+        let p5 = vec![[0.0, 0.0], [1.0, 0.0], [0.5, 1.0], [0.4, 0.5]];
+        let e = Mesh::new(p5, vec![[0, 1, 2], [0, 1, 3]], vec![], BTreeMap::new()).unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "mesh: triangles 0 and 1 overlap across edge (0, 1)"
         );
     }
 }
