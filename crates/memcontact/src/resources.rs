@@ -49,17 +49,47 @@ pub const MESH_FILE: InputKind = InputKind {
 /// still refused, not read without end).
 pub fn read_input(path: &Path, kind: InputKind) -> Result<Vec<u8>> {
     let (file, size) = open_input(path, kind)?;
+    let cannot = |e: std::io::Error| Error::File {
+        path: path.to_path_buf(),
+        message: format!("cannot read: {e}"),
+    };
+    #[cfg(unix)]
+    if size >= PARALLEL_READ {
+        if let Some(bytes) = read_in_parts(&file, size).map_err(cannot)? {
+            return Ok(bytes);
+        }
+    }
     let mut bytes = Vec::with_capacity(size as usize);
     file.take(kind.cap + 1)
         .read_to_end(&mut bytes)
-        .map_err(|e| Error::File {
-            path: path.to_path_buf(),
-            message: format!("cannot read: {e}"),
-        })?;
+        .map_err(cannot)?;
     if bytes.len() as u64 > kind.cap {
         return Err(too_big(path, kind, bytes.len() as u64));
     }
     Ok(bytes)
+}
+
+/// Files from this size on are read by [`read_in_parts`].
+#[cfg(unix)]
+const PARALLEL_READ: u64 = 16 << 20;
+
+/// The `size` bytes of a regular file read in one part per thread at once (copying a
+/// large mesh out of the page cache, and the first touch of the buffer, are shared by the
+/// cores). `None` when the file has grown since its size was taken: the caller then reads
+/// it to its end with the cap.
+#[cfg(unix)]
+fn read_in_parts(file: &std::fs::File, size: u64) -> std::io::Result<Option<Vec<u8>>> {
+    use rayon::prelude::*;
+    use std::os::unix::fs::FileExt;
+    let n = size as usize;
+    let mut bytes = vec![0u8; n];
+    let part = n.div_ceil(rayon::current_num_threads().max(1));
+    bytes
+        .par_chunks_mut(part)
+        .enumerate()
+        .try_for_each(|(k, chunk)| file.read_exact_at(chunk, (k * part) as u64))?;
+    let mut probe = [0u8; 1];
+    Ok((file.read_at(&mut probe, size)? == 0).then_some(bytes))
 }
 
 /// Opens an input file for reading as [`read_input`] does (a regular file of at most
@@ -374,6 +404,24 @@ mod tests {
         assert_eq!(parse_bytes("x"), None);
         assert_eq!(parse_bytes("-1M"), None);
         assert_eq!(human_bytes(3.0 * 1024.0 * 1024.0 * 1024.0), "3.00 GB");
+    }
+
+    #[test]
+    fn large_files_are_read_whole_in_parts() {
+        // Above the size read in parallel parts, and not a multiple of the part size.
+        let n = PARALLEL_READ as usize + 12_345;
+        let bytes: Vec<u8> = (0..n as u64)
+            .map(|i| (i.wrapping_mul(0x9E37_79B9_7F4A_7C15) >> 56) as u8)
+            .collect();
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("big.msh");
+        std::fs::write(&path, &bytes).unwrap();
+        for threads in [1, 2, 3] {
+            let read = crate::on_threads(threads, || read_input(&path, MESH_FILE)).unwrap();
+            assert!(read == bytes, "{threads} threads");
+        }
+        let e = read_input(&path, CASE_FILE).unwrap_err().to_string();
+        assert!(e.contains("big.msh"), "{e}");
     }
 
     #[test]
