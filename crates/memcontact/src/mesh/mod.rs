@@ -102,33 +102,37 @@ impl Mesh {
         if triangles.is_empty() {
             return Err(Error::Mesh("the mesh has no triangle".into()));
         }
-        for (i, p) in points.iter().enumerate() {
-            if !p[0].is_finite() || !p[1].is_finite() {
-                return Err(Error::Mesh(format!(
-                    "vertex {i} has a non-finite coordinate ({}, {})",
-                    p[0], p[1]
-                )));
-            }
+        // The first offending vertex and triangle, searched on all threads.
+        use rayon::prelude::*;
+        let bad_point = points
+            .par_iter()
+            .with_min_len(8192)
+            .position_first(|p| !p[0].is_finite() || !p[1].is_finite());
+        if let Some(i) = bad_point {
+            let p = points[i];
+            return Err(Error::Mesh(format!(
+                "vertex {i} has a non-finite coordinate ({}, {})",
+                p[0], p[1]
+            )));
         }
         let n = points.len();
-        for (k, t) in triangles.iter().enumerate() {
-            for &v in t {
-                if v as usize >= n {
-                    return Err(Error::Mesh(format!(
-                        "triangle {k} uses vertex {v}, but the mesh has only {n} vertices"
-                    )));
-                }
-            }
-            if t[0] == t[1] || t[1] == t[2] || t[0] == t[2] {
+        let bad_triangle = triangles.par_iter().with_min_len(8192).position_first(|t| {
+            t.iter().any(|&v| v as usize >= n) || t[0] == t[1] || t[1] == t[2] || t[0] == t[2]
+        });
+        if let Some(k) = bad_triangle {
+            let t = triangles[k];
+            if let Some(&v) = t.iter().find(|&&v| v as usize >= n) {
                 return Err(Error::Mesh(format!(
-                    "triangle {k} repeats a vertex: {:?}",
-                    t
+                    "triangle {k} uses vertex {v}, but the mesh has only {n} vertices"
                 )));
             }
+            return Err(Error::Mesh(format!(
+                "triangle {k} repeats a vertex: {:?}",
+                t
+            )));
         }
         // Degenerate and orientation checks: one parallel pass for the first degenerate
         // triangle and the number of clockwise ones.
-        use rayon::prelude::*;
         let (degenerate, negative) = triangles
             .par_iter()
             .enumerate()
@@ -859,6 +863,53 @@ mod tests {
         let p = vec![[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]];
         let m = Mesh::new(p, vec![[0, 2, 1]], vec![], BTreeMap::new()).unwrap();
         assert!(m.area(0) > 0.0);
+    }
+
+    #[test]
+    fn the_first_bad_vertex_or_triangle_is_named() {
+        // Enough rows for the parallel searches, with two faults each: the first is named.
+        let spec = generate::RectangleSpec {
+            x0: 0.0,
+            y0: 0.0,
+            x1: 1.0,
+            y1: 1.0,
+            nx: 200,
+            ny: 200,
+            diagonal: generate::Diagonal::Right,
+        };
+        let hierarchy = generate::rectangle(&spec).unwrap();
+        let mesh = hierarchy.finest();
+        let (n, m) = (mesh.points.len(), mesh.triangles.len());
+        let build = |points: Vec<Point>, triangles: Vec<[u32; 3]>| {
+            Mesh::new(points, triangles, vec![], BTreeMap::new())
+                .unwrap_err()
+                .to_string()
+        };
+        let mut p = mesh.points.clone();
+        p[30_000][1] = f64::NAN;
+        p[20_000][0] = f64::INFINITY;
+        let e = build(p, mesh.triangles.clone());
+        assert!(
+            e.contains("vertex 20000 has a non-finite coordinate (inf"),
+            "{e}"
+        );
+        let mut t = mesh.triangles.clone();
+        t[m - 10][2] = n as u32 + 5;
+        t[m - 20] = [7, 8, 7];
+        let e = build(mesh.points.clone(), t.clone());
+        assert!(
+            e.contains(&format!("triangle {} repeats a vertex: [7, 8, 7]", m - 20)),
+            "{e}"
+        );
+        t[m - 30][0] = n as u32;
+        let e = build(mesh.points.clone(), t);
+        assert!(
+            e.contains(&format!(
+                "triangle {} uses vertex {n}, but the mesh has only {n}",
+                m - 30
+            )),
+            "{e}"
+        );
     }
 
     #[test]
