@@ -341,18 +341,13 @@ mod tests {
         for m in [60, 400] {
             let a = lap2d_with_stiff_row(m, 3);
             let (agg, n) = pairwise(&a);
-            let firsts: Vec<u32> =
-                agg.iter()
-                    .copied()
-                    .filter(|&g| g != NONE)
-                    .fold(Vec::new(), |mut seen, g| {
-                        if g as usize >= seen.len() {
-                            seen.push(g);
-                        }
-                        seen
-                    });
-            // Each aggregate first met is the next number.
-            assert_eq!(firsts, (0..n as u32).collect::<Vec<_>>());
+            // In row order, an aggregate not met before has the next number.
+            let mut next = 0u32;
+            for (v, &g) in agg.iter().enumerate().filter(|(_, &g)| g != NONE) {
+                assert!(g <= next, "row {v}: aggregate {g} before {next}");
+                next += u32::from(g == next);
+            }
+            assert_eq!(next as usize, n);
         }
     }
 
