@@ -3,12 +3,13 @@
 //! neighbours: when neighbours are near in memory the pass runs from cache, when the order
 //! is scattered (a mesh generator's or another tool's numbering, the midpoints of a
 //! refinement) each neighbour is a miss. Meshes whose order is scattered are renumbered
-//! along a Hilbert curve through their vertices (triangles along the same curve through
-//! their centroids) before assembly; the outputs are mapped back to the user's order.
+//! along a Hilbert curve through their vertices (triangles by their first vertex on that
+//! curve) before assembly; the outputs are mapped back to the user's order.
 
 use super::refine::Hierarchy;
 use super::{Mesh, Point};
 use rayon::prelude::*;
+use std::sync::Arc;
 
 /// A permutation of `0..n`: `old_of_new[i]` is the old index of new entry `i`.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -104,13 +105,18 @@ impl Reordering {
     /// `mesh` (in the user's numbering) renumbered; the result records the renumbering in
     /// [`Mesh::numbering`].
     pub fn apply(&self, mesh: &Mesh) -> Mesh {
+        Arc::new(self.clone()).apply_shared(mesh)
+    }
+
+    /// [`Reordering::apply`] recording this shared renumbering (not a copy).
+    pub fn apply_shared(self: &Arc<Self>, mesh: &Mesh) -> Mesh {
         let v = &self.vertices;
         let mut m = self.map(
             mesh,
             (&v.new_of_old, &v.old_of_new),
             &self.triangles.old_of_new,
         );
-        m.numbering = Some(std::sync::Arc::new(self.clone()));
+        m.numbering = Some(self.clone());
         m
     }
 
@@ -263,6 +269,19 @@ fn curve_order(points: &[Point]) -> Vec<u32> {
     order_by_key(&keys)
 }
 
+/// The order of `triangles` by the first of their vertices in the new vertex order
+/// `vertices` (ties by index): each vertex's triangles come together, where its fan is
+/// assembled, and the triangles follow the vertices along the curve.
+fn triangle_order(triangles: &[[u32; 3]], vertices: &Permutation) -> Vec<u32> {
+    let new = &vertices.new_of_old;
+    let keys: Vec<u32> = triangles
+        .par_iter()
+        .with_min_len(8192)
+        .map(|t| t.map(|v| new[v as usize]).into_iter().min().unwrap_or(0))
+        .collect();
+    order_by_key(&keys)
+}
+
 /// Bits of the key sorted per pass of [`order_by_key`].
 const RADIX_BITS: u32 = 11;
 
@@ -328,7 +347,7 @@ pub fn edge_span(mesh: &Mesh) -> f64 {
 pub const LOCAL_SPAN: f64 = 4.0;
 
 /// The renumbering of `mesh` for locality: vertices along the Hilbert curve, triangles
-/// along it too (by centroid); `None` when the mesh's own order is already local
+/// by their first vertex on it; `None` when the mesh's own order is already local
 /// ([`LOCAL_SPAN`]: nothing is built, a structured mesh of millions of vertices needs no
 /// identity permutations).
 pub fn renumbering_for_locality(mesh: &Mesh) -> Option<Reordering> {
@@ -336,21 +355,7 @@ pub fn renumbering_for_locality(mesh: &Mesh) -> Option<Reordering> {
         return None;
     }
     let vertices = Permutation::from_order(curve_order(&mesh.points));
-    let centroids: Vec<Point> = mesh
-        .triangles
-        .par_iter()
-        .with_min_len(8192)
-        .map(|t| {
-            let c = |d: usize| {
-                (mesh.points[t[0] as usize][d]
-                    + mesh.points[t[1] as usize][d]
-                    + mesh.points[t[2] as usize][d])
-                    / 3.0
-            };
-            [c(0), c(1)]
-        })
-        .collect();
-    let triangles = Permutation::from_order(curve_order(&centroids));
+    let triangles = Permutation::from_order(triangle_order(&mesh.triangles, &vertices));
     Some(Reordering {
         vertices,
         triangles,
@@ -361,19 +366,22 @@ impl Hierarchy {
     /// Every level renumbered for locality ([`renumbering_for_locality`]), with the
     /// refinement relations renumbered to match; returns the renumberings, coarsest level
     /// first (`None` for a level kept in its order).
-    pub fn reordered(self) -> (Hierarchy, Vec<Option<Reordering>>) {
-        let orders: Vec<Option<Reordering>> =
-            self.levels.iter().map(renumbering_for_locality).collect();
+    pub fn reordered(self) -> (Hierarchy, Vec<Option<Arc<Reordering>>>) {
+        let orders: Vec<Option<Arc<Reordering>>> = self
+            .levels
+            .iter()
+            .map(|m| renumbering_for_locality(m).map(Arc::new))
+            .collect();
         if orders.iter().all(Option::is_none) {
             return (self, orders);
         }
         let levels: Vec<Mesh> = self
             .levels
-            .iter()
+            .into_iter()
             .zip(&orders)
             .map(|(m, r)| match r {
-                Some(r) => r.apply(m),
-                None => m.clone(),
+                Some(r) => r.apply_shared(&m),
+                None => m,
             })
             .collect();
         let refinements = self
@@ -479,6 +487,12 @@ mod tests {
         let r = renumbering_for_locality(&user).expect("a scrambled order is renumbered");
         let internal = r.apply(&user);
         assert!(edge_span(&internal) < 3.0, "{}", edge_span(&internal));
+        // Triangles follow their first vertex in the new order.
+        let first = |t: &[u32; 3]| t.iter().copied().min();
+        assert!(internal
+            .triangles
+            .windows(2)
+            .all(|w| first(&w[0]) <= first(&w[1])));
         // The same triangles (as point sets) with the same regions, and undone exactly.
         let back = r.undo(&internal);
         assert_eq!(back.points, user.points);
