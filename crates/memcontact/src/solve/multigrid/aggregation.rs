@@ -202,6 +202,7 @@ fn number_in_row_order(agg: &mut [u32], count: usize) {
 /// `a`'s), coarsest first. Coarsening stops at `coarsest` unknowns (see [`COARSEST`]), when
 /// a step no longer reduces the size enough, or at [`MAX_LEVELS`].
 pub fn hierarchy(a: &Csr, coarsest: usize) -> (Vec<Transfer>, Vec<usize>, Vec<Arc<Pattern>>) {
+    use rayon::prelude::*;
     let mut transfers: Vec<Transfer> = Vec::new();
     let mut sizes = vec![a.n()];
     let mut patterns = vec![a.pattern.clone()];
@@ -218,7 +219,8 @@ pub fn hierarchy(a: &Csr, coarsest: usize) -> (Vec<Transfer>, Vec<usize>, Vec<Ar
         let a1 = galerkin(fine, &t1);
         let (second, n2) = pairwise(&a1);
         let agg: Vec<u32> = first
-            .iter()
+            .par_iter()
+            .with_min_len(8192)
             .map(|&p| if p == NONE { NONE } else { second[p as usize] })
             .collect();
         if n2 == 0 || n2 as f64 > STAGNATION * n as f64 {

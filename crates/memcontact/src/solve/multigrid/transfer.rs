@@ -100,7 +100,8 @@ impl Transfer {
     /// (`aggregate[v] = u32::MAX`: a zero row of P).
     pub fn aggregation(aggregate: &[u32], n_coarse: usize) -> Transfer {
         let (parents, weights): (Vec<[u32; 2]>, Vec<[f32; 2]>) = aggregate
-            .iter()
+            .par_iter()
+            .with_min_len(8192)
             .map(|&a| {
                 if (a as usize) < n_coarse {
                     ([a, a], [1.0, 0.0])
