@@ -245,12 +245,12 @@ pub fn hierarchy(a: &Csr, coarsest: usize) -> (Vec<Transfer>, Vec<usize>, Vec<Ar
 /// aggregation step from `n_fine` to `n_coarse` unknowns. A piecewise-constant function on
 /// aggregates m vertices across carries its slope in jumps one element wide, so its energy
 /// is about m times that of the smooth function it stands for, and the coarse minimiser
-/// would deflect m times too little. m grows like √(n_fine / n_coarse); the exponent
-/// [`STIFFNESS_SCALE_EXPONENT`] is a little above ½ because aggregates are not squares. The
-/// foundation and load terms hold no derivative and need no factor. (The same overestimate
-/// is why plain aggregation needs over-corrected or Krylov-accelerated cycles: D. Braess,
-/// "Towards algebraic multigrid for elliptic problems of second order", Computing 55
-/// (1995).)
+/// would deflect m times too little. m grows like √(n_fine / n_coarse) for square
+/// aggregates; real ones are not square, and the exponent that serves best,
+/// [`STIFFNESS_SCALE_EXPONENT`], was measured a little above ½. The foundation and load
+/// terms hold no derivative and need no factor. (The same overestimate is why plain
+/// aggregation needs over-corrected or Krylov-accelerated cycles: D. Braess, "Towards
+/// algebraic multigrid for elliptic problems of second order", Computing 55 (1995).)
 pub fn stiffness_scale(n_fine: usize, n_coarse: usize) -> f64 {
     (n_coarse as f64 / n_fine as f64).powf(STIFFNESS_SCALE_EXPONENT)
 }
