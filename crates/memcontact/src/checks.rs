@@ -54,7 +54,11 @@ fn check_boundary_data_on(
     data: &ProblemData,
     ext: &Extensions,
 ) -> Result<()> {
-    let (fixed, heights) = crate::model::fixed_heights_on(mesh, adj, boundary, ext)?;
+    // Without boundary conditions of its own, the whole boundary is fixed at height 0.
+    let given = match ext.boundary {
+        Some(_) => Some(crate::model::fixed_heights_on(mesh, adj, boundary, ext)?),
+        None => None,
+    };
     let rigid_upper = |region: u32| {
         matches!(data.stiffness, Stiffness::Rigid) || ext.rigid_regions.contains(&region)
     };
@@ -63,7 +67,7 @@ fn check_boundary_data_on(
             continue;
         }
         let p = mesh.points[v];
-        let (fixed, g) = (fixed[v], heights[v]);
+        let (fixed, g) = given.as_ref().map_or((true, 0.0), |(f, g)| (f[v], g[v]));
         for &k in adj.of(v) {
             let region = mesh.regions[k as usize];
             let f = value(data.load, p, region);

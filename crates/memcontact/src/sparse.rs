@@ -201,13 +201,7 @@ impl Csr {
 
     /// `true` when every entry is finite.
     pub fn is_finite(&self) -> bool {
-        if self.val.len() >= PAR_ROWS {
-            self.val
-                .par_chunks(1 << 16)
-                .all(|c| c.iter().all(|v| v.is_finite()))
-        } else {
-            self.val.iter().all(|v| v.is_finite())
-        }
+        first_non_finite(&self.val).is_none()
     }
 }
 
@@ -379,15 +373,19 @@ pub fn norm_inf(a: &[f64]) -> f64 {
 }
 
 /// The first index of `x` that holds a value that is not finite (on all threads for long
-/// vectors), for the data and result checks.
+/// vectors), for the data and result checks. Each block of [`REDUCE_BLOCK`] values is
+/// tested without a branch per value (the test vectorises); the index is then looked for
+/// in the first block that fails.
 pub fn first_non_finite(x: &[f64]) -> Option<usize> {
-    if x.len() >= PAR_ROWS {
-        x.par_iter()
-            .with_min_len(4096)
-            .position_first(|v| !v.is_finite())
-    } else {
-        x.iter().position(|v| !v.is_finite())
-    }
+    let finite = map_blocks(x.len(), |r| {
+        x[r].iter().fold(true, |ok, v| ok & v.is_finite())
+    });
+    let b = finite.iter().position(|&ok| !ok)?;
+    let r = block_range(b, x.len());
+    x[r.clone()]
+        .iter()
+        .position(|v| !v.is_finite())
+        .map(|i| r.start + i)
 }
 
 /// Groups the entries of items `0..m` by key, in compressed-row form: `entries(i)` gives

@@ -228,16 +228,40 @@ impl FixedBoundary {
 
 impl DofMap {
     /// Numbers the vertices that are not fixed, in vertex order (SPEC §5: the unknowns
-    /// are all vertices not on Γ_D, free-boundary vertices included).
+    /// are all vertices not on Γ_D, free-boundary vertices included). Blocks of vertices
+    /// are counted, then numbered, on all threads (the arrays are mostly fresh memory,
+    /// whose first writes are page faults).
     pub fn from_fixed(fixed: &[bool]) -> DofMap {
-        let mut vertex = Vec::with_capacity(fixed.len());
-        let mut dof = vec![None; fixed.len()];
-        for (v, &f) in fixed.iter().enumerate() {
-            if !f {
-                dof[v] = Some(vertex.len() as u32);
-                vertex.push(v as u32);
-            }
+        use rayon::prelude::*;
+        const BLOCK: usize = 1 << 14;
+        let counts: Vec<usize> = fixed
+            .par_chunks(BLOCK)
+            .map(|c| c.iter().filter(|&&f| !f).count())
+            .collect();
+        let mut vertex = crate::sparse::filled(counts.iter().sum(), 0u32);
+        let mut dof = crate::sparse::filled(fixed.len(), None);
+        // Each block's unknowns: the next `count` entries of `vertex`, numbered from there.
+        let mut parts = Vec::with_capacity(counts.len());
+        let (mut rest, mut first) = (vertex.as_mut_slice(), 0u32);
+        for &c in &counts {
+            let (part, tail) = rest.split_at_mut(c);
+            parts.push((first, part));
+            (rest, first) = (tail, first + c as u32);
         }
+        dof.par_chunks_mut(BLOCK)
+            .zip(fixed.par_chunks(BLOCK))
+            .zip(parts)
+            .enumerate()
+            .for_each(|(b, ((dof, fixed), (first, part)))| {
+                let mut next = 0;
+                for (k, (d, &f)) in dof.iter_mut().zip(fixed).enumerate() {
+                    if !f {
+                        *d = Some(first + next as u32);
+                        part[next] = (b * BLOCK + k) as u32;
+                        next += 1;
+                    }
+                }
+            });
         DofMap { vertex, dof }
     }
 }
@@ -294,6 +318,28 @@ mod tests {
         .unwrap();
         assert_eq!(none.count(), 0);
         assert_eq!(none.free_vertices, 16);
+    }
+
+    #[test]
+    fn unknowns_number_the_free_vertices_in_order_across_blocks() {
+        // Long enough for several parallel blocks, with runs of fixed vertices crossing
+        // block ends and a block with no free vertex at all.
+        let n = 70_000;
+        let fixed: Vec<bool> = (0..n)
+            .map(|v| v % 7 == 3 || v % 11 == 0 || (16_000..33_000).contains(&v))
+            .collect();
+        let d = DofMap::from_fixed(&fixed);
+        assert_eq!(d.dof.len(), n);
+        assert_eq!(d.vertex.len(), fixed.iter().filter(|&&f| !f).count());
+        // Unknown i is the i-th free vertex: increasing vertices, each the inverse of dof.
+        assert!(d.vertex.windows(2).all(|w| w[0] < w[1]));
+        for (i, &v) in d.vertex.iter().enumerate() {
+            assert!(!fixed[v as usize]);
+            assert_eq!(d.dof[v as usize], Some(i as u32));
+        }
+        for (v, &f) in fixed.iter().enumerate() {
+            assert_eq!(d.dof[v].is_none(), f, "vertex {v}");
+        }
     }
 
     #[test]

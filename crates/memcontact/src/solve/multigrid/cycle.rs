@@ -153,35 +153,52 @@ fn coarse_dofs(refinement: &Refinement, n_vertices: usize, fine: &DofMap) -> Res
             fine.dof.len()
         )));
     }
-    let mut interior: Vec<Option<bool>> = vec![None; n_vertices];
-    for (v, &[a, b]) in refinement.parents.iter().enumerate() {
-        if a as usize >= n_vertices || b as usize >= n_vertices {
-            return Err(Error::Mesh(format!(
-                "vertex {v} of the finer level has parent vertices ({a}, {b}), but the \
-                 coarser level has only {n_vertices} vertices"
-            )));
-        }
-        if a == b {
-            interior[a as usize] = Some(fine.dof[v].is_some());
-        }
-    }
-    let mut vertex = Vec::new();
-    let mut dof = vec![None; n_vertices];
-    for (c, i) in interior.iter().enumerate() {
-        match i {
-            None => {
-                return Err(Error::Mesh(format!(
-                    "the refinement relation keeps no vertex on vertex {c} of the coarser level"
-                )))
+    use rayon::prelude::*;
+    use std::sync::atomic::{AtomicU8, Ordering::Relaxed};
+    // Per coarse vertex: 0 while no fine vertex sits on it, then FIXED or INTERIOR (each
+    // coarse vertex has one fine vertex on it, so no two threads write the same entry).
+    const FIXED: u8 = 1;
+    const INTERIOR: u8 = 2;
+    let state: Vec<AtomicU8> = (0..n_vertices)
+        .into_par_iter()
+        .with_min_len(4096)
+        .map(|_| AtomicU8::new(0))
+        .collect();
+    let bad = refinement
+        .parents
+        .par_iter()
+        .enumerate()
+        .with_min_len(4096)
+        .map(|(v, &[a, b])| {
+            if a as usize >= n_vertices || b as usize >= n_vertices {
+                return Some((v, a, b));
             }
-            Some(true) => {
-                dof[c] = Some(vertex.len() as u32);
-                vertex.push(c as u32);
+            if a == b {
+                let on = if fine.dof[v].is_some() {
+                    INTERIOR
+                } else {
+                    FIXED
+                };
+                state[a as usize].store(on, Relaxed);
             }
-            Some(false) => {}
-        }
+            None
+        })
+        .find_first(Option::is_some)
+        .flatten();
+    if let Some((v, a, b)) = bad {
+        return Err(Error::Mesh(format!(
+            "vertex {v} of the finer level has parent vertices ({a}, {b}), but the coarser \
+             level has only {n_vertices} vertices"
+        )));
     }
-    Ok(DofMap { vertex, dof })
+    let state: Vec<u8> = state.into_par_iter().map(AtomicU8::into_inner).collect();
+    if let Some(c) = state.par_iter().position_first(|&x| x == 0) {
+        return Err(Error::Mesh(format!(
+            "the refinement relation keeps no vertex on vertex {c} of the coarser level"
+        )));
+    }
+    let fixed: Vec<bool> = state.par_iter().map(|&x| x == FIXED).collect();
+    Ok(DofMap::from_fixed(&fixed))
 }
 
 /// Checks that the operator pattern couples the unknowns along the edges of the triangles

@@ -299,6 +299,26 @@ fn a_hierarchy_of_another_mesh_is_an_error() {
     )
     .unwrap_err();
     assert!(e.to_string().contains("parent"), "{e}");
+    // A coarse vertex with no fine vertex on it.
+    let mut broken = hier.clone();
+    let parents = &mut broken.refinements[1].parents;
+    let v = parents.iter().rposition(|p| p[0] == p[1]).unwrap();
+    let c = parents[v][0];
+    parents[v] = [c, if c == 0 { 1 } else { 0 }];
+    let e = solve(
+        &model,
+        Coarsening::Geometric(&broken),
+        &settings(1e-10),
+        None,
+        &mut Silent,
+    )
+    .unwrap_err();
+    assert!(
+        e.to_string().contains(&format!(
+            "keeps no vertex on vertex {c} of the coarser level"
+        )),
+        "{e}"
+    );
     let mut broken = hier;
     broken.refinements.pop();
     assert!(solve(
