@@ -1085,11 +1085,7 @@ fn vec_of(n: usize, v: f64) -> Vec<f64> {
 
 /// Checks sampled vertex values: finite, and non-negative when asked.
 fn check_vertices(mesh: &Mesh, name: &str, values: &[f64], non_negative: bool) -> Result<()> {
-    match values
-        .par_iter()
-        .with_min_len(4096)
-        .position_first(|&v| !v.is_finite() || (non_negative && v < 0.0))
-    {
+    match crate::sparse::first_where(values, |v| !v.is_finite() | (non_negative & (v < 0.0))) {
         Some(i) => Err(bad_value(name, values[i], mesh.points[i])),
         None => Ok(()),
     }

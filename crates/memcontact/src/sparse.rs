@@ -373,18 +373,25 @@ pub fn norm_inf(a: &[f64]) -> f64 {
 }
 
 /// The first index of `x` that holds a value that is not finite (on all threads for long
-/// vectors), for the data and result checks. Each block of [`REDUCE_BLOCK`] values is
-/// tested without a branch per value (the test vectorises); the index is then looked for
-/// in the first block that fails.
+/// vectors), for the data and result checks.
 pub fn first_non_finite(x: &[f64]) -> Option<usize> {
-    let finite = map_blocks(x.len(), |r| {
-        x[r].iter().fold(true, |ok, v| ok & v.is_finite())
-    });
-    let b = finite.iter().position(|&ok| !ok)?;
+    first_where(x, |v| !v.is_finite())
+}
+
+/// The first index `i` with `bad(x[i])`, on all threads for long slices. Each block of
+/// [`REDUCE_BLOCK`] items is tested without a branch per item (with a branch-free `bad`,
+/// the test vectorises); the index is then looked for in the first block that fails. For
+/// the checks of input and results, which nearly always find nothing.
+pub fn first_where<T: Copy + Sync>(
+    x: &[T],
+    bad: impl Fn(T) -> bool + Sync + Send,
+) -> Option<usize> {
+    let failed = map_blocks(x.len(), |r| x[r].iter().fold(false, |f, &v| f | bad(v)));
+    let b = failed.iter().position(|&f| f)?;
     let r = block_range(b, x.len());
     x[r.clone()]
         .iter()
-        .position(|v| !v.is_finite())
+        .position(|&v| bad(v))
         .map(|i| r.start + i)
 }
 

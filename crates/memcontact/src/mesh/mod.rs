@@ -103,11 +103,9 @@ impl Mesh {
             return Err(Error::Mesh("the mesh has no triangle".into()));
         }
         // The first offending vertex and triangle, searched on all threads.
+        use crate::sparse::first_where;
         use rayon::prelude::*;
-        let bad_point = points
-            .par_iter()
-            .with_min_len(8192)
-            .position_first(|p| !p[0].is_finite() || !p[1].is_finite());
+        let bad_point = first_where(&points, |p| !p[0].is_finite() | !p[1].is_finite());
         if let Some(i) = bad_point {
             let p = points[i];
             return Err(Error::Mesh(format!(
@@ -116,8 +114,9 @@ impl Mesh {
             )));
         }
         let n = points.len();
-        let bad_triangle = triangles.par_iter().with_min_len(8192).position_first(|t| {
-            t.iter().any(|&v| v as usize >= n) || t[0] == t[1] || t[1] == t[2] || t[0] == t[2]
+        let bad_triangle = first_where(&triangles, |t| {
+            let out = t.iter().fold(false, |o, &v| o | (v as usize >= n));
+            out | (t[0] == t[1]) | (t[1] == t[2]) | (t[0] == t[2])
         });
         if let Some(k) = bad_triangle {
             let t = triangles[k];

@@ -265,70 +265,45 @@ fn iteration_counts_do_not_grow_under_refinement() {
 #[test]
 fn a_hierarchy_of_another_mesh_is_an_error() {
     let hier = square_hierarchy(4, 3);
-    let other = square_hierarchy(3, 3);
     let model = bench_model(hier.finest(), Some(1000.0), Foundation::Lumped);
-    let e = solve(
-        &model,
-        Coarsening::Geometric(&other),
-        &settings(1e-10),
-        None,
-        &mut Silent,
-    )
-    .unwrap_err();
-    assert!(e.to_string().contains("finest level"), "{e}");
+    let error = |h: &Hierarchy| {
+        let e = solve(
+            &model,
+            Coarsening::Geometric(h),
+            &settings(1e-10),
+            None,
+            &mut Silent,
+        );
+        e.expect_err("a hierarchy that does not fit is refused")
+            .to_string()
+    };
+    let e = error(&square_hierarchy(3, 3));
+    assert!(e.contains("finest level"), "{e}");
     // A hierarchy with a broken refinement relation.
     let mut broken = hier.clone();
     broken.refinements[1].parents.pop();
-    let e = solve(
-        &model,
-        Coarsening::Geometric(&broken),
-        &settings(1e-10),
-        None,
-        &mut Silent,
-    )
-    .unwrap_err();
-    assert!(e.to_string().contains("refinement"), "{e}");
+    let e = error(&broken);
+    assert!(e.contains("refinement"), "{e}");
     let mut broken = hier.clone();
     broken.refinements[0].parents[3] = [10_000, 0];
-    let e = solve(
-        &model,
-        Coarsening::Geometric(&broken),
-        &settings(1e-10),
-        None,
-        &mut Silent,
-    )
-    .unwrap_err();
-    assert!(e.to_string().contains("parent"), "{e}");
+    let e = error(&broken);
+    assert!(e.contains("parent"), "{e}");
     // A coarse vertex with no fine vertex on it.
     let mut broken = hier.clone();
     let parents = &mut broken.refinements[1].parents;
     let v = parents.iter().rposition(|p| p[0] == p[1]).unwrap();
     let c = parents[v][0];
     parents[v] = [c, if c == 0 { 1 } else { 0 }];
-    let e = solve(
-        &model,
-        Coarsening::Geometric(&broken),
-        &settings(1e-10),
-        None,
-        &mut Silent,
-    )
-    .unwrap_err();
+    let e = error(&broken);
     assert!(
-        e.to_string().contains(&format!(
+        e.contains(&format!(
             "keeps no vertex on vertex {c} of the coarser level"
         )),
         "{e}"
     );
     let mut broken = hier;
     broken.refinements.pop();
-    assert!(solve(
-        &model,
-        Coarsening::Geometric(&broken),
-        &settings(1e-10),
-        None,
-        &mut Silent
-    )
-    .is_err());
+    error(&broken);
 }
 
 #[test]
