@@ -155,8 +155,9 @@ fn coarse_dofs(refinement: &Refinement, n_vertices: usize, fine: &DofMap) -> Res
     }
     use rayon::prelude::*;
     use std::sync::atomic::{AtomicU8, Ordering::Relaxed};
-    // Per coarse vertex: 0 while no fine vertex sits on it, then FIXED or INTERIOR (each
-    // coarse vertex has one fine vertex on it, so no two threads write the same entry).
+    // Per coarse vertex: 0 while no fine vertex sits on it, then FIXED or INTERIOR. A
+    // refinement puts one fine vertex on each coarse one; should a broken one put two, the
+    // larger state is kept, whatever the order the threads write in.
     const FIXED: u8 = 1;
     const INTERIOR: u8 = 2;
     let state: Vec<AtomicU8> = (0..n_vertices)
@@ -179,7 +180,7 @@ fn coarse_dofs(refinement: &Refinement, n_vertices: usize, fine: &DofMap) -> Res
                 } else {
                     FIXED
                 };
-                state[a as usize].store(on, Relaxed);
+                state[a as usize].fetch_max(on, Relaxed);
             }
             None
         })
@@ -192,7 +193,7 @@ fn coarse_dofs(refinement: &Refinement, n_vertices: usize, fine: &DofMap) -> Res
         )));
     }
     let state: Vec<u8> = state.into_par_iter().map(AtomicU8::into_inner).collect();
-    if let Some(c) = state.par_iter().position_first(|&x| x == 0) {
+    if let Some(c) = crate::sparse::first_where(&state, |x| x == 0) {
         return Err(Error::Mesh(format!(
             "the refinement relation keeps no vertex on vertex {c} of the coarser level"
         )));
