@@ -163,7 +163,8 @@ fn main() -> ExitCode {
             return ExitCode::FAILURE;
         }
     }
-    let result = match cli.command {
+    // The whole command runs on a worker thread of the pool (see memcontact::on_workers).
+    let result = memcontact::on_workers(|| match cli.command {
         Command::Solve {
             case,
             output,
@@ -210,7 +211,7 @@ fn main() -> ExitCode {
                 bench_cmd::run(&sizes, &foundation, phases)
             }
         }
-    };
+    });
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {

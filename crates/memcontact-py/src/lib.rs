@@ -48,17 +48,19 @@ fn solve(py: Python<'_>, case: PyRef<'_, PyCase>) -> PyResult<PyResult_> {
     let label = case.label.clone();
     drop(case);
     py.detach(move || {
-        let started = Instant::now();
-        c.settings.validate().map_err(Invalid::into_error)?;
-        let discretization = Discretization::new(&c.problem, &mut Silent)?;
-        memcontact_plot::write::check_on_mesh(&c, discretization.mesh())?;
-        let report = discretization.solve(&c.settings, &mut Silent)?;
-        let outcome = Outcome {
-            discretization,
-            report,
-        };
-        let mesh = PyMesh::new_from(outcome.discretization.user_hierarchy());
-        Ok(PyResult_::new(label, c, mesh, outcome, started))
+        memcontact::on_workers(move || {
+            let started = Instant::now();
+            c.settings.validate().map_err(Invalid::into_error)?;
+            let discretization = Discretization::new(&c.problem, &mut Silent)?;
+            memcontact_plot::write::check_on_mesh(&c, discretization.mesh())?;
+            let report = discretization.solve(&c.settings, &mut Silent)?;
+            let outcome = Outcome {
+                discretization,
+                report,
+            };
+            let mesh = PyMesh::new_from(outcome.discretization.user_hierarchy());
+            Ok(PyResult_::new(label, c, mesh, outcome, started))
+        })
     })
     .map_err(py_err)
 }
@@ -96,18 +98,20 @@ fn solve_on(
         }
     }
     py.detach(move || {
-        let started = Instant::now();
-        c.problem.validate().map_err(Invalid::into_error)?;
-        c.settings.validate().map_err(Invalid::into_error)?;
-        let discretization =
-            Discretization::assemble(&c.problem, (*mesh.hierarchy).clone(), &mut Silent)?;
-        memcontact_plot::write::check_on_mesh(&c, discretization.mesh())?;
-        let report = discretization.solve(&c.settings, &mut Silent)?;
-        let outcome = Outcome {
-            discretization,
-            report,
-        };
-        Ok(PyResult_::new(label, c, mesh, outcome, started))
+        memcontact::on_workers(move || {
+            let started = Instant::now();
+            c.problem.validate().map_err(Invalid::into_error)?;
+            c.settings.validate().map_err(Invalid::into_error)?;
+            let discretization =
+                Discretization::assemble(&c.problem, (*mesh.hierarchy).clone(), &mut Silent)?;
+            memcontact_plot::write::check_on_mesh(&c, discretization.mesh())?;
+            let report = discretization.solve(&c.settings, &mut Silent)?;
+            let outcome = Outcome {
+                discretization,
+                report,
+            };
+            Ok(PyResult_::new(label, c, mesh, outcome, started))
+        })
     })
     .map_err(py_err)
 }

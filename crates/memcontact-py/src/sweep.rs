@@ -87,10 +87,12 @@ pub fn sweep(py: Python<'_>, case: PyRef<'_, PyCase>, warm: bool) -> PyResult<Py
     let label = case.label.clone();
     drop(case);
     let (solved, all_steps, c, label) = py
-        .detach(move || -> memcontact::Result<_> {
-            let solved = solve_steps(&c, &label, warm)?;
-            let all_steps = steps(&c)?;
-            Ok((solved, all_steps, c, label))
+        .detach(move || {
+            memcontact::on_workers(move || -> memcontact::Result<_> {
+                let solved = solve_steps(&c, &label, warm)?;
+                let all_steps = steps(&c)?;
+                Ok((solved, all_steps, c, label))
+            })
         })
         .map_err(py_err)?;
     let results = solved
