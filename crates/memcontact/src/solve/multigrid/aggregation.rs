@@ -42,29 +42,6 @@ const MAX_LEVELS: usize = 40;
 /// Rows per block of a parallel matching (see [`pairwise`]).
 const MATCH_BLOCK: usize = 1 << 16;
 
-/// The strong neighbours of the rows `lo..hi`: negative couplings above [`BETA`] times
-/// the strongest of the row, among the rows of the range taking part in the matching.
-/// Vectors are indexed from `lo`.
-struct Strong<'a> {
-    a: &'a Csr,
-    lo: usize,
-    free: Vec<bool>,
-    threshold: Vec<f64>,
-}
-
-impl Strong<'_> {
-    /// `(j, a_ij)` for the strong neighbours `j` of row `i` (global indices).
-    fn of(&self, i: usize) -> impl Iterator<Item = (usize, f64)> + '_ {
-        let (cols, vals) = self.a.row(i);
-        let t = self.threshold[i - self.lo];
-        let (lo, hi) = (self.lo, self.lo + self.free.len());
-        cols.iter()
-            .zip(vals)
-            .map(|(&j, &v)| (j as usize, v))
-            .filter(move |&(j, v)| j != i && j >= lo && j < hi && self.free[j - lo] && -v > t)
-    }
-}
-
 /// One pairwise matching of the rows of `a`: the pair (or singleton) of every row, `NONE`
 /// for rows left to the smoother (zero or dominant diagonal); returns the aggregate index
 /// of every row and the number of aggregates. Rows are taken in order of fewest unmatched
@@ -120,27 +97,33 @@ fn pairwise_range(a: &Csr, lo: usize, hi: usize) -> (Vec<u32>, usize) {
         free[i - lo] = diag > 0.0 && diag < DOMINANT * off;
         threshold[i - lo] = BETA * strongest;
     }
-    let strong = Strong {
-        a,
-        lo,
-        free,
-        threshold,
-    };
+    // The strong neighbours of every row taking part, listed once (the matching visits
+    // them up to three times): negative couplings above [`BETA`] times the strongest of
+    // the row, to rows of the range taking part. Local indices, in column order.
+    let mut start = Vec::with_capacity(m + 1);
+    let mut strong: Vec<(u32, f64)> = Vec::with_capacity(8 * m);
+    start.push(0);
+    for i in lo..hi {
+        if free[i - lo] {
+            let (cols, vals) = a.row(i);
+            let t = threshold[i - lo];
+            for (&j, &v) in cols.iter().zip(vals) {
+                let j = j as usize;
+                if j != i && (lo..hi).contains(&j) && free[j - lo] && -v > t {
+                    strong.push(((j - lo) as u32, v));
+                }
+            }
+        }
+        start.push(strong.len());
+    }
+    let of = |i: usize| &strong[start[i]..start[i + 1]];
     let mut agg = vec![NONE; m];
     // A bucket queue by the number of unmatched strong neighbours, with lazy deletion.
-    let mut degree: Vec<u32> = (lo..hi)
-        .map(|i| {
-            if strong.free[i - lo] {
-                strong.of(i).count() as u32
-            } else {
-                0
-            }
-        })
-        .collect();
+    let mut degree: Vec<u32> = (0..m).map(|i| of(i).len() as u32).collect();
     let top = degree.iter().copied().max().unwrap_or(0) as usize;
     let mut buckets: Vec<Vec<u32>> = vec![Vec::new(); top + 1];
     for i in (0..m).rev() {
-        if strong.free[i] {
+        if free[i] {
             buckets[degree[i] as usize].push(i as u32);
         }
     }
@@ -158,15 +141,15 @@ fn pairwise_range(a: &Csr, lo: usize, hi: usize) -> (Vec<u32>, usize) {
             continue; // matched, or queued again with a smaller degree
         }
         let mut best: Option<(usize, f64)> = None;
-        for (j, v) in strong.of(lo + i) {
-            if agg[j - lo] == NONE && best.is_none_or(|(_, b)| v < b) {
-                best = Some((j - lo, v));
+        for &(j, v) in of(i) {
+            if agg[j as usize] == NONE && best.is_none_or(|(_, b)| v < b) {
+                best = Some((j as usize, v));
             }
         }
         for r in std::iter::once(i).chain(best.map(|b| b.0)) {
             agg[r] = count;
-            for (k, _) in strong.of(lo + r) {
-                let k = k - lo;
+            for &(k, _) in of(r) {
+                let k = k as usize;
                 if agg[k] == NONE && degree[k] > 0 {
                     degree[k] -= 1;
                     buckets[degree[k] as usize].push(k as u32);

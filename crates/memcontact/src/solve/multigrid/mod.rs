@@ -186,17 +186,32 @@ pub fn solve(
 
 /// The matrix an algebraic hierarchy is built from: S plus the diagonals of the bodies'
 /// foundations (where the membrane penetrates a body, the Newton matrices add its L to S).
+/// One pass over blocks of rows on all threads (a copy of S the size of the problem).
 fn setup_matrix(model: &Model) -> Csr {
-    let mut a = model.s.clone();
-    for (i, k) in a.pattern.diagonal_positions().into_iter().enumerate() {
-        if model.can_touch[i] {
-            a.val[k] += model.l.diag(i);
-        }
-        if let Some(low) = model.lower.as_ref().filter(|low| low.can_touch[i]) {
-            a.val[k] += low.l.diag(i);
-        }
+    use rayon::prelude::*;
+    let s = &model.s;
+    let pat = &s.pattern;
+    let mut val = Vec::with_capacity(s.val.len());
+    val.par_extend(s.val.par_iter().with_min_len(4096).copied());
+    crate::sparse::row_chunks(pat, &mut val, 4096)
+        .into_par_iter()
+        .for_each(|(first, block)| {
+            let base = pat.row_ptr[first];
+            for i in first..(first + 4096).min(pat.n()) {
+                let Some(k) = pat.find(i, i) else { continue };
+                let v = &mut block[k - base];
+                if model.can_touch[i] {
+                    *v += model.l.diag(i);
+                }
+                if let Some(low) = model.lower.as_ref().filter(|low| low.can_touch[i]) {
+                    *v += low.l.diag(i);
+                }
+            }
+        });
+    Csr {
+        pattern: pat.clone(),
+        val,
     }
-    a
 }
 
 /// [`solve`] with explicit options, also returning the per-level report (one entry per
