@@ -186,18 +186,20 @@ pub fn solve(
 
 /// The matrix an algebraic hierarchy is built from: S plus the diagonals of the bodies'
 /// foundations (where the membrane penetrates a body, the Newton matrices add its L to S).
-/// One pass over blocks of rows on all threads (a copy of S the size of the problem).
+/// S's values are copied, then its diagonal shifted, on all threads (a copy the size of
+/// the problem).
 fn setup_matrix(model: &Model) -> Csr {
     use rayon::prelude::*;
+    const ROWS: usize = 4096;
     let s = &model.s;
     let pat = &s.pattern;
     let mut val = Vec::with_capacity(s.val.len());
-    val.par_extend(s.val.par_iter().with_min_len(4096).copied());
-    crate::sparse::row_chunks(pat, &mut val, 4096)
+    val.par_extend(s.val.par_iter().with_min_len(ROWS).copied());
+    crate::sparse::row_chunks(pat, &mut val, ROWS)
         .into_par_iter()
         .for_each(|(first, block)| {
             let base = pat.row_ptr[first];
-            for i in first..(first + 4096).min(pat.n()) {
+            for i in first..(first + ROWS).min(pat.n()) {
                 let Some(k) = pat.find(i, i) else { continue };
                 let v = &mut block[k - base];
                 if model.can_touch[i] {
