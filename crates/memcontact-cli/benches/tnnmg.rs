@@ -12,12 +12,33 @@ static ALLOCATOR: mimalloc::MiMalloc = mimalloc::MiMalloc;
 use memcontact::model::Foundation;
 use memcontact::solve::multigrid::Options;
 
-/// `-- --micro N`: times the kernels of one TNNMG iteration on the N × N benchmark mesh.
-fn micro(n: usize) {
-    let h = memcontact::bench::mesh(n).unwrap();
+/// `-- --micro N`: times the kernels of one TNNMG iteration on the N × N benchmark mesh
+/// and its geometric levels (with `--mesh FILE` instead of N: on a Gmsh mesh renumbered as
+/// a solve would, and its algebraic levels).
+fn micro(args: &[String]) {
+    use memcontact::solve::multigrid::{kernel_timings, Coarsening};
+    let h = match args.iter().position(|a| a == "--mesh") {
+        Some(k) => {
+            let user = memcontact::io::gmsh::read_msh(std::path::Path::new(&args[k + 1]))
+                .unwrap()
+                .0;
+            memcontact::mesh::refine::Hierarchy::single(user)
+                .reordered()
+                .0
+        }
+        None => {
+            let n = args.iter().find_map(|a| a.parse().ok()).unwrap_or(1024);
+            memcontact::bench::mesh(n).unwrap()
+        }
+    };
+    let coarsening = if h.levels.len() > 1 {
+        Coarsening::Geometric(&h)
+    } else {
+        Coarsening::Algebraic
+    };
     for f in [Foundation::Lumped, Foundation::Consistent] {
         let m = memcontact::bench::model(h.finest(), f).unwrap();
-        let t = memcontact::solve::multigrid::kernel_timings(&m, &h, 10).unwrap();
+        let t = kernel_timings(&m, coarsening, 10).unwrap();
         println!("{}:                      wall ms   cpu ms", f.name());
         for (name, ms, cpu) in t {
             println!("  {name:<24} {ms:8.2} {cpu:8.2}");
@@ -107,9 +128,8 @@ fn main() {
         assembly(&args);
         return;
     }
-    if let Some(k) = args.iter().position(|a| a == "--micro") {
-        let n = args.get(k + 1).and_then(|a| a.parse().ok()).unwrap_or(1024);
-        micro(n);
+    if args.iter().any(|a| a == "--micro") {
+        micro(&args);
         return;
     }
     let mut sizes: Vec<usize> = args.iter().filter_map(|a| a.parse().ok()).collect();

@@ -53,6 +53,8 @@ pub struct Levels {
     pub patterns: Vec<Arc<Pattern>>,
     /// `transfers[k]` prolongates level `k` to level `k + 1`.
     pub transfers: Vec<Transfer>,
+    /// What the smoother reads from every level's pattern, coarsest first.
+    pub(crate) sweep_rows: Vec<SweepRows>,
 }
 
 impl Levels {
@@ -107,6 +109,7 @@ impl Levels {
             kind: Kind::Geometric,
             sizes,
             dofs,
+            sweep_rows: patterns.iter().map(|p| SweepRows::of(p)).collect(),
             patterns,
             transfers,
         })
@@ -120,6 +123,7 @@ impl Levels {
             kind: Kind::Algebraic,
             sizes,
             dofs: Vec::new(),
+            sweep_rows: patterns.iter().map(|p| SweepRows::of(p)).collect(),
             patterns,
             transfers,
         }
@@ -249,8 +253,6 @@ pub struct Multigrid<'a> {
     x: Vec<Vec<f64>>,
     b: Vec<Vec<f64>>,
     r: Vec<Vec<f64>>,
-    /// The rows coupled to another smoothing block, per level ([`seam_rows`]).
-    seams: Vec<Vec<u32>>,
     dirty: Vec<Vec<bool>>,
     /// Level 0's operator with zero rows replaced by the identity, and its factor.
     coarsest: Csr,
@@ -277,7 +279,6 @@ impl<'a> Multigrid<'a> {
             x: (0..top).map(zeros).collect(),
             b: (0..top).map(zeros).collect(),
             r: (0..=top).map(zeros).collect(),
-            seams: (0..=top).map(|k| seam_rows(&levels.patterns[k])).collect(),
             dirty: (0..top).map(|k| filled(levels.n(k), true)).collect(),
             coarsest: Csr::zeros(levels.patterns[0].clone()),
             chol: None,
@@ -459,8 +460,8 @@ impl<'a> Multigrid<'a> {
         let top = self.top;
         let nu1 = self.smoothing.0;
         if from_zero && nu1 == 1 && self.fused_on_top(fine) {
-            let (inv, seams) = (&self.inv_diag[top], &self.seams[top]);
-            gauss_seidel_from_zero(fine, inv, x, b, &mut self.r[top], seams);
+            let (inv, rows) = (&self.inv_diag[top], &self.levels.sweep_rows[top]);
+            gauss_seidel_from_zero(fine, inv, x, b, &mut self.r[top], rows);
             return;
         }
         if from_zero {
@@ -506,8 +507,8 @@ impl<'a> Multigrid<'a> {
         zero_held(fine, x);
         let nu2 = self.smoothing.1;
         if let Some(y) = product.filter(|_| nu2 == 1 && self.fused_on_top(fine)) {
-            let (inv, seams) = (&self.inv_diag[top], &self.seams[top]);
-            gauss_seidel_back_with_product(fine, inv, x, b, &mut self.r[top], y, seams);
+            let (inv, rows) = (&self.inv_diag[top], &self.levels.sweep_rows[top]);
+            gauss_seidel_back_with_product(fine, inv, x, b, &mut self.r[top], y, rows);
             return true;
         }
         for _ in 0..nu2 {
@@ -579,7 +580,7 @@ impl<'a> Multigrid<'a> {
         let (a, inv) = (&self.coarse[k], &self.inv_diag[k]);
         let (xk, bk) = (&mut self.x[k], &self.b[k]);
         if self.smoothing.0 == 1 {
-            gauss_seidel_from_zero(a, inv, xk, bk, &mut self.r[k], &self.seams[k]);
+            gauss_seidel_from_zero(a, inv, xk, bk, &mut self.r[k], &self.levels.sweep_rows[k]);
         } else {
             xk.iter_mut().for_each(|v| *v = 0.0);
             for _ in 0..self.smoothing.0 {
@@ -604,7 +605,8 @@ impl<'a> Multigrid<'a> {
             &mut self.r[k],
         );
         if let Some(y) = product.as_deref_mut().filter(|_| self.smoothing.1 == 1) {
-            gauss_seidel_back_with_product(a, inv, &mut xu[0], b, r, y, &self.seams[k]);
+            let rows = &self.levels.sweep_rows[k];
+            gauss_seidel_back_with_product(a, inv, &mut xu[0], b, r, y, rows);
             return;
         }
         for _ in 0..self.smoothing.1 {
@@ -1008,26 +1010,49 @@ pub(crate) fn gauss_seidel<A: TopOperator>(
         .for_each(|(k, xs)| sweep(k * block, xs, outside));
 }
 
-/// The rows of `pattern` that couple to another smoothing block ([`gs_block`] rows; none
-/// up to one block): the rows whose residual [`gauss_seidel_from_zero`] completes at the end.
-pub(crate) fn seam_rows(pattern: &Pattern) -> Vec<u32> {
-    use rayon::prelude::*;
-    let n = pattern.n();
-    let block = gs_block(n);
-    if n <= block {
-        return Vec::new();
+/// What the fused sweeps ([`gauss_seidel_from_zero`], [`gauss_seidel_back_with_product`])
+/// read from a level's pattern besides the matrix, found once per hierarchy.
+#[derive(Debug, Clone, Default)]
+pub(crate) struct SweepRows {
+    /// The rows that couple to another smoothing block ([`gs_block`] rows; none up to one
+    /// block): the rows whose residual or product a sweep completes at the end.
+    pub seams: Vec<u32>,
+    /// Per row, the number of its columns before the diagonal (the diagonal's offset in
+    /// the row when it is stored). Looked up rather than counted: on an unstructured
+    /// mesh the count varies from row to row, and a counting loop's exit is then
+    /// mispredicted in almost every row.
+    pub diag: Vec<u32>,
+}
+
+impl SweepRows {
+    /// The seam rows and diagonal offsets of `pattern`: one pass of a few comparisons per
+    /// row (columns are sorted: a row stays inside its block when its first and last
+    /// columns do).
+    pub(crate) fn of(pattern: &Pattern) -> SweepRows {
+        use rayon::prelude::*;
+        let n = pattern.n();
+        let block = gs_block(n);
+        let row = |i: usize| &pattern.col[pattern.row_ptr[i]..pattern.row_ptr[i + 1]];
+        let seams = if n <= block {
+            Vec::new()
+        } else {
+            (0..n)
+                .into_par_iter()
+                .with_min_len(4096)
+                .filter(|&i| {
+                    let (lo, hi) = (i / block * block, (i / block + 1) * block);
+                    !within(row(i), lo, hi)
+                })
+                .map(|i| i as u32)
+                .collect()
+        };
+        let diag = (0..n)
+            .into_par_iter()
+            .with_min_len(4096)
+            .map(|i| row(i).iter().map(|&c| ((c as usize) < i) as u32).sum())
+            .collect();
+        SweepRows { seams, diag }
     }
-    (0..n)
-        .into_par_iter()
-        .with_min_len(4096)
-        .filter(|&i| {
-            let own = i / block;
-            pattern.col[pattern.row_ptr[i]..pattern.row_ptr[i + 1]]
-                .iter()
-                .any(|&j| j as usize / block != own)
-        })
-        .map(|i| i as u32)
-        .collect()
 }
 
 /// One forward sweep of [`gauss_seidel`] from `x = 0` (whatever `x` holds on entry), with
@@ -1036,7 +1061,7 @@ pub(crate) fn seam_rows(pattern: &Pattern) -> Vec<u32> {
 /// (later unknowns of its block are still 0); the later rows' part reaches r_i from
 /// them, `a_ki x_k = a_ik x_k` scattered from row k as soon as x_k is known. Unknowns of
 /// other blocks are 0 during the sweep (the hybrid sweep's start), so their part is added
-/// at the end, on the rows of `seams` ([`seam_rows`] of A's pattern) alone. Held rows
+/// at the end, on the seam rows of `rows` ([`SweepRows::of`] A's pattern) alone. Held rows
 /// keep `x = 0` and `r = b`.
 pub(crate) fn gauss_seidel_from_zero<A: TopOperator>(
     op: &A,
@@ -1044,7 +1069,7 @@ pub(crate) fn gauss_seidel_from_zero<A: TopOperator>(
     x: &mut [f64],
     b: &[f64],
     r: &mut [f64],
-    seams: &[u32],
+    rows: &SweepRows,
 ) {
     use rayon::prelude::*;
     let a = op.matrix();
@@ -1062,11 +1087,7 @@ pub(crate) fn gauss_seidel_from_zero<A: TopOperator>(
             } else {
                 cols.iter().map(|&c| ((c as usize) < lo) as usize).sum()
             };
-            let diag = first
-                + cols[first..]
-                    .iter()
-                    .take_while(|&&c| (c as usize) < i)
-                    .count();
+            let diag = rows.diag[i] as usize;
             let (lc, lv) = (&cols[first..diag], &vals[first..diag]);
             let lower: f64 = lc
                 .iter()
@@ -1107,12 +1128,12 @@ pub(crate) fn gauss_seidel_from_zero<A: TopOperator>(
         .for_each(|(k, (xs, rs))| sweep(k * block, xs, rs));
     // The other blocks' unknowns, now known, on the rows that see them.
     let x: &[f64] = x;
-    add_outside_blocks(a, seams, r, -1.0, |j| x[j]);
+    add_outside_blocks(a, &rows.seams, r, -1.0, |j| x[j]);
     restore_held(r);
 }
 
 /// `out_i += sign · Σ_j a_ij value(j)` over the columns j outside row i's smoothing block
-/// ([`gs_block`] rows), for the rows of `seams` ([`seam_rows`] of A's pattern): the hybrid
+/// ([`gs_block`] rows), for the rows of `seams` ([`SweepRows::seams`] of A's pattern): the hybrid
 /// sweeps' contribution of the other blocks, added once they are done.
 fn add_outside_blocks(
     a: &Csr,
@@ -1149,7 +1170,7 @@ fn add_outside_blocks(
 /// already, as `a_ki Δx_i = a_ik Δx_i` from row i's own entries, and the rows before it
 /// send theirs when they are relaxed. Unknowns of other blocks change during the sweep
 /// (the hybrid sweep reads them from `snapshot`, as they were before it), so their changes
-/// are added at the end, on the rows of `seams` ([`seam_rows`] of A's pattern) alone.
+/// are added at the end, on the seam rows of `rows` ([`SweepRows::of`] A's pattern) alone.
 /// Held rows keep x and get `y = 0`, as [`apply`] gives.
 pub(crate) fn gauss_seidel_back_with_product<A: TopOperator>(
     op: &A,
@@ -1158,7 +1179,7 @@ pub(crate) fn gauss_seidel_back_with_product<A: TopOperator>(
     b: &[f64],
     snapshot: &mut [f64],
     y: &mut [f64],
-    seams: &[u32],
+    rows: &SweepRows,
 ) {
     use rayon::prelude::*;
     let a = op.matrix();
@@ -1180,7 +1201,7 @@ pub(crate) fn gauss_seidel_back_with_product<A: TopOperator>(
             let dx = (b[i] - ax) * d;
             xs[k] += dx;
             // Columns are sorted: i's later neighbours in the block are `diag + 1..last`.
-            let diag = cols.iter().take_while(|&&c| (c as usize) < i).count();
+            let diag = rows.diag[i] as usize;
             let last: usize = if inside {
                 cols.len()
             } else {
@@ -1221,7 +1242,7 @@ pub(crate) fn gauss_seidel_back_with_product<A: TopOperator>(
         .for_each(|(k, (xs, ys))| sweep(k * block, xs, ys, before));
     // The other blocks' changes, now known, on the rows that see them.
     let x: &[f64] = x;
-    add_outside_blocks(a, seams, y, 1.0, |j| x[j] - before[j]);
+    add_outside_blocks(a, &rows.seams, y, 1.0, |j| x[j] - before[j]);
     clear_held(y);
 }
 

@@ -625,12 +625,12 @@ fn level_solve(ls: LevelSolve) -> Result<(usize, f64, Option<Certificate>)> {
 }
 
 /// Wall-clock and CPU (all threads) milliseconds per call of the kernels of one TNNMG
-/// iteration on `model` (for the benchmark's `--micro` mode; `reps` calls each, at a point
-/// with every vertex state).
+/// iteration on `model` with the levels of `coarsening` (for the benchmark's `--micro`
+/// mode; `reps` calls each, at a point with every vertex state).
 #[doc(hidden)]
 pub fn kernel_timings(
     model: &Model,
-    hierarchy: &Hierarchy,
+    coarsening: Coarsening,
     reps: usize,
 ) -> Result<Vec<(&'static str, f64, f64)>> {
     let mut out = Vec::new();
@@ -646,9 +646,17 @@ pub fn kernel_timings(
     };
     let mut levels = None;
     time("levels setup", &mut || {
-        levels = Levels::new(hierarchy, &model.dofs, model.s.pattern.clone()).ok()
+        levels = match coarsening {
+            Coarsening::Geometric(h) => Levels::new(h, &model.dofs, model.s.pattern.clone()).ok(),
+            Coarsening::Algebraic => Some(Levels::algebraic(
+                &setup_matrix(model),
+                aggregation::COARSEST,
+            )),
+        }
     });
-    let levels = levels.ok_or_else(|| crate::Error::Mesh("hierarchy does not fit".into()))?;
+    let levels = levels
+        .filter(|l| l.len() > 1)
+        .ok_or_else(|| crate::Error::Mesh("the hierarchy does not fit or has one level".into()))?;
     let top = levels.len() - 1;
     time("coarse models", &mut || {
         std::hint::black_box(coarse_model(
@@ -686,7 +694,7 @@ pub fn kernel_timings(
     });
     let mut delta = vec![0.0; n];
     let rhs: Vec<f64> = g.iter().map(|x| -x).collect();
-    time("v-cycle", &mut || mg.v_cycle(&a, &mut delta, &rhs));
+    time("cycle", &mut || mg.cycle(&a, &mut delta, &rhs));
     let mut work = cycle::FcgWork::default();
     let mut b = rhs.clone();
     time("flexible CG, 3 steps", &mut || {
@@ -707,15 +715,18 @@ pub fn kernel_timings(
     time("gauss-seidel sweep", &mut || {
         cycle::gauss_seidel(&a, &inv, &mut delta, &rhs, &mut snap, false)
     });
-    let seams = cycle::seam_rows(&a.pattern);
+    let rows = cycle::SweepRows::of(&a.pattern);
+    time("sweep rows (setup)", &mut || {
+        std::hint::black_box(cycle::SweepRows::of(&a.pattern));
+    });
     let mut res = vec![0.0; n];
     time("sweep from zero + residual", &mut || {
-        cycle::gauss_seidel_from_zero(&a, &inv, &mut delta, &rhs, &mut res, &seams)
+        cycle::gauss_seidel_from_zero(&a, &inv, &mut delta, &rhs, &mut res, &rows)
     });
     let mut prod = vec![0.0; n];
     time("backward sweep + product", &mut || {
         cycle::gauss_seidel_back_with_product(
-            &a, &inv, &mut delta, &rhs, &mut snap, &mut prod, &seams,
+            &a, &inv, &mut delta, &rhs, &mut snap, &mut prod, &rows,
         )
     });
     time("residual", &mut || {

@@ -340,6 +340,43 @@ fn block_gauss_seidel_keeps_the_rate_and_ignores_the_thread_count() {
 }
 
 #[test]
+fn sweep_rows_are_the_seams_and_the_diagonal_offsets() {
+    // A level of one smoothing block and one of several; then a pattern with an empty row
+    // (an unknown no fine unknown restricts to), whose offset is 0.
+    for levels in [5, 7] {
+        let h = square_hierarchy(4, levels);
+        let model = bench_model(h.finest(), Some(0.0), Foundation::Lumped);
+        let p = &model.s.pattern;
+        let rows = cycle::SweepRows::of(p);
+        let n = p.n();
+        let block = cycle::gs_block(n);
+        let cols = |i: usize| &p.col[p.row_ptr[i]..p.row_ptr[i + 1]];
+        for i in 0..n {
+            let before = cols(i).iter().filter(|&&c| (c as usize) < i).count();
+            assert_eq!(rows.diag[i] as usize, before, "row {i}");
+            assert_eq!(
+                cols(i)[before] as usize,
+                i,
+                "row {i}: the diagonal is stored"
+            );
+        }
+        let seams: Vec<u32> = (0..n)
+            .filter(|&i| n > block && cols(i).iter().any(|&c| c as usize / block != i / block))
+            .map(|i| i as u32)
+            .collect();
+        assert_eq!(rows.seams, seams);
+        assert_eq!(seams.is_empty(), levels == 5);
+    }
+    let empty = crate::sparse::Pattern {
+        row_ptr: vec![0, 1, 1, 2],
+        col: vec![0, 2],
+    };
+    let rows = cycle::SweepRows::of(&empty);
+    assert_eq!(rows.diag, vec![0, 0, 0]);
+    assert!(rows.seams.is_empty());
+}
+
+#[test]
 fn fused_sweep_from_zero_is_the_sweep_and_its_residual() {
     // One level below GS_BLOCK (one sequential sweep) and one above (blocks and seams),
     // with truncated unknowns: their rows and columns zero, as in the Newton matrix.
@@ -366,13 +403,13 @@ fn fused_sweep_from_zero_is_the_sweep_and_its_residual() {
         cycle::gauss_seidel(&a, &inv, &mut x_ref, &b, &mut snap, false);
         let mut r_ref = vec![0.0; n];
         cycle::residual(&a, &x_ref, &b, &mut r_ref);
-        let seams = cycle::seam_rows(&a.pattern);
-        assert_eq!(seams.is_empty(), n <= cycle::gs_block(n));
+        let rows = cycle::SweepRows::of(&a.pattern);
+        assert_eq!(rows.seams.is_empty(), n <= cycle::gs_block(n));
         let fused = |threads: usize| {
             // Whatever x holds on entry is ignored.
             let (mut x, mut r) = (vec![1.0; n], vec![f64::NAN; n]);
             crate::on_threads(threads, || {
-                cycle::gauss_seidel_from_zero(&a, &inv, &mut x, &b, &mut r, &seams)
+                cycle::gauss_seidel_from_zero(&a, &inv, &mut x, &b, &mut r, &rows)
             });
             (x, r)
         };
@@ -425,7 +462,7 @@ fn backward_sweep_with_product_is_the_sweep_and_its_product() {
                 }
             })
             .collect();
-        let seams = cycle::seam_rows(&model.s.pattern);
+        let rows = cycle::SweepRows::of(&model.s.pattern);
         let check = |name: &str,
                      fused: &dyn Fn(usize) -> (Vec<f64>, Vec<f64>),
                      reference: (Vec<f64>, Vec<f64>)| {
@@ -460,7 +497,7 @@ fn backward_sweep_with_product_is_the_sweep_and_its_product() {
             let (mut x, mut snap, mut y) = (x0.clone(), vec![0.0; n], vec![f64::NAN; n]);
             crate::on_threads(threads, || {
                 cycle::gauss_seidel_back_with_product(
-                    &op, &inv, &mut x, &b, &mut snap, &mut y, &seams,
+                    &op, &inv, &mut x, &b, &mut snap, &mut y, &rows,
                 )
             });
             for i in (0..n).filter(|&i| held[i]) {
@@ -490,7 +527,7 @@ fn backward_sweep_with_product_is_the_sweep_and_its_product() {
             let (mut x, mut snap, mut y) = (x1.clone(), vec![0.0; n], vec![f64::NAN; n]);
             crate::on_threads(threads, || {
                 cycle::gauss_seidel_back_with_product(
-                    &a, &inv, &mut x, &b, &mut snap, &mut y, &seams,
+                    &a, &inv, &mut x, &b, &mut snap, &mut y, &rows,
                 )
             });
             (x, y)
