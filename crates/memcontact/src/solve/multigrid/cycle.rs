@@ -1018,10 +1018,11 @@ pub(crate) struct SweepRows {
     /// block): the rows whose residual or product a sweep completes at the end.
     pub seams: Vec<u32>,
     /// Per row, the number of its columns before the diagonal (the diagonal's offset in
-    /// the row when it is stored). Looked up rather than counted: on an unstructured
-    /// mesh the count varies from row to row, and a counting loop's exit is then
-    /// mispredicted in almost every row.
-    pub diag: Vec<u32>,
+    /// the row when it is stored), or [`SweepRows::MANY`] from that many on. Looked up
+    /// rather than counted: on an unstructured mesh the count varies from row to row, and
+    /// a counting loop's exit is then mispredicted in almost every row. One byte per row
+    /// (a 16.8 M-unknown level keeps 17 MB, not 67).
+    pub diag: Vec<u8>,
 }
 
 impl SweepRows {
@@ -1049,9 +1050,26 @@ impl SweepRows {
         let diag = (0..n)
             .into_par_iter()
             .with_min_len(4096)
-            .map(|i| row(i).iter().map(|&c| ((c as usize) < i) as u32).sum())
+            .map(|i| {
+                let before: usize = row(i).iter().map(|&c| ((c as usize) < i) as usize).sum();
+                before.min(Self::MANY as usize) as u8
+            })
             .collect();
         SweepRows { seams, diag }
+    }
+
+    /// The stored offsets saturate here: rows with this many columns before the diagonal
+    /// or more (a vertex in hundreds of triangles) count them.
+    pub(crate) const MANY: u8 = u8::MAX;
+
+    /// The number of columns before the diagonal in row `i`, whose sorted columns are
+    /// `cols`.
+    #[inline(always)]
+    pub(crate) fn diag_of(&self, i: usize, cols: &[u32]) -> usize {
+        match self.diag[i] {
+            Self::MANY => cols.partition_point(|&c| (c as usize) < i),
+            d => d as usize,
+        }
     }
 }
 
@@ -1087,7 +1105,7 @@ pub(crate) fn gauss_seidel_from_zero<A: TopOperator>(
             } else {
                 cols.iter().map(|&c| ((c as usize) < lo) as usize).sum()
             };
-            let diag = rows.diag[i] as usize;
+            let diag = rows.diag_of(i, cols);
             let (lc, lv) = (&cols[first..diag], &vals[first..diag]);
             let lower: f64 = lc
                 .iter()
@@ -1201,7 +1219,7 @@ pub(crate) fn gauss_seidel_back_with_product<A: TopOperator>(
             let dx = (b[i] - ax) * d;
             xs[k] += dx;
             // Columns are sorted: i's later neighbours in the block are `diag + 1..last`.
-            let diag = rows.diag[i] as usize;
+            let diag = rows.diag_of(i, cols);
             let last: usize = if inside {
                 cols.len()
             } else {

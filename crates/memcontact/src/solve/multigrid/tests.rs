@@ -354,6 +354,7 @@ fn sweep_rows_are_the_seams_and_the_diagonal_offsets() {
         for i in 0..n {
             let before = cols(i).iter().filter(|&&c| (c as usize) < i).count();
             assert_eq!(rows.diag[i] as usize, before, "row {i}");
+            assert_eq!(rows.diag_of(i, cols(i)), before, "row {i}");
             assert_eq!(
                 cols(i)[before] as usize,
                 i,
@@ -374,6 +375,64 @@ fn sweep_rows_are_the_seams_and_the_diagonal_offsets() {
     let rows = cycle::SweepRows::of(&empty);
     assert_eq!(rows.diag, vec![0, 0, 0]);
     assert!(rows.seams.is_empty());
+    // Rows with more columns before the diagonal than a byte counts: the offset is found
+    // in the row (a symmetric pattern: rows 0 and m − 1 coupled to all, the others to
+    // those two).
+    let m = 600;
+    let mut row_ptr = vec![0];
+    let mut col: Vec<u32> = Vec::new();
+    for i in 0..m {
+        let cols: Vec<u32> = if i == 0 || i == m - 1 {
+            (0..m as u32).collect()
+        } else {
+            vec![0, i as u32, m as u32 - 1]
+        };
+        col.extend(&cols);
+        row_ptr.push(col.len());
+    }
+    let star = crate::sparse::Pattern { row_ptr, col };
+    let rows = cycle::SweepRows::of(&star);
+    assert_eq!(rows.diag[m - 1], cycle::SweepRows::MANY);
+    for i in 0..m {
+        let cols = &star.col[star.row_ptr[i]..star.row_ptr[i + 1]];
+        let expected = match i {
+            0 => 0,
+            i if i == m - 1 => i,
+            _ => 1,
+        };
+        assert_eq!(rows.diag_of(i, cols), expected);
+    }
+    // Both fused sweeps on the star's graph Laplacian plus the identity (SPD), through
+    // the counted offsets: the plain sweep with its residual, and with its product.
+    let star = std::sync::Arc::new(star);
+    let mut a = Csr::zeros(star.clone());
+    for i in 0..m {
+        for k in star.row_ptr[i]..star.row_ptr[i + 1] {
+            let j = star.col[k] as usize;
+            a.val[k] = if i == j {
+                (star.row_ptr[i + 1] - star.row_ptr[i]) as f64
+            } else {
+                -1.0
+            };
+        }
+    }
+    let mut inv = vec![0.0; m];
+    cycle::fill_inv_diag(&a, &mut inv);
+    let b: Vec<f64> = (0..m).map(|i| ((i as f64) * 0.71).sin()).collect();
+    let (mut x, mut r, mut snap) = (vec![1.0; m], vec![0.0; m], vec![0.0; m]);
+    cycle::gauss_seidel_from_zero(&a, &inv, &mut x, &b, &mut r, &rows);
+    let mut x_ref = vec![0.0; m];
+    cycle::gauss_seidel(&a, &inv, &mut x_ref, &b, &mut snap, false);
+    let mut r_ref = vec![0.0; m];
+    cycle::residual(&a, &x_ref, &b, &mut r_ref);
+    let close = |p: &[f64], q: &[f64]| p.iter().zip(q).all(|(u, v)| (u - v).abs() <= 1e-12);
+    assert!(close(&x, &x_ref) && close(&r, &r_ref));
+    let mut y = vec![0.0; m];
+    cycle::gauss_seidel_back_with_product(&a, &inv, &mut x, &b, &mut snap, &mut y, &rows);
+    cycle::gauss_seidel(&a, &inv, &mut x_ref, &b, &mut snap, true);
+    let mut y_ref = vec![0.0; m];
+    a.mul_into(&x_ref, &mut y_ref);
+    assert!(close(&x, &x_ref) && close(&y, &y_ref));
 }
 
 #[test]
