@@ -1079,7 +1079,7 @@ impl SweepRows {
 /// (later unknowns of its block are still 0); the later rows' part reaches r_i from
 /// them, `a_ki x_k = a_ik x_k` scattered from row k as soon as x_k is known. Unknowns of
 /// other blocks are 0 during the sweep (the hybrid sweep's start), so their part is added
-/// at the end, on the seam rows of `rows` ([`SweepRows::of`] A's pattern) alone. Held rows
+/// at the end, on the seam rows alone (`rows`: [`SweepRows::of`] A's pattern). Held rows
 /// keep `x = 0` and `r = b`.
 pub(crate) fn gauss_seidel_from_zero<A: TopOperator>(
     op: &A,
@@ -1151,8 +1151,8 @@ pub(crate) fn gauss_seidel_from_zero<A: TopOperator>(
 }
 
 /// `out_i += sign · Σ_j a_ij value(j)` over the columns j outside row i's smoothing block
-/// ([`gs_block`] rows), for the rows of `seams` ([`SweepRows::seams`] of A's pattern): the hybrid
-/// sweeps' contribution of the other blocks, added once they are done.
+/// ([`gs_block`] rows), for the rows of `seams` ([`SweepRows::seams`] of A's pattern):
+/// the hybrid sweeps' contribution of the other blocks, added once they are done.
 fn add_outside_blocks(
     a: &Csr,
     seams: &[u32],
@@ -1188,7 +1188,7 @@ fn add_outside_blocks(
 /// already, as `a_ki Δx_i = a_ik Δx_i` from row i's own entries, and the rows before it
 /// send theirs when they are relaxed. Unknowns of other blocks change during the sweep
 /// (the hybrid sweep reads them from `snapshot`, as they were before it), so their changes
-/// are added at the end, on the seam rows of `rows` ([`SweepRows::of`] A's pattern) alone.
+/// are added at the end, on the seam rows alone (`rows`: [`SweepRows::of`] A's pattern).
 /// Held rows keep x and get `y = 0`, as [`apply`] gives.
 pub(crate) fn gauss_seidel_back_with_product<A: TopOperator>(
     op: &A,
