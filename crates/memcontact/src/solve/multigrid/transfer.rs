@@ -192,6 +192,8 @@ impl Transfer {
     /// computed once per hierarchy). The diagonal is always stored.
     pub fn galerkin_pattern(&self, fine: &Pattern) -> Pattern {
         const ROWS: usize = 4096;
+        /// Rows up to this long are sorted by rank.
+        const SMALL: usize = 32;
         let n_coarse = self.n_coarse;
         // Per block of coarse rows: the row lengths and the concatenated sorted columns.
         // `seen[j] == i` marks column j as already in row i (no sort of duplicates).
@@ -216,9 +218,20 @@ impl Transfer {
                         }
                     }
                 }
-                r.sort_unstable();
+                if r.len() <= SMALL {
+                    // The row's columns by rank (the count of smaller ones): branch-free
+                    // on the distinct columns, where a comparison sort mispredicts.
+                    let mut sorted = [0u32; SMALL];
+                    for &x in &r {
+                        let rank: usize = r.iter().map(|&y| (y < x) as usize).sum();
+                        sorted[rank] = x;
+                    }
+                    cols.extend_from_slice(&sorted[..r.len()]);
+                } else {
+                    r.sort_unstable();
+                    cols.extend_from_slice(&r);
+                }
                 lens.push(r.len() as u32);
-                cols.extend_from_slice(&r);
             }
             (lens, cols)
         };
