@@ -13,7 +13,7 @@ use memcontact::output::WriteOptions;
 use memcontact::problem::MeshSource;
 use memcontact::solve::multigrid::Kind;
 use memcontact::solve::{HierarchyChoice, Method, Silent};
-use memcontact::{Case, Discretization, Outcome};
+use memcontact::Case;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -139,13 +139,7 @@ pub fn run_case(case: &Case, scratch: &Path, pictures: bool) -> Result<CaseRun> 
     reset_peak_memory();
     let stolen_before = stolen_seconds();
     let started = Instant::now();
-    let discretization = Discretization::new(&case.problem, &mut Silent)?;
-    memcontact_plot::write::check_on_mesh(&case, discretization.mesh())?;
-    let report = discretization.solve(&case.settings, &mut Silent)?;
-    let outcome = Outcome {
-        discretization,
-        report,
-    };
+    let outcome = memcontact_plot::write::solve_case(&case, &mut Silent)?;
     let t_write = Instant::now();
     let dir = scratch.join(format!("memcontact-bench-{}", std::process::id()));
     let options = WriteOptions {

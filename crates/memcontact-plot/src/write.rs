@@ -13,7 +13,7 @@ use memcontact::output::{step_label, write_result_set, SweepSet, WriteOptions};
 use memcontact::problem::{PictureKind, VtuFormat};
 use memcontact::results::NodalFields;
 use memcontact::sweep::{StepRow, StepSpec};
-use memcontact::{Case, Error, Outcome, Result, Summary};
+use memcontact::{Case, Discretization, Error, Observer, Outcome, Result, Summary};
 use std::path::Path;
 use std::time::{Duration, Instant};
 
@@ -51,6 +51,19 @@ pub fn plot_options(case: &Case, label: &str) -> PlotOptions {
         },
         title: Some(label.to_string()),
     }
+}
+
+/// Solves a case of one step (no `[sweep]`, no `[[load_case]]`): the mesh and assembly,
+/// the picture options checked on the mesh ([`check_on_mesh`]) before anything is solved,
+/// then the solve. The outcome is returned whatever the solve's status.
+pub fn solve_case(case: &Case, observer: &mut dyn Observer) -> Result<Outcome> {
+    let discretization = Discretization::new(&case.problem, observer)?;
+    check_on_mesh(case, discretization.mesh())?;
+    let report = discretization.solve(&case.settings, observer)?;
+    Ok(Outcome {
+        discretization,
+        report,
+    })
 }
 
 /// Checks the picture options of `case` against the mesh before anything is solved: a

@@ -51,13 +51,7 @@ fn solve(py: Python<'_>, case: PyRef<'_, PyCase>) -> PyResult<PyResult_> {
         memcontact::on_workers(move || {
             let started = Instant::now();
             c.settings.validate().map_err(Invalid::into_error)?;
-            let discretization = Discretization::new(&c.problem, &mut Silent)?;
-            memcontact_plot::write::check_on_mesh(&c, discretization.mesh())?;
-            let report = discretization.solve(&c.settings, &mut Silent)?;
-            let outcome = Outcome {
-                discretization,
-                report,
-            };
+            let outcome = memcontact_plot::write::solve_case(&c, &mut Silent)?;
             let mesh = PyMesh::new_from(outcome.discretization.user_hierarchy());
             Ok(PyResult_::new(label, c, mesh, outcome, started))
         })
