@@ -10,6 +10,11 @@ from it. No refinement hierarchy: every vertex comes from Gmsh's Delaunay mesher
     python scripts/make_mesh.py --size 0.0015 --ascii -o site.msh    # MSH 4.1 ASCII
     python scripts/make_mesh.py --size 0.05 --format 2.2 -o site.msh # MSH 2.2
 
+With --geo FILE.geo it meshes that Gmsh geometry file instead of the site (for the
+examples' and the tests' meshes written as .geo files), in any of the four flavours:
+
+    python scripts/make_mesh.py --geo examples/liner-slope.geo --ascii -o examples/liner-slope.msh
+
 Needs the gmsh package (pip install gmsh). About 1 M vertices at --size 0.0015.
 """
 
@@ -63,19 +68,26 @@ def build(size: float, grading: float = 2.0) -> None:
 
 def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--size", type=float, required=True, help="element size near the hole")
+    ap.add_argument("--size", type=float, help="element size near the hole (the site)")
+    ap.add_argument("--geo", help="mesh this Gmsh .geo file instead of the site")
     ap.add_argument("--grading", type=float, default=2.0, help="size far from the hole / size near it")
     ap.add_argument("--format", choices=["4.1", "2.2"], default="4.1")
     ap.add_argument("--ascii", action="store_true", help="ASCII instead of binary")
     ap.add_argument("--threads", type=int, default=0, help="Gmsh threads (0: all cores)")
     ap.add_argument("-o", "--output", required=True)
     args = ap.parse_args()
+    if (args.size is None) == (args.geo is None):
+        ap.error("give either --size (the site) or --geo FILE")
     gmsh.initialize(["-nopopup"])
     try:
         gmsh.option.setNumber("General.Terminal", 0)
         gmsh.option.setNumber("General.NumThreads", args.threads)
-        gmsh.model.add("site")
-        build(args.size, args.grading)
+        if args.geo:
+            gmsh.open(args.geo)
+            gmsh.model.mesh.generate(2)
+        else:
+            gmsh.model.add("site")
+            build(args.size, args.grading)
         gmsh.option.setNumber("Mesh.MshFileVersion", float(args.format))
         gmsh.option.setNumber("Mesh.Binary", 0 if args.ascii else 1)
         gmsh.option.setNumber("Mesh.SaveAll", 0)

@@ -209,6 +209,10 @@ pub fn check(case_path: &Path, sets: &[String]) -> Result<()> {
         "{}",
         output::mesh_report(mesh, &d.quality, d.hierarchy.depth())
     );
+    print!(
+        "{}",
+        output::boundary_report(mesh, &case.problem.boundary.free)
+    );
     println!(
         "  obstacle     {} vertices can touch (M), foundation {}{}",
         d.model.can_touch.iter().filter(|&&c| c).count(),

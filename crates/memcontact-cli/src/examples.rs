@@ -105,6 +105,15 @@ const EXAMPLES: &[Example] = &[
             ("disk.msh", include_str!("../../../examples/disk.msh")),
         ],
     },
+    Example {
+        name: "liner-slope",
+        about: "a geomembrane liner on a slope, meshed in Gmsh: heights per physical curve, a free crest, soils above and below",
+        files: &[
+            ("liner-slope.toml", include_str!("../../../examples/liner-slope.toml")),
+            ("liner-slope.msh", include_str!("../../../examples/liner-slope.msh")),
+            ("liner-slope.geo", include_str!("../../../examples/liner-slope.geo")),
+        ],
+    },
 ];
 
 /// Lists the examples, or writes example `name` into `dir`.

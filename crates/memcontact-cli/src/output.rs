@@ -33,6 +33,37 @@ pub fn mesh_report(mesh: &Mesh, q: &MeshQuality, levels: usize) -> String {
     s
 }
 
+/// The boundary regions line of `check`: every boundary region with its edges and length,
+/// and whether it is held (u = g) or free (the names in `free`).
+pub fn boundary_report(mesh: &Mesh, free: &[String]) -> String {
+    let adj = memcontact::mesh::VertexTriangles::new(mesh);
+    let tagged = mesh.tagged_boundary(&adj);
+    let present = tagged.present();
+    let free_tags: Vec<u32> = free
+        .iter()
+        .flat_map(|k| mesh.boundary.resolve(k, &present))
+        .collect();
+    let regions: Vec<String> = mesh
+        .boundary_regions_summary(&tagged)
+        .iter()
+        .map(|r| {
+            format!(
+                "{} ({} edge{}, length {:.6}, {})",
+                r.name,
+                r.edges,
+                if r.edges == 1 { "" } else { "s" },
+                r.length,
+                if free_tags.contains(&r.tag) {
+                    "free"
+                } else {
+                    "held"
+                }
+            )
+        })
+        .collect();
+    format!("  boundary     {}\n", regions.join(", "))
+}
+
 /// What to do when a solve stopped at the rounding floor above the tolerance.
 pub fn floor_note(outcome: &Outcome) -> Option<String> {
     let r = &outcome.report;

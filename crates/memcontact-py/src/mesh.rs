@@ -167,7 +167,7 @@ impl PyMesh {
     /// mapping tags to names (the keys of region tables). `boundary_edges` (k, 2) vertex
     /// pairs of boundary edges with `boundary_tags` (k,) and `boundary_names` name
     /// boundary regions (the keys of `[boundary]` tables and `free`; untagged boundary
-    /// edges are region 0). The mesh is checked: finite coordinates, no degenerate,
+    /// edges form the region `default`). The mesh is checked: finite coordinates, no degenerate,
     /// inverted or duplicate element, no unused vertex, a manifold boundary, tagged edges
     /// on the boundary; clockwise meshes are reoriented.
     #[new]
@@ -263,7 +263,8 @@ impl PyMesh {
     }
 
     /// The tagged boundary edges (vertex pairs), shape (k, 2), int64: Gmsh physical curves
-    /// or the generators' sides (a new array).
+    /// or the generators' sides (a new array). Boundary edges not listed form the region
+    /// `default`.
     #[getter]
     fn boundary_edges<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<i64>> {
         let b = &self.finest().boundary;

@@ -98,6 +98,42 @@ def test_meshes_from_arrays_name_their_boundary_regions():
     assert len(fine.boundary_edges) == 4  # each lid edge halved
 
 
+def test_gmsh_physical_curves_are_boundary_regions(examples):
+    # The liner example's mesh: six physical curves on the boundary.
+    liner = mc.read_gmsh(examples / "liner-slope.msh")
+    assert sorted(liner.boundary_names.values()) == [
+        "crest_anchor", "crest_east", "crest_west", "flank_east", "flank_west", "toe"]
+    assert liner.boundary_edges.shape == (len(liner.boundary_tags), 2)
+    # Every tagged edge is an edge of the boundary, and covers all of it here.
+    on_boundary = liner.boundary
+    assert np.all(on_boundary[liner.boundary_edges])
+    lengths = np.linalg.norm(liner.vertices[liner.boundary_edges[:, 0]]
+                             - liner.vertices[liner.boundary_edges[:, 1]], axis=1)
+    by_name = {name: lengths[liner.boundary_tags == tag].sum()
+               for tag, name in liner.boundary_names.items()}
+    assert by_name == pytest.approx({"toe": 40.0, "flank_east": 20.0, "crest_east": 15.0,
+                                     "crest_anchor": 10.0, "crest_west": 15.0,
+                                     "flank_west": 20.0}, abs=1e-9)
+    # Free edges and heights per curve on a Gmsh mesh: as on the generator's mesh.
+    data = examples.parent / "crates" / "memcontact" / "tests" / "data"
+    # Its physical curve "seam" lies inside the mesh: a warning, not an error.
+    with pytest.warns(UserWarning, match=r'curve "seam" \(tag 15\): 16 line elements lie'):
+        gmsh = mc.read_gmsh(data / "rect_v41_binary.msh")
+    assert gmsh.boundary_names == {11: "bottom", 12: "right", 13: "top", 14: "left",
+                                   15: "seam"}
+    grid = mc.rectangle(x1=2.0, nx=16, ny=8)
+    kw = dict(tension=1.0, load="2 - 4*x*y", shape=0.05, stiffness=200.0, free=["top"],
+              boundary_height={"bottom": "0.01*x", "left": "0.02*y", "right": "0.02"})
+    a, b = mc.solve_mesh(gmsh, **kw), mc.solve_mesh(grid, **kw)
+    key = lambda v: [tuple(p) for p in np.round(v, 9)]
+    order_a = sorted(range(gmsh.n_vertices), key=lambda i: key(gmsh.vertices)[i])
+    order_b = sorted(range(grid.n_vertices), key=lambda i: key(grid.vertices)[i])
+    assert np.allclose(a.u[order_a], b.u[order_b], rtol=0, atol=1e-9)
+    with pytest.raises(ValueError, match=r"curves: bottom, right, top, left; regions of "
+                                         r"triangles, surfaces: lower, upper"):
+        mc.solve_mesh(gmsh, **{**kw, "free": ["crest"]})
+
+
 def test_bad_extension_data_raises_value_errors_naming_the_key():
     mesh = mc.rectangle(nx=8)
     kw = dict(tension=1.0, load=1.0, shape=0.5, stiffness=100.0)

@@ -154,16 +154,13 @@ fn bind_height(boundary: &crate::problem::Boundary, mesh: &Mesh) -> Result<Bound
     let fixed = crate::mesh::boundary::FixedBoundary::new(mesh, &adj, &boundary.free)?;
     let tagged = mesh.tagged_boundary(&adj);
     let present = tagged.present();
-    // Keys may name the free regions too (the value is then not used).
-    let names = &mesh.boundary.names;
+    // Keys may name the free regions too (the value is then not used). Messages call the
+    // edges no region covers `default`.
+    let names = &mesh.boundary.labels();
     if let crate::field::Field::Regions(table) = &boundary.height {
         for key in table.keys() {
             if key != crate::field::DEFAULT_KEY && mesh.boundary.resolve(key, &present).is_empty() {
-                return Err(Error::Data(format!(
-                    "{name}: no boundary region named '{key}' in the mesh (boundary regions: \
-                     {})",
-                    mesh.boundary_listing(&tagged)
-                )));
+                return Err(mesh.no_boundary_region(name, key, &tagged));
             }
         }
         let fixed_only: std::collections::BTreeMap<String, crate::field::Field> = table

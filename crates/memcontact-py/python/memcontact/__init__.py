@@ -202,7 +202,10 @@ def polygon(
 
 def read_gmsh(path: PathLike) -> Mesh:
     """Reads a Gmsh mesh (MSH 2.2 or 4.1, ASCII or binary, 3-node triangles); physical
-    surfaces become named regions. Skipped elements are reported as warnings."""
+    surfaces become named regions, physical curves on the boundary become boundary regions
+    (`boundary_edges`, `boundary_tags`, `boundary_names`: the keys of `free` and of
+    boundary height tables; boundary edges no curve covers form the region `default`).
+    Skipped elements and physical curves inside the mesh are reported as warnings."""
     mesh, notes = _native.read_gmsh(os.fspath(path))
     for note in notes:
         warnings.warn(f"{os.fspath(path)}: {note}", stacklevel=2)

@@ -1,8 +1,11 @@
 //! Gmsh MSH meshes: a reader for versions 2.2 and 4.1, ASCII and binary, and a writer.
 //!
 //! Only 3-node triangles (element type 2) make the mesh; physical surfaces become regions
-//! (`$PhysicalNames` of dimension 2 name them). Every other element type is skipped with a
-//! warning. The format is described in the Gmsh reference manual, section "MSH file format".
+//! (`$PhysicalNames` of dimension 2 name them). 2-node lines (element type 1) of physical
+//! curves become boundary regions where they lie on the mesh's boundary (`$PhysicalNames`
+//! of dimension 1 name them); lines inside the mesh are reported with a warning. Every
+//! other element type is skipped with a warning. The format is described in the Gmsh
+//! reference manual, section "MSH file format".
 
 use crate::mesh::Mesh;
 use crate::{Error, Result};
@@ -26,8 +29,9 @@ pub enum MshVersion {
 /// Reads a 2-D triangle mesh from a Gmsh MSH file (2.2 or 4.1, ASCII or binary).
 ///
 /// Returns the mesh (vertices: the nodes used by triangles, in file order; regions: the
-/// physical surface of each triangle, 0 if none) and warnings: skipped element types,
-/// dropped nodes, surfaces with several physical tags. Parse failures are
+/// physical surface of each triangle, 0 if none; boundary regions: the physical curves of
+/// the boundary edges) and warnings: skipped element types, dropped nodes, entities with
+/// several physical tags, physical curves with lines that are not boundary edges. Parse failures are
 /// [`Error::File`] with the line (ASCII) or section (binary) and what was expected; a
 /// broken mesh (inverted, duplicate vertices...) is reported by [`Mesh::new`]'s checks.
 pub fn read_msh(path: &Path) -> Result<(Mesh, Vec<String>)> {
@@ -104,8 +108,12 @@ struct Raw {
     nodes: Vec<(u64, [f64; 3])>,
     /// (element tag, node tags, physical tag) of every 3-node triangle.
     triangles: Vec<(u64, [u64; 3], u32)>,
+    /// (node tags, physical tag) of every 2-node line of a physical curve.
+    lines: Vec<([u64; 2], u32)>,
     /// Physical names of dimension 2.
     names: BTreeMap<u32, String>,
+    /// Physical names of dimension 1 (curves).
+    curve_names: BTreeMap<u32, String>,
     /// Skipped elements per type.
     skipped: BTreeMap<i32, usize>,
     warnings: Vec<String>,
@@ -123,7 +131,9 @@ impl Raw {
         let Raw {
             nodes,
             triangles,
+            lines,
             names,
+            curve_names,
             skipped,
             mut warnings,
         } = self;
@@ -213,11 +223,90 @@ impl Raw {
             ));
         }
         warnings.extend(crate::field::region_name_warnings(&names, &regions));
-        match Mesh::new(points, tris, regions, names) {
-            Ok(mesh) => Ok((mesh, warnings)),
-            Err(e) => Err(ParseOrMesh::Mesh(e, warnings)),
+        let mesh = match Mesh::new(points, tris, regions, names) {
+            Ok(mesh) => mesh,
+            Err(e) => return Err(ParseOrMesh::Mesh(e, warnings)),
+        };
+        // Lines of physical curves, as vertex pairs (`u32::MAX`: a node no triangle uses).
+        let vertex = |tag: u64| lookup.find(tag).map_or(u32::MAX, |i| new_index[i as usize]);
+        let lines: Vec<([u32; 2], u32)> = lines
+            .iter()
+            .map(|&([a, b], phys)| ([vertex(a), vertex(b)], phys))
+            .collect();
+        let mesh = curves_to_boundary_regions(mesh, &lines, curve_names, &mut warnings);
+        Ok((mesh, warnings))
+    }
+}
+
+/// Makes the lines of physical curves that lie on the mesh's boundary its boundary regions
+/// (a boundary edge in two physical curves keeps the first), and warns about the lines that
+/// are not boundary edges: inside the mesh (a seam), or not an edge of it at all.
+fn curves_to_boundary_regions(
+    mesh: Mesh,
+    lines: &[([u32; 2], u32)],
+    curve_names: BTreeMap<u32, String>,
+    warnings: &mut Vec<String>,
+) -> Mesh {
+    if lines.is_empty() {
+        return mesh;
+    }
+    let uses = mesh.edge_uses(lines.iter().map(|l| l.0));
+    let label = |tag: u32| match curve_names.get(&tag) {
+        Some(name) => format!("physical curve \"{name}\" (tag {tag})"),
+        None => format!("physical curve {tag}"),
+    };
+    // Per curve: lines inside the mesh, lines that are no edge of it.
+    let mut inside: BTreeMap<u32, usize> = BTreeMap::new();
+    let mut stray: BTreeMap<u32, usize> = BTreeMap::new();
+    let mut twice: BTreeMap<(u32, u32), usize> = BTreeMap::new();
+    let mut first_tag: std::collections::HashMap<(u32, u32), u32> = Default::default();
+    let (mut edges, mut tags) = (Vec::new(), Vec::new());
+    for (&([a, b], tag), &n) in lines.iter().zip(&uses) {
+        match n {
+            1 => match first_tag.entry((a.min(b), a.max(b))) {
+                std::collections::hash_map::Entry::Vacant(e) => {
+                    e.insert(tag);
+                    edges.push([a, b]);
+                    tags.push(tag);
+                }
+                std::collections::hash_map::Entry::Occupied(e) => {
+                    if *e.get() != tag {
+                        *twice.entry((*e.get(), tag)).or_default() += 1;
+                    }
+                }
+            },
+            2 => *inside.entry(tag).or_default() += 1,
+            _ => *stray.entry(tag).or_default() += 1,
         }
     }
+    for (tag, n) in inside {
+        warnings.push(format!(
+            "{}: {n} line element{} inside the mesh, not on its boundary (a seam?): a \
+             boundary region holds boundary edges only, these are ignored",
+            label(tag),
+            if n == 1 { " lies" } else { "s lie" }
+        ));
+    }
+    for (tag, n) in stray {
+        warnings.push(format!(
+            "{}: {n} line element{} not an edge of any triangle: ignored",
+            label(tag),
+            if n == 1 { " is" } else { "s are" }
+        ));
+    }
+    for ((first, other), n) in twice {
+        warnings.push(format!(
+            "{n} boundary edge{} of {} also belong{} to {}: {} keep{} the first",
+            if n == 1 { "" } else { "s" },
+            label(first),
+            if n == 1 { "s" } else { "" },
+            label(other),
+            if n == 1 { "it" } else { "they" },
+            if n == 1 { "s" } else { "" },
+        ));
+    }
+    warnings.extend(crate::mesh::boundary::boundary_name_warnings(&curve_names));
+    mesh.with_checked_boundary_regions(edges, tags, curve_names)
 }
 
 /// Node tag → index in file order.
@@ -514,7 +603,7 @@ fn parse(buf: &[u8]) -> Parse<Raw> {
     c.expect("$EndMeshFormat")?;
 
     let mut raw = Raw::default();
-    let mut entities: BTreeMap<i32, Vec<i32>> = BTreeMap::new();
+    let mut entities = Entities::default();
     let mut saw_nodes = false;
     let mut saw_elements = false;
     while let Some((tok, start)) = c.token() {
@@ -618,21 +707,47 @@ fn read_physical_names(c: &mut Cursor, raw: &mut Raw) -> Parse<()> {
             .ok_or_else(|| format!("line {line} ($PhysicalNames): unterminated name"))?;
         let name = String::from_utf8_lossy(&c.buf[start..start + len]).into_owned();
         c.pos = start + len + 1;
-        if dim == 2 {
+        if dim == 1 || dim == 2 {
             let tag = u32::try_from(tag)
                 .map_err(|_| format!("line {line} ($PhysicalNames): bad physical tag {tag}"))?;
-            raw.names.insert(tag, name);
+            let names = if dim == 2 {
+                &mut raw.names
+            } else {
+                &mut raw.curve_names
+            };
+            names.insert(tag, name);
         }
     }
     c.expect("$EndPhysicalNames")
 }
 
-/// `$Entities` (4.1): the physical tags of every surface.
-fn read_entities(
-    c: &mut Cursor,
-    binary: bool,
-    warnings: &mut Vec<String>,
-) -> Parse<BTreeMap<i32, Vec<i32>>> {
+/// The physical tags of the entities of `$Entities` (4.1), by dimension and entity tag.
+#[derive(Default)]
+struct Entities {
+    /// Curves (dimension 1).
+    curves: BTreeMap<i32, Vec<i32>>,
+    /// Surfaces (dimension 2).
+    surfaces: BTreeMap<i32, Vec<i32>>,
+}
+
+impl Entities {
+    /// The physical tag the elements of entity `entity` of dimension `dim` get: the
+    /// entity's first (0: none, or an entity that is neither a curve nor a surface).
+    fn physical(&self, dim: i32, entity: i32) -> i32 {
+        let map = match dim {
+            1 => &self.curves,
+            2 => &self.surfaces,
+            _ => return 0,
+        };
+        map.get(&entity)
+            .and_then(|p| p.first())
+            .copied()
+            .unwrap_or(0)
+    }
+}
+
+/// `$Entities` (4.1): the physical tags of every curve and surface.
+fn read_entities(c: &mut Cursor, binary: bool, warnings: &mut Vec<String>) -> Parse<Entities> {
     let mut counts = [0usize; 4];
     for (k, what) in ["points", "curves", "surfaces", "volumes"]
         .iter()
@@ -647,7 +762,7 @@ fn read_entities(
         let min = if binary { 28 } else { 8 };
         counts[k] = c.check_count(n, min, &format!("the number of {what}"))?;
     }
-    let mut surfaces = BTreeMap::new();
+    let mut entities = Entities::default();
     for (dim, &count) in counts.iter().enumerate() {
         for _ in 0..count {
             let tag: i32 = if binary {
@@ -700,19 +815,24 @@ fn read_entities(
                     }
                 }
             }
-            if dim == 2 {
+            if dim == 1 || dim == 2 {
+                let (kind, elements, map) = if dim == 2 {
+                    ("surface", "triangles", &mut entities.surfaces)
+                } else {
+                    ("curve", "lines", &mut entities.curves)
+                };
                 if phys.len() > 1 {
                     warnings.push(format!(
-                        "surface {tag} has {} physical tags; its triangles get the first ({})",
+                        "{kind} {tag} has {} physical tags; its {elements} get the first ({})",
                         phys.len(),
                         phys[0]
                     ));
                 }
-                surfaces.insert(tag, phys);
+                map.insert(tag, phys);
             }
         }
     }
-    Ok(surfaces)
+    Ok(entities)
 }
 
 fn read_nodes_v2(c: &mut Cursor, binary: bool, raw: &mut Raw) -> Parse<()> {
@@ -912,8 +1032,17 @@ fn read_elements_v2(c: &mut Cursor, binary: bool, raw: &mut Raw) -> Parse<()> {
     Ok(())
 }
 
-/// Records a triangle or counts a skipped element.
+/// Records a triangle or a line of a physical curve, or counts a skipped element.
 fn add_element(raw: &mut Raw, ty: i32, tag: i64, v: [u64; 3], phys: i64) -> Parse<()> {
+    if ty == 1 {
+        // A line of no physical curve (all elements saved) marks nothing.
+        if phys != 0 {
+            let phys = u32::try_from(phys)
+                .map_err(|_| format!("$Elements: line {tag}: bad physical tag {phys}"))?;
+            raw.lines.push(([v[0], v[1]], phys));
+        }
+        return Ok(());
+    }
     if ty != 2 {
         *raw.skipped.entry(ty).or_default() += 1;
         return Ok(());
@@ -924,12 +1053,7 @@ fn add_element(raw: &mut Raw, ty: i32, tag: i64, v: [u64; 3], phys: i64) -> Pars
     Ok(())
 }
 
-fn read_elements_v4(
-    c: &mut Cursor,
-    binary: bool,
-    entities: &BTreeMap<i32, Vec<i32>>,
-    raw: &mut Raw,
-) -> Parse<()> {
+fn read_elements_v4(c: &mut Cursor, binary: bool, entities: &Entities, raw: &mut Raw) -> Parse<()> {
     let mut head = [0u64; 4];
     for (h, what) in head.iter_mut().zip([
         "the number of element blocks",
@@ -965,15 +1089,7 @@ fn read_elements_v4(
             if binary { 8 } else { 2 },
             "the number of elements in the block",
         )?;
-        let phys = if dim == 2 {
-            entities
-                .get(&entity)
-                .and_then(|p| p.first())
-                .copied()
-                .unwrap_or(0)
-        } else {
-            0
-        };
+        let phys = entities.physical(dim, entity);
         let known = element_type(ty);
         if known.is_none() {
             if binary {
@@ -1290,11 +1406,19 @@ mod tests {
         let expect: BTreeMap<u32, String> =
             BTreeMap::from([(1, "foam".into()), (2, "soil".into())]);
         assert_eq!(first.region_names, expect);
+        assert!(warnings.is_empty(), "{warnings:?}");
+        // The physical curve "rim" covers the whole boundary.
+        let adj = crate::mesh::VertexTriangles::new(first);
+        let tagged = first.tagged_boundary(&adj);
         assert!(
-            warnings
-                .iter()
-                .any(|w| w.contains("of type 1 (2-node line)")),
-            "{warnings:?}"
+            tagged.tags.iter().all(|&t| t == 3),
+            "{:?}",
+            tagged.present()
+        );
+        assert_eq!(first.boundary.edges.len(), tagged.edges.len());
+        assert_eq!(
+            first.boundary.names,
+            BTreeMap::from([(3, "rim".to_string())])
         );
         // Geometry: the disc of radius 1 (inscribed polygon), the foam disc of radius 0.5.
         let pi = std::f64::consts::PI;
@@ -1317,6 +1441,65 @@ mod tests {
             assert!(same_mesh(m, first, 1e-14), "{name}: not the same triangles");
             assert_eq!(m.region_names, first.region_names, "{name}");
             assert_eq!(w, warnings, "{name}");
+            assert_eq!(
+                boundary_by_coordinates(m),
+                boundary_by_coordinates(first),
+                "{name}"
+            );
+        }
+    }
+
+    /// An edge by its end coordinates (in units of 1e-9), sorted.
+    type EdgeKey = [(i64, i64); 2];
+
+    /// The tagged boundary edges as sorted pairs of end coordinates (rounded to 1e-9) with
+    /// their tags and names: a description independent of the numbering.
+    fn boundary_by_coordinates(m: &Mesh) -> Vec<(EdgeKey, u32, String)> {
+        let key = |v: u32| {
+            let p = m.points[v as usize];
+            ((p[0] * 1e9).round() as i64, (p[1] * 1e9).round() as i64)
+        };
+        let mut v: Vec<_> = m
+            .boundary
+            .edges
+            .iter()
+            .zip(&m.boundary.tags)
+            .map(|(&[a, b], &t)| {
+                let mut e = [key(a), key(b)];
+                e.sort();
+                (e, t, m.boundary.name(t))
+            })
+            .collect();
+        v.sort();
+        v
+    }
+
+    #[test]
+    fn curve_tags_survive_refinement_and_renumbering() {
+        use crate::mesh::refine::Hierarchy;
+        let side = |p: Point| match p {
+            [_, y] if y.abs() < 1e-9 => "bottom",
+            [_, y] if (y - 1.0).abs() < 1e-9 => "top",
+            [x, _] if x.abs() < 1e-9 => "left",
+            [x, _] if (x - 2.0).abs() < 1e-9 => "right",
+            _ => "inside",
+        };
+        for flavour in ["v22_binary", "v41_ascii"] {
+            let (mesh, _) = read_msh(&data(&format!("rect_{flavour}.msh"))).unwrap();
+            let (h, orders) = Hierarchy::refined(mesh, 2).reordered();
+            // The refined levels' numbering (new vertices after the old) is scattered.
+            assert!(orders[1..].iter().all(Option::is_some), "{flavour}");
+            for (level, m) in h.levels.iter().enumerate() {
+                let adj = crate::mesh::VertexTriangles::new(m);
+                let tagged = m.tagged_boundary(&adj);
+                // Every boundary edge carries the tag of the side it lies on.
+                assert_eq!(tagged.edges.len(), 48 << level);
+                for (&[a, b], &tag) in tagged.edges.iter().zip(&tagged.tags) {
+                    let (p, q) = (m.points[a as usize], m.points[b as usize]);
+                    let mid = [0.5 * (p[0] + q[0]), 0.5 * (p[1] + q[1])];
+                    assert_eq!(m.boundary.name(tag), side(mid), "{flavour}, level {level}");
+                }
+            }
         }
     }
 
@@ -1363,8 +1546,9 @@ mod tests {
     }
 
     /// A unit square of 4 triangles around a centre node written by hand from the format
-    /// documentation: sparse node tags, a point element and line elements to skip, two
-    /// physical surfaces, a name with a space.
+    /// documentation: sparse node tags, a point element to skip, two physical surfaces, a
+    /// name with a space, a physical curve "edge" on two sides (and a line that is no edge
+    /// of the mesh), an unnamed physical curve 8 inside the mesh.
     const SQUARE_22: &str = "$MeshFormat
 2.2 0 8
 $EndMeshFormat
@@ -1383,10 +1567,12 @@ $Nodes
 99 0.5 0.5 0
 $EndNodes
 $Elements
-7
+9
 1 15 2 0 1 10
 2 1 2 7 1 10 20
 3 1 2 7 1 20 30
+4 1 2 8 1 10 99
+5 1 2 7 1 10 30
 11 2 2 5 1 10 20 99
 12 2 2 6 1 20 30 99
 13 2 2 6 2 30 40 99
@@ -1454,9 +1640,22 @@ $EndElements
         assert_eq!(m2.region_name(6), "right");
         assert!(!m2.region_names.contains_key(&7));
         assert!((m2.total_area() - 1.0).abs() < 1e-15);
-        assert_eq!(w2.len(), 2, "{w2:?}");
-        assert!(w2.contains(&"skipped 1 elements of type 15 (1-node point)".to_string()));
-        assert!(w2.contains(&"skipped 2 elements of type 1 (2-node line)".to_string()));
+        // The curve's boundary lines are boundary edges; the others are reported.
+        assert_eq!(m2.boundary.edges, vec![[0, 1], [1, 2]]);
+        assert_eq!(m2.boundary.tags, vec![7, 7]);
+        assert_eq!(m2.boundary.names, BTreeMap::from([(7, "edge".to_string())]));
+        assert_eq!(
+            w2,
+            vec![
+                "skipped 1 elements of type 15 (1-node point)".to_string(),
+                "physical curve 8: 1 line element lies inside the mesh, not on its boundary \
+                 (a seam?): a boundary region holds boundary edges only, these are ignored"
+                    .to_string(),
+                "physical curve \"edge\" (tag 7): 1 line element is not an edge of any \
+                 triangle: ignored"
+                    .to_string(),
+            ]
+        );
 
         // 4.1: the third triangle block element 15 would overlap; drop it for the good case.
         let good41 = SQUARE_41
@@ -1467,10 +1666,11 @@ $EndElements
         assert_eq!(m4.points.len(), 5);
         assert_eq!(canonical(&m4), canonical(&m2));
         assert_eq!(m4.region_names, m2.region_names);
-        assert_eq!(
-            w4,
-            vec!["skipped 1 elements of type 1 (2-node line)".to_string()]
-        );
+        // Curve entity 3 of physical curve 7 (no name in this file) holds edge 10-20.
+        assert_eq!(m4.boundary.edges, vec![[0, 1]]);
+        assert_eq!(m4.boundary.tags, vec![7]);
+        assert!(m4.boundary.names.is_empty());
+        assert!(w4.is_empty(), "{w4:?}");
         // The overlapping extra triangle is caught by the mesh checks.
         let e = read_msh(&write_text("sq41bad.msh", SQUARE_41)).unwrap_err();
         assert!(e.to_string().contains("sq41bad.msh"), "{e}");

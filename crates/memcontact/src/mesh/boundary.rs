@@ -30,22 +30,38 @@ impl BoundaryRegions {
         self.edges.is_empty()
     }
 
-    /// The name of tag `tag`, or the tag as text.
+    /// The name of tag `tag`: its own, [`UNTAGGED_NAME`] for the edges no region covers,
+    /// or the tag as text.
     pub fn name(&self, tag: u32) -> String {
-        self.names
-            .get(&tag)
-            .cloned()
-            .unwrap_or_else(|| tag.to_string())
+        match self.names.get(&tag) {
+            Some(name) => name.clone(),
+            None if tag == UNTAGGED => UNTAGGED_NAME.to_string(),
+            None => tag.to_string(),
+        }
     }
 
-    /// The tags named `key` (a name, or a tag written as a number), among `present`.
+    /// The names of the tags, with [`UNTAGGED_NAME`] for [`UNTAGGED`] unless it has a name
+    /// of its own (for messages).
+    pub fn labels(&self) -> BTreeMap<u32, String> {
+        let mut names = self.names.clone();
+        names
+            .entry(UNTAGGED)
+            .or_insert_with(|| UNTAGGED_NAME.to_string());
+        names
+    }
+
+    /// The tags named `key` (a name, [`UNTAGGED_NAME`] for the edges no region covers, or
+    /// a tag written as a number), among `present`.
     pub fn resolve(&self, key: &str, present: &[u32]) -> Vec<u32> {
-        let by_name: Vec<u32> = self
+        let mut by_name: Vec<u32> = self
             .names
             .iter()
             .filter(|(&t, n)| n.as_str() == key && present.contains(&t))
             .map(|(&t, _)| t)
             .collect();
+        if key == UNTAGGED_NAME && present.contains(&UNTAGGED) && !by_name.contains(&UNTAGGED) {
+            by_name.insert(0, UNTAGGED);
+        }
         if !by_name.is_empty() {
             return by_name;
         }
@@ -54,6 +70,30 @@ impl BoundaryRegions {
             _ => Vec::new(),
         }
     }
+}
+
+/// The name of the boundary edges that no boundary region covers (tag [`UNTAGGED`]): the
+/// key that `free` and `[boundary]` tables give them by.
+pub const UNTAGGED_NAME: &str = "default";
+
+/// Warnings about boundary region names that `free` and `[boundary]` tables cannot address
+/// plainly: a region named [`UNTAGGED_NAME`] (the name of the edges no region covers, and
+/// the key of every other region's value in a table), or with an empty name.
+pub fn boundary_name_warnings(names: &BTreeMap<u32, String>) -> Vec<String> {
+    let mut warnings = Vec::new();
+    for (&tag, name) in names {
+        if name == UNTAGGED_NAME && tag != UNTAGGED {
+            warnings.push(format!(
+                "physical curve {tag} is named \"{UNTAGGED_NAME}\", the name of the boundary \
+                 edges no physical curve covers: give it by its tag, \"{tag}\", or rename it"
+            ));
+        } else if name.trim().is_empty() {
+            warnings.push(format!(
+                "physical curve {tag} has an empty name: give it by its tag, \"{tag}\""
+            ));
+        }
+    }
+    warnings
 }
 
 /// Every boundary edge of a mesh with its boundary region tag.
@@ -80,7 +120,7 @@ impl Mesh {
     /// order) carries `tags[k]`, `names` names the tags. Errors: lengths that differ, an
     /// edge that is not a boundary edge of the mesh, an edge given twice with two tags.
     pub fn with_boundary_regions(
-        mut self,
+        self,
         edges: Vec<[u32; 2]>,
         tags: Vec<u32>,
         names: BTreeMap<u32, String>,
@@ -92,15 +132,11 @@ impl Mesh {
                 edges.len()
             )));
         }
-        let boundary: HashMap<(u32, u32), ()> = self
-            .boundary_edges()
-            .into_iter()
-            .map(|[a, b]| ((a.min(b), a.max(b)), ()))
-            .collect();
+        let uses = self.edge_uses(edges.iter().copied());
         let mut seen: HashMap<(u32, u32), u32> = HashMap::with_capacity(edges.len());
-        for (&[a, b], &tag) in edges.iter().zip(&tags) {
+        for ((&[a, b], &tag), &n) in edges.iter().zip(&tags).zip(&uses) {
             let key = (a.min(b), a.max(b));
-            if !boundary.contains_key(&key) {
+            if n != 1 {
                 return Err(Error::Mesh(format!(
                     "boundary region {}: edge ({a}, {b}) is not an edge of the mesh's boundary",
                     names.get(&tag).cloned().unwrap_or_else(|| tag.to_string())
@@ -119,8 +155,67 @@ impl Mesh {
                 }
             }
         }
+        Ok(self.with_checked_boundary_regions(edges, tags, names))
+    }
+
+    /// [`Mesh::with_boundary_regions`] for edges known to be distinct boundary edges.
+    pub(crate) fn with_checked_boundary_regions(
+        mut self,
+        edges: Vec<[u32; 2]>,
+        tags: Vec<u32>,
+        names: BTreeMap<u32, String>,
+    ) -> Mesh {
         self.boundary = BoundaryRegions { edges, tags, names };
-        Ok(self)
+        self
+    }
+
+    /// How many triangles have each of `edges` as an edge (either vertex order): 1 on the
+    /// boundary, 2 inside, 0 for a pair of vertices that is no edge (or a vertex index out
+    /// of range). One pass over the triangles, looking up only the edges whose two ends
+    /// are among the given edges' vertices.
+    pub fn edge_uses(&self, edges: impl Iterator<Item = [u32; 2]>) -> Vec<u32> {
+        use rayon::prelude::*;
+        let n = self.n_vertices();
+        let mut marked = vec![false; n];
+        let mut index: HashMap<(u32, u32), usize> = HashMap::new();
+        let slots: Vec<Option<usize>> = edges
+            .map(|[a, b]| {
+                if a as usize >= n || b as usize >= n || a == b {
+                    return None;
+                }
+                marked[a as usize] = true;
+                marked[b as usize] = true;
+                let next = index.len();
+                Some(*index.entry((a.min(b), a.max(b))).or_insert(next))
+            })
+            .collect();
+        let counts = self
+            .triangles
+            .par_chunks(1 << 14)
+            .fold(
+                || vec![0u32; index.len()],
+                |mut counts, chunk| {
+                    for t in chunk {
+                        for e in 0..3 {
+                            let (a, b) = (t[e], t[(e + 1) % 3]);
+                            if marked[a as usize] & marked[b as usize] {
+                                if let Some(&k) = index.get(&(a.min(b), a.max(b))) {
+                                    counts[k] += 1;
+                                }
+                            }
+                        }
+                    }
+                    counts
+                },
+            )
+            .reduce(
+                || vec![0u32; index.len()],
+                |mut x, y| {
+                    x.iter_mut().zip(y).for_each(|(x, y)| *x += y);
+                    x
+                },
+            );
+        slots.iter().map(|s| s.map_or(0, |k| counts[k])).collect()
     }
 
     /// Every boundary edge with its region tag ([`UNTAGGED`] where none is given).
@@ -153,6 +248,67 @@ impl Mesh {
             .collect();
         names.join(", ")
     }
+
+    /// The error for a key of `field` (`boundary.free`, `boundary.height`) that names no
+    /// boundary region of the mesh: it lists the regions the mesh has with their kinds
+    /// (boundary regions are curves, regions of triangles are surfaces), and says so when
+    /// the key names a region of triangles.
+    pub fn no_boundary_region(&self, field: &str, key: &str, tagged: &TaggedBoundary) -> Error {
+        let surfaces: Vec<String> = self
+            .region_tags()
+            .iter()
+            .map(|&t| self.region_name(t))
+            .collect();
+        let surface = surfaces.iter().any(|s| s == key);
+        Error::Data(format!(
+            "{field}: no boundary region named '{key}' in the mesh (boundary regions, \
+             curves: {}; regions of triangles, surfaces: {}){}",
+            self.boundary_listing(tagged),
+            surfaces.join(", "),
+            if surface {
+                format!(
+                    "; '{key}' is a region of triangles: boundary heights and free edges \
+                     are given by boundary regions (Gmsh physical curves, generator sides)"
+                )
+            } else {
+                String::new()
+            }
+        ))
+    }
+
+    /// Every boundary region present with its number of edges and its length, in tag
+    /// order (the edges no region covers under [`UNTAGGED`]).
+    pub fn boundary_regions_summary(&self, tagged: &TaggedBoundary) -> Vec<BoundaryRegionSize> {
+        let mut sizes: BTreeMap<u32, (usize, f64)> = BTreeMap::new();
+        for (&[a, b], &tag) in tagged.edges.iter().zip(&tagged.tags) {
+            let s = sizes.entry(tag).or_default();
+            s.0 += 1;
+            s.1 += super::dist(self.points[a as usize], self.points[b as usize]);
+        }
+        sizes
+            .into_iter()
+            .map(|(tag, (edges, length))| BoundaryRegionSize {
+                tag,
+                name: self.boundary.name(tag),
+                edges,
+                length,
+            })
+            .collect()
+    }
+}
+
+/// A boundary region's size ([`Mesh::boundary_regions_summary`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct BoundaryRegionSize {
+    /// The tag.
+    pub tag: u32,
+    /// The name (the tag as text when it has none; `default` for the edges no region
+    /// covers).
+    pub name: String,
+    /// The number of boundary edges.
+    pub edges: usize,
+    /// The total length of its edges.
+    pub length: f64,
 }
 
 /// The fixed part Γ_D of the boundary: which vertices are fixed (`u = g` there) and which
@@ -184,11 +340,7 @@ impl FixedBoundary {
         for key in free {
             let tags = mesh.boundary.resolve(key, &present);
             if tags.is_empty() {
-                return Err(Error::Data(format!(
-                    "boundary.free: no boundary region named '{key}' in the mesh (boundary \
-                     regions: {})",
-                    mesh.boundary_listing(&tagged)
-                )));
+                return Err(mesh.no_boundary_region("boundary.free", key, &tagged));
             }
             free_tags.extend(tags);
         }
@@ -303,12 +455,11 @@ mod tests {
         assert_eq!(top.free_vertices, 3);
         assert_eq!(top.count(), 13);
         let e = FixedBoundary::new(&m, &adj, &["lid".into()]).unwrap_err();
-        assert!(
-            e.to_string().contains(
-                "no boundary region named 'lid' in the mesh (boundary regions: \
-                           bottom, right, top, left)"
-            ),
-            "{e}"
+        assert_eq!(
+            e.to_string(),
+            "invalid data: boundary.free: no boundary region named 'lid' in the mesh \
+             (boundary regions, curves: bottom, right, top, left; regions of triangles, \
+             surfaces: 0)"
         );
         let none = FixedBoundary::new(
             &m,

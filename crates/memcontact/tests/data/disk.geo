@@ -1,6 +1,6 @@
 // Unit disc with two physical surfaces: the inner disc "foam" (r < 0.5) and the annulus
-// "soil" (0.5 < r < 1), plus a physical curve "rim" on the outer circle (line elements
-// that the reader skips with a warning). Regenerate the four fixtures with:
+// "soil" (0.5 < r < 1), plus a physical curve "rim" on the outer circle (a boundary
+// region). Regenerate the four fixtures with:
 //   gmsh disk.geo -2 -format msh22 -o disk_v22_ascii.msh
 //   gmsh disk.geo -2 -format msh22 -bin -o disk_v22_binary.msh
 //   gmsh disk.geo -2 -format msh41 -o disk_v41_ascii.msh
