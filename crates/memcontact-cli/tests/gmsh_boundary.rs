@@ -112,6 +112,14 @@ fn every_msh_flavour_solves_like_the_generator_mesh_with_curves_as_boundary_regi
                 "{out}"
             );
         }
+        // Multigrid on algebraic levels (aggregates of the Gmsh mesh) agrees too.
+        let body = gmsh_case("v41_binary", refine).replace(
+            "[solver]\n",
+            "[solver]\nmethod = \"multigrid\"\nhierarchy = \"algebraic\"\n",
+        );
+        let (u, _) = solve(&dir, &format!("algebraic-{refine}"), &body);
+        let d = max_difference(&u, &reference);
+        assert!(d <= 1e-9, "algebraic levels, refine {refine}: {d:e}");
     }
 }
 
