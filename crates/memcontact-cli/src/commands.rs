@@ -236,11 +236,11 @@ pub fn check(case_path: &Path, sets: &[String]) -> Result<()> {
         method.name(),
         choice.reason()
     );
-    let (available, source) = memcontact::resources::available_memory();
+    let (available, source) = memcontact::limits::available_memory();
     println!(
         "  memory       about {} to solve ({} available: {source})",
-        memcontact::resources::human_bytes(d.memory_estimate(&case.settings)),
-        memcontact::resources::human_bytes(available as f64)
+        memcontact::limits::human_bytes(d.memory_estimate(&case.settings)),
+        memcontact::limits::human_bytes(available as f64)
     );
     Ok(())
 }

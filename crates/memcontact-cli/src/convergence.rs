@@ -518,8 +518,8 @@ pub fn run(args: &Args) -> Result<()> {
         );
     }
     if args.h_sweep {
-        let base = memcontact::resources::MeshSize::of(hierarchy.finest());
-        memcontact::resources::check_mesh_fits(
+        let base = memcontact::limits::MeshSize::of(hierarchy.finest());
+        memcontact::limits::check_mesh_fits(
             base,
             args.levels,
             &format!(

@@ -11,7 +11,7 @@ mod sweep;
 use case::PyCase;
 use convert::py_err;
 use memcontact::field::{Field, Stiffness};
-use memcontact::problem::Invalid;
+use memcontact::Invalid;
 use memcontact::solve::Silent;
 use memcontact::{Discretization, Outcome};
 use mesh::PyMesh;

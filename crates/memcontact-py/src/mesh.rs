@@ -362,8 +362,8 @@ impl PyMesh {
                 memcontact::problem::MAX_REFINE
             )));
         }
-        let base = memcontact::resources::MeshSize::of(self.finest());
-        memcontact::resources::check_mesh_fits(
+        let base = memcontact::limits::MeshSize::of(self.finest());
+        memcontact::limits::check_mesh_fits(
             base,
             times,
             &format!(

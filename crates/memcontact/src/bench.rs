@@ -9,12 +9,12 @@
 //! multigrid V-cycle (from zero, to the same relative tolerance), as the yardstick. Only
 //! the library runs here: the CLI's `memcontact bench` prints the rows.
 
+use crate::error::Result;
 use crate::fem::FnCoefficient;
 use crate::mesh::generate::{rectangle, Diagonal, RectangleSpec};
 use crate::model::{Foundation, Model, ProblemData, Sampling, Stiffness};
 use crate::solve::multigrid::{self, Options};
 use crate::solve::{Method, Settings, Silent};
-use crate::Result;
 use std::f64::consts::PI;
 use std::time::Instant;
 
@@ -72,8 +72,8 @@ pub fn obstacle(p: [f64; 2]) -> f64 {
 /// hierarchy the rectangle generator builds.
 pub fn mesh(n: usize) -> Result<crate::mesh::refine::Hierarchy> {
     let cells = n as f64 * n as f64;
-    crate::resources::check_mesh_fits(
-        crate::resources::MeshSize::simply_connected((n as f64 + 1.0).powi(2), 2.0 * cells),
+    crate::limits::check_mesh_fits(
+        crate::limits::MeshSize::simply_connected((n as f64 + 1.0).powi(2), 2.0 * cells),
         0,
         &format!("the benchmark's {n} × {n} square"),
     )?;

@@ -8,12 +8,12 @@
 //! convergence studies and the load sweeps use it; a sweep step that scales a model is
 //! checked again with [`check_model`].
 
+use crate::error::{Error, Result};
 use crate::fem::{Coefficient, VertexTriangles};
 use crate::mesh::Mesh;
 use crate::model::{Extensions, FoundationMatrix, Model, ProblemData, Stiffness};
 use crate::results::{NodalFields, Totals};
 use crate::sparse::first_non_finite;
-use crate::{Error, Result};
 
 /// Assembles the model of `data` with the extensions `ext` on `mesh`
 /// ([`Model::assemble_with`]) between the checks of the boundary data

@@ -30,6 +30,7 @@
 //!
 //! Nothing here prints or writes files: the command-line tool formats the results.
 
+use crate::error::{Error, Result};
 use crate::errors::{error_norms, rates, ErrorNorms};
 use crate::exact::ExactSolution;
 use crate::fem::{Coefficient, Element};
@@ -37,7 +38,6 @@ use crate::mesh::refine::Hierarchy;
 use crate::mesh::{Mesh, Point};
 use crate::model::{Extensions, Model, ProblemData, Stiffness};
 use crate::solve::{self, Method, Settings, Silent, Solution};
-use crate::{Error, Result};
 use std::time::Instant;
 
 /// The load of a manufactured solution (SPEC §4): `f = −t Δu + h (u − φ)⁺`, from the exact
@@ -220,8 +220,8 @@ pub fn run_with(
             "a convergence study needs at least one refinement level (levels ≥ 1)".into(),
         ));
     }
-    let base = crate::resources::MeshSize::of(hierarchy.finest());
-    crate::resources::check_mesh_fits(
+    let base = crate::limits::MeshSize::of(hierarchy.finest());
+    crate::limits::check_mesh_fits(
         base,
         settings.levels,
         &format!(
@@ -385,7 +385,7 @@ fn solve_level(
         Method::Auto => solve::auto_method(model, Some(hierarchy)),
         m => m,
     };
-    crate::resources::check_solver_fits(method, model.n())?;
+    crate::solve::check_solver_fits(method, model.n())?;
     let a = solve::attempt(model, Some(hierarchy), settings, &mut Silent)?;
     if !a.status.is_accepted(settings) {
         return Err(solve::not_converged(&a, settings));

@@ -101,3 +101,32 @@ pub fn excerpt(text: &str) -> std::borrow::Cow<'_, str> {
 
 /// Shorthand for results of this library.
 pub type Result<T, E = Error> = std::result::Result<T, E>;
+
+/// A value refused by validation: the key (dotted path) and what is wrong.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Invalid {
+    /// The dotted key, e.g. `membrane.tension`.
+    pub key: String,
+    /// What is wrong.
+    pub message: String,
+}
+
+impl Invalid {
+    /// A refusal of `key`.
+    pub fn new(key: impl Into<String>, message: impl Into<String>) -> Invalid {
+        Invalid {
+            key: key.into(),
+            message: message.into(),
+        }
+    }
+
+    /// The library error, without a file.
+    pub fn into_error(self) -> Error {
+        Error::Case {
+            file: None,
+            line: None,
+            key: self.key,
+            message: self.message,
+        }
+    }
+}

@@ -26,10 +26,10 @@
 //!
 //! `max_nodal` is `max_i |u(a_i) - U_i|` over all vertices, boundary vertices included.
 
+use crate::error::{Error, Result};
 use crate::exact::ExactSolution;
 use crate::mesh::Mesh;
 use crate::quadrature::{gauss_legendre, map, DEGREE5};
-use crate::{Error, Result};
 use rayon::prelude::*;
 use std::f64::consts::PI;
 

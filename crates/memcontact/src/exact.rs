@@ -13,7 +13,7 @@
 //! the caller's error and must be checked by the caller (the error norms of
 //! [`crate::errors`] do).
 
-use crate::{Error, Result};
+use crate::error::{Error, Result};
 use spec_math::cephes64::{i0, i0e, i1e};
 use std::f64::consts::PI;
 

@@ -36,7 +36,7 @@
 //! look at is NaN, so that the data checks of [`crate::field`] catch it.
 
 use crate::error::excerpt;
-use crate::{Error, Result};
+use crate::error::{Error, Result};
 use std::fmt;
 
 /// Nesting limit of parentheses, unary operators and exponents (protects the parser's stack).

@@ -7,10 +7,10 @@
 //! whether it is constant on a region, to skip quadrature). [`check_values`] validates
 //! sampled values (`h ≥ 0`, no NaN, ...) and says where a bad value sits.
 
+use crate::error::{Error, Result};
 use crate::expr::Expr;
 use crate::mesh::Mesh;
 use crate::nodal::NodalP1;
-use crate::{Error, Result};
 use serde::de::{self, Deserializer, MapAccess, SeqAccess, Visitor};
 use serde::ser::{SerializeMap, Serializer};
 use std::collections::BTreeMap;
@@ -18,7 +18,7 @@ use std::fmt;
 use std::sync::Arc;
 
 /// The key of a region table that applies to the regions not listed.
-pub const DEFAULT_KEY: &str = "default";
+pub const DEFAULT_KEY: &str = crate::mesh::regions::DEFAULT;
 
 /// A scalar field on the domain: the data f, φ or h.
 ///
@@ -224,44 +224,6 @@ impl Field {
             fallback,
         })
     }
-}
-
-/// Warnings about region names that region tables cannot address plainly: a region other
-/// than tag 0 named `"default"` (the key of every other region's value), an empty name, or
-/// a number
-/// that is another region's tag (its key would be ambiguous, and is refused by
-/// [`Field::bind`]). `tags` are the region tags of the mesh (repetitions are fine).
-pub fn region_name_warnings(names: &BTreeMap<u32, String>, tags: &[u32]) -> Vec<String> {
-    let mut warnings = Vec::new();
-    let mut present = tags.to_vec();
-    present.sort_unstable();
-    present.dedup();
-    let is_tag = |t: u32| present.binary_search(&t).is_ok() || names.contains_key(&t);
-    for (&tag, n) in names {
-        // Tag 0 named "default" is this program's own convention (the triangles outside
-        // every named polygon region): the default value is indeed its value.
-        if n == DEFAULT_KEY && tag != 0 {
-            warnings.push(format!(
-                "physical surface {tag} is named \"{DEFAULT_KEY}\", the region-table key \
-                 of the value of every other region: give its own value under the key \
-                 \"{tag}\" (its tag), or rename it"
-            ));
-        } else if n.trim().is_empty() {
-            warnings.push(format!(
-                "physical surface {tag} has an empty name: region tables reach it by its \
-                 tag, \"{tag}\""
-            ));
-        } else if let Ok(other) = n.trim().parse::<u32>() {
-            if other != tag && is_tag(other) {
-                warnings.push(format!(
-                    "physical surface {tag} is named \"{n}\", which is also the tag of \
-                     physical surface {other}: a region-table key \"{n}\" is ambiguous and \
-                     is refused; rename the surface"
-                ));
-            }
-        }
-    }
-    warnings
 }
 
 impl From<f64> for Field {
@@ -939,44 +901,6 @@ mod tests {
     }
 
     #[test]
-    fn ambiguous_region_names_are_warned_about_and_refused() {
-        // Tag 5 is named "2", and tag 2 exists: the key "2" could mean either.
-        let names = BTreeMap::from([
-            (2, "clay".to_string()),
-            (5, "2".to_string()),
-            (6, "default".to_string()),
-            (7, String::new()),
-            (8, "8".to_string()),
-        ]);
-        let tags = [2, 5, 6, 7, 8, 2];
-        let w = region_name_warnings(&names, &tags);
-        assert_eq!(w.len(), 3, "{w:?}");
-        assert!(
-            w[0].contains("surface 5") && w[0].contains("ambiguous"),
-            "{w:?}"
-        );
-        assert!(
-            w[1].contains("surface 6") && w[1].contains("\"6\""),
-            "{w:?}"
-        );
-        assert!(
-            w[2].contains("surface 7") && w[2].contains("empty"),
-            "{w:?}"
-        );
-        let m = data_error(json(r#"{"2": 1, "default": 0}"#).bind("stiffness h", &names, &tags));
-        assert!(m.contains("'2' is ambiguous") && m.contains("clay"), "{m}");
-        // Tags reach the regions whose names are reserved or empty; a name equal to its
-        // own tag is no ambiguity.
-        let h = json(r#"{"6": 1, "7": 2, "8": 3, "clay": 4, "default": 0}"#)
-            .bind("stiffness h", &names, &tags)
-            .unwrap();
-        assert_eq!(h.eval([0.0, 0.0], 6), 1.0);
-        assert_eq!(h.eval([0.0, 0.0], 7), 2.0);
-        assert_eq!(h.eval([0.0, 0.0], 8), 3.0);
-        assert_eq!(h.eval([0.0, 0.0], 5), 0.0);
-    }
-
-    #[test]
     fn region_tables_by_name_tag_and_default() {
         let table = json(r#"{"soil": 100, "2": "50*x", "default": 7}"#);
         let h = table
@@ -1197,5 +1121,29 @@ mod tests {
         check::<Field>();
         check::<BoundField>();
         check::<Stiffness>();
+    }
+
+    #[test]
+    fn ambiguous_region_names_are_refused() {
+        // Tag 5 is named "2", and tag 2 exists: the key "2" could mean either.
+        let names = BTreeMap::from([
+            (2, "clay".to_string()),
+            (5, "2".to_string()),
+            (6, "default".to_string()),
+            (7, String::new()),
+            (8, "8".to_string()),
+        ]);
+        let tags = [2, 5, 6, 7, 8, 2];
+        let m = data_error(json(r#"{"2": 1, "default": 0}"#).bind("stiffness h", &names, &tags));
+        assert!(m.contains("'2' is ambiguous") && m.contains("clay"), "{m}");
+        // Tags reach the regions whose names are reserved or empty; a name equal to its
+        // own tag is no ambiguity.
+        let h = json(r#"{"6": 1, "7": 2, "8": 3, "clay": 4, "default": 0}"#)
+            .bind("stiffness h", &names, &tags)
+            .unwrap();
+        assert_eq!(h.eval([0.0, 0.0], 6), 1.0);
+        assert_eq!(h.eval([0.0, 0.0], 7), 2.0);
+        assert_eq!(h.eval([0.0, 0.0], 8), 3.0);
+        assert_eq!(h.eval([0.0, 0.0], 5), 0.0);
     }
 }

@@ -4,6 +4,7 @@
 //! certificates of Problems 2e and 2f.
 
 pub use crate::certificate::Certificate;
+use crate::error::{Error, Result};
 use crate::fem::assemble_lift;
 use crate::fem::{
     assemble_stiffness_and_mass, unknowns_pattern, Coefficient, Loads, VertexTriangles,
@@ -12,7 +13,6 @@ use crate::mesh::boundary::FixedBoundary;
 use crate::mesh::{DofMap, Mesh};
 use crate::quadrature::gauss_legendre;
 use crate::sparse::{norm_inf, Csr};
-use crate::{Error, Result};
 use rayon::prelude::*;
 use std::sync::Arc;
 

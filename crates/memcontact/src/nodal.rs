@@ -7,8 +7,8 @@
 //! the piecewise-linear function, and φ sampled at a vertex is exactly the value given
 //! there. Points are located with a uniform grid of triangle buckets.
 
+use crate::error::{Error, Result};
 use crate::mesh::{Mesh, Point};
-use crate::{Error, Result};
 use std::sync::Arc;
 
 /// The P1 interpolant of values at the vertices of a mesh, evaluable at any point of the

@@ -10,6 +10,7 @@
 //! room for it (the CSV header lines are contracts), are bound to it by their hashes in
 //! the summary or manifest.
 
+use crate::error::{Error, Result};
 use crate::io::csv::write_columns_csv;
 use crate::io::json::write_json;
 use crate::io::result_set::ResultSet;
@@ -19,7 +20,6 @@ use crate::results::NodalFields;
 use crate::run::Outcome;
 use crate::summary::{FileRecord, Summary};
 use crate::sweep::{StepRow, StepSpec};
-use crate::{Error, Result};
 use std::path::Path;
 use std::time::Instant;
 
@@ -90,8 +90,8 @@ pub fn input_hash(case: &Case) -> String {
         // Streamed through the hash (the digest of the whole file's bytes), never held in
         // memory whole.
         use std::io::Read;
-        let kind = crate::resources::MESH_FILE;
-        let streamed = crate::resources::open_input(path, kind).and_then(|(file, _)| {
+        let kind = crate::io::input::MESH_FILE;
+        let streamed = crate::io::input::open_input(path, kind).and_then(|(file, _)| {
             let mut reader = file.take(kind.cap + 1);
             let mut buf = vec![0u8; 1 << 20];
             loop {

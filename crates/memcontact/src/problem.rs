@@ -7,21 +7,21 @@
 //! and its discretisation), the solver [`Settings`], the [`OutputOptions`] and, for
 //! convergence studies, the [`ExactSpec`] of a closed-form solution.
 
+use crate::error::{Error, Invalid, Result};
 use crate::field::{Field, Stiffness};
+use crate::limits::{check_mesh_fits, MeshSize};
 use crate::mesh::generate::{self, Diagonal, PolygonSpec, RectangleSpec};
 use crate::mesh::refine::Hierarchy;
 use crate::model::{Foundation, Sampling};
-use crate::resources::{check_mesh_fits, MeshSize};
 use crate::solve::Settings;
-use crate::{Error, Result};
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 
-pub use crate::resources::CASE_FILE_CAP;
+pub use crate::io::input::CASE_FILE_CAP;
 
 /// The largest number of uniform refinements accepted (each multiplies the triangles by
 /// four); the size of the refined mesh is checked separately against the memory available
-/// ([`crate::resources::check_mesh_fits`], before refining).
+/// ([`crate::limits::check_mesh_fits`], before refining).
 pub const MAX_REFINE: usize = 12;
 
 /// A whole case: the problem, how to solve it, what to write, and (optionally) its exact
@@ -1011,35 +1011,6 @@ impl BenchmarkBody {
     }
 }
 
-/// A value refused by validation: the key (dotted path) and what is wrong.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Invalid {
-    /// The dotted key, e.g. `membrane.tension`.
-    pub key: String,
-    /// What is wrong.
-    pub message: String,
-}
-
-impl Invalid {
-    /// A refusal of `key`.
-    pub fn new(key: impl Into<String>, message: impl Into<String>) -> Invalid {
-        Invalid {
-            key: key.into(),
-            message: message.into(),
-        }
-    }
-
-    /// The library error, without a file.
-    pub fn into_error(self) -> Error {
-        Error::Case {
-            file: None,
-            line: None,
-            key: self.key,
-            message: self.message,
-        }
-    }
-}
-
 /// Checks a field's constants (a number, or the numbers of a region table): finite, and
 /// non-negative when asked. Expressions are checked where they are evaluated.
 fn check_field(key: &str, f: &Field, non_negative: bool) -> std::result::Result<(), Invalid> {
@@ -1275,7 +1246,7 @@ impl Case {
 
 /// Reads a case file: a regular file, at most [`CASE_FILE_CAP`] bytes, UTF-8.
 fn read_case_text(path: &Path) -> Result<String> {
-    let bytes = crate::resources::read_input(path, crate::resources::CASE_FILE)?;
+    let bytes = crate::io::input::read_input(path, crate::io::input::CASE_FILE)?;
     String::from_utf8(bytes).map_err(|e| Error::File {
         path: path.to_path_buf(),
         message: format!(

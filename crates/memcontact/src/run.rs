@@ -11,18 +11,19 @@
 //! and its certificate. The library prints nothing: progress reaches the caller through
 //! the [`Observer`].
 
+use crate::error::Invalid;
+use crate::error::{Error, Result};
 use crate::field::BoundField;
 use crate::mesh::refine::Hierarchy;
 use crate::mesh::{Mesh, MeshQuality};
 use crate::model::{
     BodyData, BoundaryData, Certificate, Extensions, Model, ProblemData, Stiffness,
 };
-use crate::problem::{Invalid, Problem};
+use crate::problem::Problem;
 use crate::results::{derive_from, NodalFields, Totals};
 use crate::solve::{
     self, Choice, Fallback, IterationRecord, Method, Observer, Settings, Solution, Status,
 };
-use crate::{Error, Result};
 use std::borrow::Cow;
 use std::time::Instant;
 
@@ -342,16 +343,16 @@ impl Discretization {
     }
 
     /// Refuses a solve with `settings` whose factorisation would not fit in the memory
-    /// available ([`crate::resources::check_solver_fits`]); `solve` and `check` call it.
+    /// available ([`crate::solve::check_solver_fits`]); `solve` and `check` call it.
     pub fn check_memory(&self, settings: &Settings) -> Result<()> {
-        crate::resources::check_solver_fits(self.method_for(settings), self.model.n())
+        crate::solve::check_solver_fits(self.method_for(settings), self.model.n())
     }
 
     /// The estimated peak memory of solving with `settings` (bytes): the run's data on
-    /// this mesh and the solver's factorisation ([`crate::resources`]).
+    /// this mesh ([`crate::limits::run_bytes`]) and the solver's factorisation ([`crate::solve::solver_bytes`]).
     pub fn memory_estimate(&self, settings: &Settings) -> f64 {
-        crate::resources::run_bytes(crate::resources::MeshSize::of(self.mesh()))
-            + crate::resources::solver_bytes(self.method_for(settings), self.model.n())
+        crate::limits::run_bytes(crate::limits::MeshSize::of(self.mesh()))
+            + crate::solve::solver_bytes(self.method_for(settings), self.model.n())
     }
 
     /// Solves the discrete problem with `settings`.
@@ -491,7 +492,7 @@ impl Report {
     }
 
     /// The error naming how the solve ended, when the settings do not accept it.
-    pub fn error(&self) -> Option<crate::Error> {
+    pub fn error(&self) -> Option<crate::error::Error> {
         (!self.accepted).then(|| {
             solve::status_error(
                 self.status,

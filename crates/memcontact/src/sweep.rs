@@ -8,14 +8,15 @@
 //! L, the tension S, and the obstacle offset adds to φₙ. A load case with new data
 //! assembles once on the same mesh.
 
+use crate::error::Invalid;
+use crate::error::{Error, Result};
 use crate::field::{Field, Stiffness};
 use crate::mesh::refine::Hierarchy;
 use crate::mesh::Mesh;
 use crate::model::{FoundationMatrix, Model};
-use crate::problem::{Case, Invalid, Problem};
+use crate::problem::{Case, Problem};
 use crate::run::{assemble_model, bind_and_check, Discretization, Outcome};
 use crate::solve::Observer;
-use crate::{Error, Result};
 use serde::{Deserialize, Serialize};
 use std::time::Instant;
 

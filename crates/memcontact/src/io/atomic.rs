@@ -3,7 +3,7 @@
 //! as they are written ([`Written`]), so a result set's manifest never reads its files back.
 
 use super::staged::Staged;
-use crate::{Error, Result};
+use crate::error::{Error, Result};
 use std::io::Write;
 use std::path::Path;
 

@@ -3,7 +3,9 @@
 mod atomic;
 pub mod csv;
 pub mod gmsh;
+pub mod input;
 pub mod json;
+pub mod numbers;
 pub mod result_set;
 mod staged;
 pub mod vtu;

@@ -3,7 +3,7 @@
 
 use super::refine::{Hierarchy, Refinement};
 use super::{Circle, Mesh, Point};
-use crate::{Error, Result};
+use crate::error::{Error, Result};
 use rayon::prelude::*;
 use spade::{
     AngleLimit, ConstrainedDelaunayTriangulation, Point2, RefinementParameters, Triangulation,

@@ -4,11 +4,12 @@
 pub mod boundary;
 pub mod generate;
 pub mod refine;
+pub mod regions;
 pub mod reorder;
 
 pub use boundary::BoundaryRegions;
 
-use crate::{Error, Result};
+use crate::error::{Error, Result};
 use std::collections::BTreeMap;
 
 /// A point of the plane.
@@ -697,7 +698,7 @@ mod tests {
             }
         }
         for threads in [1, 2, 3] {
-            let adj = crate::on_threads(threads, || VertexTriangles::new(&mesh));
+            let adj = crate::parallel::on_threads(threads, || VertexTriangles::new(&mesh));
             for (v, list) in lists.iter().enumerate() {
                 assert_eq!(adj.of(v), &list[..], "vertex {v}, {threads} threads");
             }

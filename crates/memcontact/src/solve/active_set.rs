@@ -22,9 +22,9 @@ use super::line_search::{apply_step, exact_step, line_data};
 use super::local::sweep_forward;
 use super::newton::{newton_system, unit_diagonal_on_truncated, NewtonStates};
 use super::{IterationRecord, Method, Observer, PhaseTimer, Settings, Solution};
+use crate::error::{Error, Result};
 use crate::model::Model;
 use crate::sparse::{Cholesky, Csr};
-use crate::{Error, Result};
 
 /// Default iteration limit.
 pub(crate) const MAX_ITERATIONS: usize = 500;

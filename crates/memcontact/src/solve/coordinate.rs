@@ -5,8 +5,8 @@
 
 use super::local::sweep_forward;
 use super::{IterationRecord, Method, Observer, PhaseTimer, Settings, Solution};
+use crate::error::Result;
 use crate::model::Model;
-use crate::Result;
 
 /// Default limit on sweeps.
 pub(crate) const MAX_SWEEPS: usize = 1_000_000;

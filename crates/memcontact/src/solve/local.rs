@@ -459,7 +459,7 @@ mod tests {
                 energy = e;
             }
             let mut serial = start.clone();
-            crate::on_threads(1, || {
+            crate::parallel::on_threads(1, || {
                 for _ in 0..3 {
                     sweep_forward(model, &mut serial);
                 }

@@ -21,9 +21,9 @@ pub mod multigrid;
 pub mod newton;
 pub mod qp;
 
+use crate::error::{Error, Result};
 use crate::mesh::refine::Hierarchy;
 use crate::model::{Certificate, Model};
-use crate::{Error, Result};
 use std::time::Instant;
 
 /// The solution methods.
@@ -119,8 +119,8 @@ pub const LOOSEST_TOLERANCE: f64 = 1e-2;
 
 impl Settings {
     /// Checks the settings: `0 < tolerance <` [`LOOSEST_TOLERANCE`], `max_iterations ≥ 1`.
-    pub fn validate(&self) -> std::result::Result<(), crate::problem::Invalid> {
-        use crate::problem::Invalid;
+    pub fn validate(&self) -> std::result::Result<(), crate::error::Invalid> {
+        use crate::error::Invalid;
         let tol = self.tolerance;
         if !(tol.is_finite() && tol > 0.0) {
             return Err(Invalid::new(
@@ -663,6 +663,42 @@ pub fn status_error(
             "{what}, with scaled KKT residual {kkt:.3e} above the tolerance {tolerance:.1e}{why}"
         ),
     }
+}
+
+/// The memory a solve by `method` adds to the run's ([`crate::limits::run_bytes`]) on `unknowns`
+/// unknowns: a sparse factorisation for the direct methods, nothing that grows faster
+/// than the run's own data for multigrid and coordinate descent.
+pub fn solver_bytes(method: Method, unknowns: usize) -> f64 {
+    let n = unknowns.max(2) as f64;
+    match method {
+        Method::ActiveSet | Method::Linear => {
+            crate::limits::DIRECT_BYTES_PER_UNKNOWN_LOG * n * n.log2()
+        }
+        Method::Qp => crate::limits::QP_BYTES_PER_UNKNOWN_LOG * n * n.log2(),
+        Method::Auto | Method::Multigrid | Method::Coordinate => 0.0,
+    }
+}
+
+/// Refuses a solve by `method` of a model of `unknowns` unknowns when its factorisation
+/// would not fit in the memory available now (the mesh and the model are already
+/// allocated and so are not counted again).
+pub fn check_solver_fits(method: Method, unknowns: usize) -> Result<()> {
+    let need = solver_bytes(method, unknowns);
+    if need == 0.0 {
+        return Ok(());
+    }
+    let (available, source) = crate::limits::available_memory();
+    if need > available as f64 {
+        return Err(Error::Data(format!(
+            "solver {}: its factorisation of {unknowns} unknowns needs about {} of memory, \
+             more than the {} available ({source}): use method = \"multigrid\" (with \
+             mesh.refine ≥ 2) or \"auto\", or a coarser mesh",
+            method.name(),
+            crate::limits::human_bytes(need),
+            crate::limits::human_bytes(available as f64),
+        )));
+    }
+    Ok(())
 }
 
 #[cfg(test)]

@@ -73,9 +73,9 @@
 
 use super::newton::{truncated_hessian, NewtonStates};
 use super::{Method, Multipliers, PhaseTimer, Settings, Solution};
+use crate::error::{Error, Result};
 use crate::model::{Certificate, FoundationMatrix, Model};
 use crate::sparse::{Cholesky, Csr};
-use crate::{Error, Result};
 use clarabel::algebra::CscMatrix;
 use clarabel::solver::{
     DefaultSettingsBuilder, DefaultSolver, IPSolver, SolverStatus, SupportedConeT,

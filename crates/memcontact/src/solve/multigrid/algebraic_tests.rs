@@ -225,7 +225,7 @@ fn results_do_not_depend_on_the_thread_count() {
     let m = model(&mesh, Some(&1000.0), Foundation::Consistent);
     assert!(m.n() > 2 * super::cycle::GS_BLOCK, "{}", m.n());
     let run = |threads: usize| {
-        crate::on_threads(threads, || {
+        crate::parallel::on_threads(threads, || {
             solve_with(
                 &m,
                 Coarsening::Algebraic,

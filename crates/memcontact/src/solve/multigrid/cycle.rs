@@ -20,10 +20,10 @@
 
 use super::operator::{apply, values_into, zero_held, TopOperator};
 use super::transfer::{galerkin_patterns, par_copy_from, par_rows, Transfer};
+use crate::error::{Error, Result};
 use crate::mesh::refine::{Hierarchy, Refinement};
 use crate::mesh::{DofMap, Mesh};
 use crate::sparse::{filled, zeroed, Cholesky, Csr, Pattern};
-use crate::{Error, Result};
 use std::sync::Arc;
 
 /// Where the coarse levels of a multigrid come from.

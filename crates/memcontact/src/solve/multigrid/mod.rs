@@ -48,10 +48,10 @@ use super::line_search::{apply_step, exact_step, line_data};
 use super::local::sweep_forward;
 use super::newton::{mark_dirty, newton_system, NewtonMatrix, NewtonStates};
 use super::{IterationRecord, Method, Observer, PhaseTimer, Settings, Solution};
+use crate::error::Result;
 use crate::mesh::refine::Hierarchy;
 use crate::model::{Certificate, FoundationMatrix, Model};
 use crate::sparse::{filled, zeroed, Csr};
-use crate::Result;
 use std::time::Instant;
 use transfer::par_rows;
 
@@ -654,9 +654,9 @@ pub fn kernel_timings(
             )),
         }
     });
-    let levels = levels
-        .filter(|l| l.len() > 1)
-        .ok_or_else(|| crate::Error::Mesh("the hierarchy does not fit or has one level".into()))?;
+    let levels = levels.filter(|l| l.len() > 1).ok_or_else(|| {
+        crate::error::Error::Mesh("the hierarchy does not fit or has one level".into())
+    })?;
     let top = levels.len() - 1;
     time("coarse models", &mut || {
         std::hint::black_box(coarse_model(

@@ -329,7 +329,7 @@ fn block_gauss_seidel_keeps_the_rate_and_ignores_the_thread_count() {
     let model = bench_model(h.finest(), Some(0.0), Foundation::Lumped);
     assert!(model.n() > cycle::GS_BLOCK);
     let run = |threads: usize| {
-        crate::on_threads(threads, || {
+        crate::parallel::on_threads(threads, || {
             poisson_solve(&model.s, &model.d, &h, &model.dofs, 1e-10, None, 50).unwrap()
         })
     };
@@ -467,7 +467,7 @@ fn fused_sweep_from_zero_is_the_sweep_and_its_residual() {
         let fused = |threads: usize| {
             // Whatever x holds on entry is ignored.
             let (mut x, mut r) = (vec![1.0; n], vec![f64::NAN; n]);
-            crate::on_threads(threads, || {
+            crate::parallel::on_threads(threads, || {
                 cycle::gauss_seidel_from_zero(&a, &inv, &mut x, &b, &mut r, &rows)
             });
             (x, r)
@@ -554,7 +554,7 @@ fn backward_sweep_with_product_is_the_sweep_and_its_product() {
         };
         let fused = |threads: usize| {
             let (mut x, mut snap, mut y) = (x0.clone(), vec![0.0; n], vec![f64::NAN; n]);
-            crate::on_threads(threads, || {
+            crate::parallel::on_threads(threads, || {
                 cycle::gauss_seidel_back_with_product(
                     &op, &inv, &mut x, &b, &mut snap, &mut y, &rows,
                 )
@@ -584,7 +584,7 @@ fn backward_sweep_with_product_is_the_sweep_and_its_product() {
         };
         let fused = |threads: usize| {
             let (mut x, mut snap, mut y) = (x1.clone(), vec![0.0; n], vec![f64::NAN; n]);
-            crate::on_threads(threads, || {
+            crate::parallel::on_threads(threads, || {
                 cycle::gauss_seidel_back_with_product(
                     &a, &inv, &mut x, &b, &mut snap, &mut y, &rows,
                 )

@@ -10,10 +10,10 @@
 //! fixed order: results never depend on the number of threads.
 
 use super::operator::{entry, TopOperator};
+use crate::error::{Error, Result};
 use crate::mesh::refine::Refinement;
 use crate::mesh::DofMap;
 use crate::sparse::{row_chunks, Csr, Pattern};
-use crate::{Error, Result};
 use rayon::prelude::*;
 use std::sync::Arc;
 
