@@ -116,7 +116,7 @@ impl Exact {
 /// manufactured case.
 struct ExactHeight<'a>(&'a dyn ExactSolution);
 
-impl memcontact::fem::Coefficient for ExactHeight<'_> {
+impl memcontact::field::Coefficient for ExactHeight<'_> {
     fn at(&self, p: [f64; 2], _: u32) -> f64 {
         if self.0.contains(p) {
             self.0.value(p)
@@ -438,7 +438,7 @@ pub fn run(args: &Args) -> Result<()> {
         check_benchmark(b, &case, hierarchy.finest(), &fields)?;
     }
     let manufactured_load;
-    let load: &dyn memcontact::fem::Coefficient = match &exact {
+    let load: &dyn memcontact::field::Coefficient = match &exact {
         Some(e) if e.manufactured() => {
             manufactured_load = ManufacturedLoad {
                 exact: e.solution(),
@@ -453,8 +453,8 @@ pub fn run(args: &Args) -> Result<()> {
                         b.stiffness
                             .as_ref()
                             .expect("elastic, checked by parse_exact")
-                            as &dyn memcontact::fem::Coefficient,
-                        &b.shape as &dyn memcontact::fem::Coefficient,
+                            as &dyn memcontact::field::Coefficient,
+                        &b.shape as &dyn memcontact::field::Coefficient,
                     )
                 }),
             };

@@ -10,7 +10,7 @@
 //! the library runs here: the CLI's `memcontact bench` prints the rows.
 
 use crate::error::Result;
-use crate::fem::FnCoefficient;
+use crate::field::FnCoefficient;
 use crate::mesh::generate::{rectangle, Diagonal, RectangleSpec};
 use crate::model::{Foundation, Model, ProblemData, Sampling, Stiffness};
 use crate::solve::multigrid::{self, Options};

@@ -9,8 +9,9 @@
 //! checked again with [`check_model`].
 
 use crate::error::{Error, Result};
-use crate::fem::{Coefficient, VertexTriangles};
+use crate::field::Coefficient;
 use crate::mesh::Mesh;
+use crate::mesh::VertexTriangles;
 use crate::model::{Extensions, FoundationMatrix, Model, ProblemData, Stiffness};
 use crate::results::{NodalFields, Totals};
 use crate::sparse::first_non_finite;

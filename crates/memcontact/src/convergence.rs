@@ -33,7 +33,8 @@
 use crate::error::{Error, Result};
 use crate::errors::{error_norms, rates, ErrorNorms};
 use crate::exact::ExactSolution;
-use crate::fem::{Coefficient, Element};
+use crate::fem::Element;
+use crate::field::Coefficient;
 use crate::mesh::refine::Hierarchy;
 use crate::mesh::{Mesh, Point};
 use crate::model::{Extensions, Model, ProblemData, Stiffness};
@@ -609,7 +610,7 @@ pub fn rigid_limit_sweep(
 mod tests {
     use super::*;
     use crate::exact::{DiskSolution, Manufactured};
-    use crate::fem::FnCoefficient;
+    use crate::field::FnCoefficient;
     use crate::mesh::generate::{self, Diagonal, RectangleSpec};
     use crate::model::{Foundation, Sampling};
 

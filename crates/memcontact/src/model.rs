@@ -6,9 +6,8 @@
 pub use crate::certificate::Certificate;
 use crate::error::{Error, Result};
 use crate::fem::assemble_lift;
-use crate::fem::{
-    assemble_stiffness_and_mass, unknowns_pattern, Coefficient, Loads, VertexTriangles,
-};
+use crate::fem::{assemble_stiffness_and_mass, unknowns_pattern, Loads, VertexTriangles};
+use crate::field::Coefficient;
 use crate::mesh::boundary::FixedBoundary;
 use crate::mesh::{DofMap, Mesh};
 use crate::quadrature::gauss_legendre;
@@ -1233,7 +1232,7 @@ mod tests {
     fn mollification_keeps_constants_and_linear_functions() {
         let m = square(4);
         let adj = VertexTriangles::new(&m);
-        let c = crate::fem::FnCoefficient(|p: crate::mesh::Point| 2.0 * p[0] - p[1] + 0.5);
+        let c = crate::field::FnCoefficient(|p: crate::mesh::Point| 2.0 * p[0] - p[1] + 0.5);
         let v = mollify(&m, &adj, &c, 0.3);
         for (k, p) in m.points.iter().enumerate() {
             assert!((v[k] - (2.0 * p[0] - p[1] + 0.5)).abs() < 1e-13);

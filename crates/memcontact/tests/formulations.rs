@@ -3,7 +3,7 @@
 //! partial foundation, the solutions of 2f (active set), 2c (QP, Clarabel) and 2b
 //! (coordinate descent) coincide, and every answer satisfies the 2e and 2f certificates.
 
-use memcontact::fem::{Coefficient, FnCoefficient};
+use memcontact::field::{Coefficient, FnCoefficient};
 use memcontact::io::gmsh::read_msh;
 use memcontact::mesh::generate::{disk, rectangle, Diagonal, RectangleSpec};
 use memcontact::mesh::Mesh;

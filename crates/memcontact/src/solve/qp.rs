@@ -865,7 +865,7 @@ fn polish(model: &Model, guess: NewtonStates, tolerance: f64) -> Option<Polished
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::fem::{Coefficient, FnCoefficient};
+    use crate::field::{Coefficient, FnCoefficient};
     use crate::model::Foundation;
     use crate::solve::tests::{model, square};
     use crate::solve::{active_set, Silent};

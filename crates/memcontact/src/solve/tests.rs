@@ -2,7 +2,7 @@
 //! certificates at the tolerance.
 
 use super::*;
-use crate::fem::FnCoefficient;
+use crate::field::FnCoefficient;
 use crate::mesh::Mesh;
 use crate::model::{Foundation, ProblemData, Sampling, Stiffness};
 use std::collections::BTreeMap;
@@ -44,7 +44,7 @@ fn rel_diff(a: &[f64], b: &[f64]) -> f64 {
 
 pub(crate) fn model(
     mesh: &Mesh,
-    h: Option<&dyn crate::fem::Coefficient>,
+    h: Option<&dyn crate::field::Coefficient>,
     foundation: Foundation,
 ) -> Model {
     let phi = FnCoefficient(|p: [f64; 2]| 0.12 + 0.05 * (6.0 * p[0]).sin() * p[1]);

@@ -5,7 +5,7 @@
 //! results independent of the number of threads.
 
 use super::*;
-use crate::fem::Coefficient;
+use crate::field::Coefficient;
 use crate::mesh::generate::{disk, polygon, PolygonSpec};
 use crate::mesh::{Mesh, Point};
 use crate::model::{Foundation, ProblemData, Sampling, Stiffness};

@@ -2,7 +2,7 @@
 //! against the active-set method, monotone energy, iteration counts under refinement.
 
 use super::*;
-use crate::fem::FnCoefficient;
+use crate::field::FnCoefficient;
 use crate::mesh::refine::Refinement;
 use crate::mesh::{DofMap, Mesh};
 use crate::model::{Foundation, ProblemData, Sampling, Stiffness};

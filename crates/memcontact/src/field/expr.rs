@@ -52,7 +52,7 @@ const INLINE_STACK: usize = 24;
 /// is described in the [module documentation](self).
 ///
 /// ```
-/// use memcontact::expr::Expr;
+/// use memcontact::field::expr::Expr;
 /// let e = Expr::parse("0.5 + 0.1*sin(2*pi*x)*cos(2*pi*y)").unwrap();
 /// assert!((e.eval(0.25, 0.0) - 0.6).abs() < 1e-15);
 /// assert_eq!(Expr::parse("2^10 - 24").unwrap().constant_value(), Some(1000.0));

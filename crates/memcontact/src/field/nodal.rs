@@ -258,7 +258,7 @@ mod tests {
         let mesh = generate::disk([0.0, 0.0], 1.0, 0.15).unwrap();
         let (f, h, phi) = ("6 + 2*x - y", "80 + 30*x + 10*y", "0.9 - 0.2*x + 0.1*y");
         let nodal = |e: &str| {
-            let e = crate::expr::Expr::parse(e).unwrap();
+            let e = crate::field::expr::Expr::parse(e).unwrap();
             Field::Nodal(mesh.points.iter().map(|p| e.eval(p[0], p[1])).collect())
         };
         for foundation in [Foundation::Consistent, Foundation::Lumped] {
