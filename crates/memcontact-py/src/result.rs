@@ -4,7 +4,7 @@
 use crate::case::PyCase;
 use crate::convert::{py_err, to_py};
 use crate::mesh::{hierarchy_from_state, mesh_state, PyMesh};
-use memcontact::model::Certificate;
+use memcontact::certificate::Certificate;
 use memcontact::output::{input_hash, new_run_id, WriteOptions};
 use memcontact::problem::VtuFormat;
 use memcontact::results::{LowerFields, NodalFields};

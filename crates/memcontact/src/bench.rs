@@ -12,7 +12,7 @@
 use crate::error::Result;
 use crate::field::FnCoefficient;
 use crate::mesh::generate::{rectangle, Diagonal, RectangleSpec};
-use crate::model::{Foundation, Model, ProblemData, Sampling, Stiffness};
+use crate::model::{BodyStiffness, Foundation, Model, ProblemData, Sampling};
 use crate::solve::multigrid::{self, Options};
 use crate::solve::{Method, Settings, Silent};
 use std::f64::consts::PI;
@@ -97,7 +97,7 @@ pub fn model(mesh: &crate::mesh::Mesh, foundation: Foundation) -> Result<Model> 
             tension: 1.0,
             load: &20.0,
             shape: &phi,
-            stiffness: Stiffness::Elastic(&1000.0),
+            stiffness: BodyStiffness::Elastic(&1000.0),
             foundation,
             sampling: Sampling::Nodal,
         },

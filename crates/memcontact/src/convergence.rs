@@ -37,7 +37,7 @@ use crate::fem::Element;
 use crate::field::Coefficient;
 use crate::mesh::refine::Hierarchy;
 use crate::mesh::{Mesh, Point};
-use crate::model::{Extensions, Model, ProblemData, Stiffness};
+use crate::model::{BodyStiffness, Extensions, Model, ProblemData};
 use crate::solve::{self, Method, Settings, Silent, Solution};
 use std::time::Instant;
 
@@ -244,7 +244,8 @@ pub fn run_with(
         let refine_seconds = t0.elapsed().as_secs_f64();
         let mesh = hierarchy.finest();
         let t1 = Instant::now();
-        let model = crate::checks::assemble(mesh, data, ext).map_err(|e| at_level(level, e))?;
+        let model =
+            crate::model::assemble_checked(mesh, data, ext).map_err(|e| at_level(level, e))?;
         let assembly_seconds = t1.elapsed().as_secs_f64();
         let t2 = Instant::now();
         let (solution, note) =
@@ -375,7 +376,7 @@ fn at_level(level: usize, e: Error) -> Error {
 /// one policy ([`solve::attempt`]: with [`Method::Auto`], multigrid when the hierarchy
 /// allows it and the active-set method when multigrid does not converge), after the
 /// memory check of its solver. A status the settings do not accept is an error, and so is
-/// an answer whose J or certificate is not finite ([`crate::checks::check_solution`]); a
+/// an answer whose J or certificate is not finite ([`crate::outcome::checks::check_solution`]); a
 /// fallback is returned as a note.
 fn solve_level(
     model: &Model,
@@ -404,7 +405,7 @@ fn solve_level(
             a.solution.method.name()
         )
     });
-    crate::checks::check_solution(
+    crate::outcome::checks::check_solution(
         a.solution.energy,
         a.solution.certificate.kkt(),
         model.is_rigid(),
@@ -567,20 +568,20 @@ pub fn rigid_limit_sweep(
     }
     let mesh = hierarchy.finest();
     let rigid_data = ProblemData {
-        stiffness: Stiffness::Rigid,
+        stiffness: BodyStiffness::Rigid,
         ..*data
     };
-    let rigid_model = crate::checks::assemble(mesh, &rigid_data, &Extensions::default())?;
+    let rigid_model = crate::model::assemble_checked(mesh, &rigid_data, &Extensions::default())?;
     let (rigid, _) = solve_level(&rigid_model, hierarchy, solver)?;
     let rigid_u = rigid_model.to_vertices(&rigid.u);
     let rigid_contact = contact_estimate(mesh, &rigid_model, &rigid.u);
     let mut rows = Vec::with_capacity(stiffnesses.len());
     for &h in stiffnesses {
         let d = ProblemData {
-            stiffness: Stiffness::Elastic(&h),
+            stiffness: BodyStiffness::Elastic(&h),
             ..*data
         };
-        let model = crate::checks::assemble(mesh, &d, &Extensions::default())?;
+        let model = crate::model::assemble_checked(mesh, &d, &Extensions::default())?;
         let t = Instant::now();
         let (s, _) = solve_level(&model, hierarchy, solver)?;
         let solve_seconds = t.elapsed().as_secs_f64();
@@ -636,7 +637,7 @@ mod tests {
             tension: 1.0,
             load: &8.0,
             shape: &1.0,
-            stiffness: Stiffness::Elastic(&100.0),
+            stiffness: BodyStiffness::Elastic(&100.0),
             foundation,
             sampling: Sampling::Nodal,
         };
@@ -711,7 +712,7 @@ mod tests {
             tension: 1.5,
             load: &load,
             shape: &phi,
-            stiffness: Stiffness::Elastic(&h),
+            stiffness: BodyStiffness::Elastic(&h),
             foundation,
             sampling: Sampling::Nodal,
         };
@@ -775,7 +776,7 @@ mod tests {
             tension: 1.0,
             load: &8.0,
             shape: &1.0,
-            stiffness: Stiffness::Elastic(&0.0),
+            stiffness: BodyStiffness::Elastic(&0.0),
             foundation: Foundation::Consistent,
             sampling: Sampling::Nodal,
         };

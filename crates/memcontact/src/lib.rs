@@ -10,7 +10,7 @@
 
 pub mod bench;
 pub mod certificate;
-pub mod checks;
+
 pub mod convergence;
 pub mod error;
 pub mod errors;
@@ -21,6 +21,7 @@ pub mod io;
 pub mod limits;
 pub mod mesh;
 pub mod model;
+pub mod outcome;
 pub mod output;
 pub mod parallel;
 pub mod problem;

@@ -231,7 +231,7 @@ pub fn write_files(
     let t0 = Instant::now();
     let (fields, totals) = outcome.checked_fields()?;
     let r = &outcome.report;
-    crate::checks::check_solution(
+    crate::outcome::checks::check_solution(
         r.energy,
         r.certificate.kkt(),
         outcome.discretization.model.is_rigid(),

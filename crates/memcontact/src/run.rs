@@ -11,14 +11,13 @@
 //! and its certificate. The library prints nothing: progress reaches the caller through
 //! the [`Observer`].
 
+use crate::certificate::Certificate;
 use crate::error::Invalid;
 use crate::error::{Error, Result};
 use crate::field::BoundField;
 use crate::mesh::refine::Hierarchy;
 use crate::mesh::{Mesh, MeshQuality};
-use crate::model::{
-    BodyData, BoundaryData, Certificate, Extensions, Model, ProblemData, Stiffness,
-};
+use crate::model::{BodyData, BodyStiffness, BoundaryData, Extensions, Model, ProblemData};
 use crate::problem::Problem;
 use crate::results::{derive_from, NodalFields, Totals};
 use crate::solve::{
@@ -74,10 +73,10 @@ impl BoundBody {
         })
     }
 
-    fn stiffness(&self) -> Stiffness<'_> {
+    fn stiffness(&self) -> BodyStiffness<'_> {
         match &self.stiffness {
-            Some(h) => Stiffness::Elastic(h),
-            None => Stiffness::Rigid,
+            Some(h) => BodyStiffness::Elastic(h),
+            None => BodyStiffness::Rigid,
         }
     }
 }
@@ -114,8 +113,8 @@ impl BoundData {
             load: &self.load,
             shape: &self.shape,
             stiffness: match &self.stiffness {
-                Some(h) => Stiffness::Elastic(h),
-                None => Stiffness::Rigid,
+                Some(h) => BodyStiffness::Elastic(h),
+                None => BodyStiffness::Rigid,
             },
             foundation: problem.obstacle.foundation,
             sampling: problem.obstacle.sampling(),
@@ -256,8 +255,13 @@ impl Discretization {
         let (adj, boundary) = mesh.patches();
         let bound = BoundData::new(problem, mesh)?;
         let data = bound.data(problem);
-        let model =
-            crate::checks::assemble_on(mesh, &adj, &boundary, &data, &bound.extensions(problem))?;
+        let model = crate::model::assemble_checked_on(
+            mesh,
+            &adj,
+            &boundary,
+            &data,
+            &bound.extensions(problem),
+        )?;
         let quality = mesh.quality_with(&boundary);
         let seconds = t0.elapsed().as_secs_f64();
         observer.phase_finished("assembly", seconds);
@@ -374,7 +378,7 @@ impl Discretization {
         observer.phase_started("solve");
         let t0 = Instant::now();
         let a = solve::attempt_from(&self.model, self.levels(), settings, start, observer)?;
-        crate::checks::check_solution(
+        crate::outcome::checks::check_solution(
             a.solution.energy,
             a.solution.certificate.kkt(),
             self.model.is_rigid(),
@@ -382,7 +386,7 @@ impl Discretization {
         // The fields and totals of the answer (pressures, forces, areas) must be finite
         // too: refused here, before any caller reports or writes them.
         let (fields, totals) = derive_from(self.mesh(), &self.model, &a.solution.u);
-        crate::checks::check_results(self.mesh(), &fields, &totals)?;
+        crate::outcome::checks::check_results(self.mesh(), &fields, &totals)?;
         let derived = Some(std::sync::Arc::new((fields, totals)));
         let seconds = t0.elapsed().as_secs_f64();
         observer.phase_finished("solve", seconds);
@@ -420,18 +424,18 @@ impl Discretization {
 }
 
 /// Binds the problem's data to `mesh`, checks it (on the boundary, and for overflow:
-/// [`crate::checks::assemble`]) and assembles the model S, L, D, φₙ, M of the paper's §2.
+/// [`crate::model::assemble_checked`]) and assembles the model S, L, D, φₙ, M of the paper's §2.
 /// `problem.mesh` is not used.
 pub fn assemble_model(problem: &Problem, mesh: &Mesh) -> Result<Model> {
     let bound = BoundData::new(problem, mesh)?;
-    crate::checks::assemble(mesh, &bound.data(problem), &bound.extensions(problem))
+    crate::model::assemble_checked(mesh, &bound.data(problem), &bound.extensions(problem))
 }
 
 /// Binds the problem's data to `mesh` and checks it where assembly does not sample it (on
 /// the boundary): the checks of [`assemble_model`] that need no assembly.
 pub fn bind_and_check(problem: &Problem, mesh: &Mesh) -> Result<BoundData> {
     let bound = BoundData::new(problem, mesh)?;
-    crate::checks::check_boundary_data(mesh, &bound.data(problem), &bound.extensions(problem))?;
+    crate::model::check_boundary_data(mesh, &bound.data(problem), &bound.extensions(problem))?;
     Ok(bound)
 }
 
@@ -557,11 +561,11 @@ impl Outcome {
         self.solver_fields().1
     }
 
-    /// [`Outcome::fields`], checked to be finite ([`crate::checks::check_results`]): the
+    /// [`Outcome::fields`], checked to be finite ([`crate::outcome::checks::check_results`]): the
     /// fields that result files hold.
     pub fn checked_fields(&self) -> Result<(Cow<'_, NodalFields>, Totals)> {
         let (fields, totals) = self.solver_fields();
-        crate::checks::check_results(self.discretization.mesh(), &fields, &totals)?;
+        crate::outcome::checks::check_results(self.discretization.mesh(), &fields, &totals)?;
         Ok((self.to_user(fields), totals))
     }
 

@@ -538,7 +538,7 @@ pub fn run_sweep_on(
                 seconds,
             });
         }
-        crate::checks::check_model(current.mesh(), &current.model)
+        crate::model::check_model(current.mesh(), &current.model)
             .map_err(|e| at_step(step, case, e))?;
         let report = current
             .solve_from(

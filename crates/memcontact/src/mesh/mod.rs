@@ -662,6 +662,29 @@ pub fn dist(a: Point, b: Point) -> f64 {
     ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2)).sqrt()
 }
 
+/// The unit square cut into `n × n` cells, each into two triangles (tests of every
+/// layer).
+#[cfg(test)]
+/// The unit square cut into `n × n` cells, each into two triangles.
+pub(crate) fn test_square(n: usize) -> Mesh {
+    let mut p = Vec::new();
+    for j in 0..=n {
+        for i in 0..=n {
+            p.push([i as f64 / n as f64, j as f64 / n as f64]);
+        }
+    }
+    let mut t = Vec::new();
+    let w = (n + 1) as u32;
+    for j in 0..n as u32 {
+        for i in 0..n as u32 {
+            let a = j * w + i;
+            t.push([a, a + 1, a + w + 1]);
+            t.push([a, a + w + 1, a + w]);
+        }
+    }
+    Mesh::new(p, t, vec![], BTreeMap::new()).unwrap()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

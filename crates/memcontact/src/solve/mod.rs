@@ -21,9 +21,10 @@ pub mod multigrid;
 pub mod newton;
 pub mod qp;
 
+use crate::certificate::Certificate;
 use crate::error::{Error, Result};
 use crate::mesh::refine::Hierarchy;
-use crate::model::{Certificate, Model};
+use crate::model::Model;
 use std::time::Instant;
 
 /// The solution methods.

@@ -73,8 +73,9 @@
 
 use super::newton::{truncated_hessian, NewtonStates};
 use super::{Method, Multipliers, PhaseTimer, Settings, Solution};
+use crate::certificate::Certificate;
 use crate::error::{Error, Result};
-use crate::model::{Certificate, FoundationMatrix, Model};
+use crate::model::{FoundationMatrix, Model};
 use crate::sparse::{Cholesky, Csr};
 use clarabel::algebra::CscMatrix;
 use clarabel::solver::{
@@ -866,8 +867,9 @@ fn polish(model: &Model, guess: NewtonStates, tolerance: f64) -> Option<Polished
 mod tests {
     use super::*;
     use crate::field::{Coefficient, FnCoefficient};
+    use crate::mesh::test_square as square;
+    use crate::model::testing::model;
     use crate::model::Foundation;
-    use crate::solve::tests::{model, square};
     use crate::solve::{active_set, Silent};
     use crate::sparse::norm_inf;
 

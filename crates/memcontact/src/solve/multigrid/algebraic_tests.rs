@@ -8,7 +8,7 @@ use super::*;
 use crate::field::Coefficient;
 use crate::mesh::generate::{disk, polygon, PolygonSpec};
 use crate::mesh::{Mesh, Point};
-use crate::model::{Foundation, ProblemData, Sampling, Stiffness};
+use crate::model::{BodyStiffness, Foundation, ProblemData, Sampling};
 use crate::solve::{active_set, Silent};
 use crate::sparse::norm_inf;
 
@@ -43,8 +43,8 @@ fn model(mesh: &Mesh, h: Option<&dyn Coefficient>, foundation: Foundation) -> Mo
             load: &20.0,
             shape: &phi,
             stiffness: match h {
-                Some(h) => Stiffness::Elastic(h),
-                None => Stiffness::Rigid,
+                Some(h) => BodyStiffness::Elastic(h),
+                None => BodyStiffness::Rigid,
             },
             foundation,
             sampling: Sampling::Nodal,

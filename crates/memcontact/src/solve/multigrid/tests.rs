@@ -4,9 +4,9 @@
 use super::*;
 use crate::field::FnCoefficient;
 use crate::mesh::refine::Refinement;
+use crate::mesh::test_square as square;
 use crate::mesh::{DofMap, Mesh};
-use crate::model::{Foundation, ProblemData, Sampling, Stiffness};
-use crate::solve::tests::square;
+use crate::model::{BodyStiffness, Foundation, ProblemData, Sampling};
 use crate::solve::{active_set, Silent};
 use crate::sparse::{norm_inf, Cholesky};
 
@@ -54,8 +54,8 @@ pub(crate) fn bench_model(mesh: &Mesh, h: Option<f64>, foundation: Foundation) -
             load: &20.0,
             shape: &phi,
             stiffness: match h {
-                Some(_) => Stiffness::Elastic(&hv),
-                None => Stiffness::Rigid,
+                Some(_) => BodyStiffness::Elastic(&hv),
+                None => BodyStiffness::Rigid,
             },
             foundation,
             sampling: Sampling::Nodal,

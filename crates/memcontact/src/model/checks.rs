@@ -4,28 +4,30 @@
 //! the fields and totals). A non-finite number is a clear error naming the data that made
 //! it, never a certificate of 0 or a `null` in `summary.json`.
 //!
-//! [`assemble`] is the one way to a checked model: the front door ([`crate::run`]), the
+//! [`assemble_checked`] is the one way to a checked model: the front door ([`crate::run`]), the
 //! convergence studies and the load sweeps use it; a sweep step that scales a model is
 //! checked again with [`check_model`].
 
+use super::body::FoundationMatrix;
+use super::data::{BodyStiffness, Extensions, ProblemData};
+use super::system::Model;
 use crate::error::{Error, Result};
+use crate::fem::{Loads, VertexTriangles};
 use crate::field::Coefficient;
 use crate::mesh::Mesh;
-use crate::mesh::VertexTriangles;
-use crate::model::{Extensions, FoundationMatrix, Model, ProblemData, Stiffness};
-use crate::results::{NodalFields, Totals};
 use crate::sparse::first_non_finite;
+use rayon::prelude::*;
 
 /// Assembles the model of `data` with the extensions `ext` on `mesh`
 /// ([`Model::assemble_with`]) between the checks of the boundary data
 /// ([`check_boundary_data`]) and of overflow ([`check_model`]).
-pub fn assemble(mesh: &Mesh, data: &ProblemData, ext: &Extensions) -> Result<Model> {
+pub fn assemble_checked(mesh: &Mesh, data: &ProblemData, ext: &Extensions) -> Result<Model> {
     let (adj, boundary) = mesh.patches();
-    assemble_on(mesh, &adj, &boundary, data, ext)
+    assemble_checked_on(mesh, &adj, &boundary, data, ext)
 }
 
 /// [`assemble`] given the mesh's vertex → triangles adjacency and its boundary vertices.
-pub fn assemble_on(
+pub fn assemble_checked_on(
     mesh: &Mesh,
     adj: &VertexTriangles,
     boundary: &[bool],
@@ -57,11 +59,11 @@ fn check_boundary_data_on(
 ) -> Result<()> {
     // Without boundary conditions of its own, the whole boundary is fixed at height 0.
     let given = match ext.boundary {
-        Some(_) => Some(crate::model::fixed_heights_on(mesh, adj, boundary, ext)?),
+        Some(_) => Some(super::boundary::fixed_heights_on(mesh, adj, boundary, ext)?),
         None => None,
     };
     let rigid_upper = |region: u32| {
-        matches!(data.stiffness, Stiffness::Rigid) || ext.rigid_regions.contains(&region)
+        matches!(data.stiffness, BodyStiffness::Rigid) || ext.rigid_regions.contains(&region)
     };
     for (v, &on) in boundary.iter().enumerate() {
         if !on {
@@ -95,7 +97,8 @@ fn check_boundary_data_on(
                 }
             }
             if let Some(low) = &ext.lower {
-                if matches!(low.stiffness, Stiffness::Rigid) || low.rigid_regions.contains(&region)
+                if matches!(low.stiffness, BodyStiffness::Rigid)
+                    || low.rigid_regions.contains(&region)
                 {
                     let phi = value(low.shape, p, region);
                     if phi > g {
@@ -201,108 +204,192 @@ fn matrix_finite(l: &FoundationMatrix) -> bool {
 
 /// What overflowed, in terms of the data, for the messages of [`check_solution`] and
 /// [`check_results`].
-const OVERFLOW_HINT: &str = "the data's scales (tension t, load f, stiffness h, shape φ, \
+pub const OVERFLOW_HINT: &str = "the data's scales (tension t, load f, stiffness h, shape φ, \
                              mesh size) overflow double precision; rescale the problem \
                              (units)";
 
-/// Refuses a solve whose energy J(U) or certificate is not a finite number (`rigid`: an
-/// iterate outside `U ≤ φ` has J = +∞ by definition and is refused by its certificate
-/// instead).
-pub fn check_solution(energy: f64, kkt: f64, rigid: bool) -> Result<()> {
-    if energy.is_nan() || (energy.is_infinite() && !(rigid && energy > 0.0)) {
-        return Err(Error::Data(format!(
-            "the energy J(U) of the answer is {energy}: {OVERFLOW_HINT}"
-        )));
-    }
-    if kkt.is_nan() {
-        return Err(Error::Data(format!(
-            "the certificate of the answer is not a number: {OVERFLOW_HINT}"
-        )));
-    }
-    Ok(())
-}
-
-/// Refuses result fields or totals that are not finite numbers, naming the quantity and,
-/// for a field, the vertex. Called before any result file is written.
-pub fn check_results(mesh: &Mesh, fields: &NodalFields, totals: &Totals) -> Result<()> {
-    let vertex_fields: [(&str, &[f64]); 4] = [
-        ("the deflection u", &fields.u),
-        ("the contact pressure", &fields.pressure),
-        ("the contact force X₁", &fields.contact_force),
-        ("the penetration", &fields.penetration),
-    ];
-    for (name, values) in vertex_fields {
-        if let Some(v) = first_non_finite(values) {
-            let p = mesh.points[v];
+impl Model {
+    /// Refuses a membrane that nothing holds (SPEC §5): every connected group of unknowns
+    /// that no fixed vertex touches must be held by the bodies: by one from each side, or
+    /// by one body toward which the net load on the group pushes. Otherwise J has no
+    /// minimiser (or no unique one) and S is singular on the group.
+    pub(super) fn check_held(&self, mesh: &Mesh) -> Result<()> {
+        let n = self.n();
+        // Union-find over the couplings of S.
+        let mut parent: Vec<u32> = (0..n as u32).collect();
+        fn find(p: &mut [u32], mut i: u32) -> u32 {
+            while p[i as usize] != i {
+                p[i as usize] = p[p[i as usize] as usize];
+                i = p[i as usize];
+            }
+            i
+        }
+        let pat = &self.s.pattern;
+        for i in 0..n {
+            for &j in &pat.col[pat.row_ptr[i]..pat.row_ptr[i + 1]] {
+                let (a, b) = (find(&mut parent, i as u32), find(&mut parent, j));
+                if a != b {
+                    parent[a.max(b) as usize] = a.min(b);
+                }
+            }
+        }
+        // Unknowns next to a fixed vertex: a triangle of theirs has a fixed corner.
+        let adj = VertexTriangles::new(mesh);
+        #[derive(Clone, Copy, Default)]
+        struct Group {
+            anchored: bool,
+            upper: bool,
+            lower: bool,
+            load: f64,
+            first: u32,
+            size: usize,
+        }
+        let mut groups = vec![Group::default(); n];
+        for (i, &v) in self.dofs.vertex.iter().enumerate() {
+            let anchored = adj.of(v as usize).iter().any(|&k| {
+                mesh.triangles[k as usize]
+                    .iter()
+                    .any(|&w| self.dofs.dof[w as usize].is_none())
+            });
+            let r = find(&mut parent, i as u32) as usize;
+            let g = &mut groups[r];
+            if g.size == 0 {
+                g.first = i as u32;
+            }
+            g.size += 1;
+            g.anchored |= anchored;
+            g.upper |= self.can_touch[i];
+            g.lower |= self.lower.as_ref().is_some_and(|b| b.can_touch[i]);
+            g.load += self.d[i];
+        }
+        for g in groups.iter().filter(|g| g.size > 0 && !g.anchored) {
+            let held = (g.upper && (g.lower || g.load > 0.0)) || (g.lower && g.load < 0.0);
+            if held {
+                continue;
+            }
+            let p = mesh.points[self.dofs.vertex[g.first as usize] as usize];
+            let why = if !g.upper && !g.lower {
+                "no body can touch it".to_string()
+            } else if g.upper {
+                format!(
+                    "only the obstacle above can touch it, and the net load on it ({:e}) does \
+                     not push it up against the obstacle",
+                    g.load
+                )
+            } else {
+                format!(
+                    "only the body below can touch it, and the net load on it ({:e}) does \
+                     not push it down onto the body",
+                    g.load
+                )
+            };
             return Err(Error::Data(format!(
-                "{name} is {} at the vertex ({}, {}): {OVERFLOW_HINT}",
-                values[v], p[0], p[1]
+                "the membrane is not held: {} vertices (one at ({}, {})) touch no fixed \
+                 boundary and {why}, so it can move without bound; fix part of the boundary \
+                 (boundary.free lists the free regions) or give it a body on each side",
+                g.size, p[0], p[1]
             )));
         }
+        Ok(())
     }
-    let scalars = [
-        ("the total load ∫f", totals.total_load),
-        ("the total contact force", totals.total_contact_force),
-        ("the contact area", totals.contact_area),
-        ("the lift-off area", totals.liftoff_area),
-        ("the largest pressure", totals.max_pressure),
-        ("the largest deflection", totals.max_deflection),
-    ];
-    for (name, v) in scalars {
-        if !v.is_finite() {
-            return Err(Error::Data(format!("{name} is {v}: {OVERFLOW_HINT}")));
+
+    /// Refuses two rigid bodies that overlap at an unknown (φ_low > φ there: no admissible
+    /// deflection, SPEC §5), naming the vertices.
+    pub(super) fn check_squeeze(&self, mesh: &Mesh) -> Result<()> {
+        let Some(low) = &self.lower else {
+            return Ok(());
+        };
+        let bad: Vec<usize> = (0..self.n())
+            .filter(|&i| self.rigid_at(i) && low.rigid_at(i) && low.phi[i] > self.phi[i])
+            .collect();
+        if bad.is_empty() {
+            return Ok(());
         }
+        let shown: Vec<String> = bad
+            .iter()
+            .take(5)
+            .map(|&i| {
+                let v = self.dofs.vertex[i] as usize;
+                let p = mesh.points[v];
+                format!(
+                    "vertex {v} at ({}, {}): φ_low = {} > φ = {}",
+                    p[0], p[1], low.phi[i], self.phi[i]
+                )
+            })
+            .collect();
+        let more = if bad.len() > 5 {
+            format!(" and {} more", bad.len() - 5)
+        } else {
+            String::new()
+        };
+        Err(Error::Data(format!(
+            "both bodies are rigid and overlap, so no deflection fits between them \
+             (φ_low ≤ u ≤ φ is empty) at {} vertices: {}{more}",
+            bad.len(),
+            shown.join("; ")
+        )))
     }
-    Ok(())
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::field::Field;
-    use crate::model::{Foundation, Sampling};
+/// The error for a bad value `v` of `name` at `p`.
+pub(super) fn bad_value(name: &str, v: f64, p: [f64; 2]) -> Error {
+    let what = if v.is_nan() {
+        "is NaN".to_string()
+    } else if !v.is_finite() {
+        format!("is infinite ({v})")
+    } else {
+        format!("is negative ({v})")
+    };
+    Error::Data(format!("{name} {what} at ({}, {})", p[0], p[1]))
+}
 
-    #[test]
-    fn loads_singular_on_the_boundary_and_rigid_bodies_below_it_are_refused() {
-        let mesh = crate::solve::tests::square(4);
-        let bind = |f: &str| {
-            Field::parse(f)
-                .unwrap()
-                .bind_to_mesh("membrane.load", &mesh)
-                .unwrap()
-        };
-        let (load, shape, h) = (bind("1/x"), bind("0.1"), bind("10"));
-        let mut data = ProblemData {
-            tension: 1.0,
-            load: &load,
-            shape: &shape,
-            stiffness: Stiffness::Elastic(&h),
-            foundation: Foundation::Consistent,
-            sampling: Sampling::Nodal,
-        };
-        let e = assemble(&mesh, &data, &Extensions::default())
-            .unwrap_err()
-            .to_string();
-        assert!(e.contains("boundary") && e.contains("membrane.load"), "{e}");
-        let (one, below) = (bind("1"), bind("x - 0.5"));
-        data.load = &one;
-        data.shape = &below;
-        data.stiffness = Stiffness::Rigid;
-        let e = assemble(&mesh, &data, &Extensions::default())
-            .unwrap_err()
-            .to_string();
-        assert!(e.contains("below the fixed boundary"), "{e}");
-        data.stiffness = Stiffness::Elastic(&h);
-        assert!(assemble(&mesh, &data, &Extensions::default()).is_ok());
+/// Checks a coefficient at every triangle centroid: finite, and non-negative when asked
+/// (once per region where it is constant, once in all where it has one value everywhere).
+pub(super) fn check_centroids(
+    mesh: &Mesh,
+    loads: &Loads,
+    name: &str,
+    c: &dyn Coefficient,
+    non_negative: bool,
+) -> Result<()> {
+    let bad = |v: f64| !v.is_finite() || (non_negative && v < 0.0);
+    // One value everywhere: checked once (a bad one is named at the first centroid).
+    if let Some(v) = loads.uniform(c) {
+        if !bad(v) {
+            return Ok(());
+        }
     }
+    let found = (0..mesh.n_triangles())
+        .into_par_iter()
+        .with_min_len(4096)
+        .find_map_first(|k| {
+            let r = mesh.regions[k];
+            // The centroid only where c is not constant on the region (or to name a bad value).
+            let centroid = || {
+                let cs = mesh.corners(k);
+                [
+                    (cs[0][0] + cs[1][0] + cs[2][0]) / 3.0,
+                    (cs[0][1] + cs[1][1] + cs[2][1]) / 3.0,
+                ]
+            };
+            let v = c.on_region(r).unwrap_or_else(|| c.at(centroid(), r));
+            bad(v).then(|| (v, centroid()))
+        });
+    match found {
+        Some((v, p)) => Err(bad_value(name, v, p)),
+        None => Ok(()),
+    }
+}
 
-    #[test]
-    fn non_finite_answers_are_refused_naming_them() {
-        assert!(check_solution(1.0, 1e-12, false).is_ok());
-        assert!(check_solution(f64::INFINITY, 1.0, true).is_ok());
-        let e = check_solution(f64::NAN, 1e-12, false).unwrap_err();
-        assert!(e.to_string().contains("energy J(U)"), "{e}");
-        assert!(check_solution(f64::NEG_INFINITY, 1e-12, true).is_err());
-        assert!(check_solution(1.0, f64::NAN, false).is_err());
+/// Checks sampled vertex values: finite, and non-negative when asked.
+pub(super) fn check_vertices(
+    mesh: &Mesh,
+    name: &str,
+    values: &[f64],
+    non_negative: bool,
+) -> Result<()> {
+    match crate::sparse::first_where(values, |v| !v.is_finite() | (non_negative & (v < 0.0))) {
+        Some(i) => Err(bad_value(name, values[i], mesh.points[i])),
+        None => Ok(()),
     }
 }
