@@ -8,7 +8,6 @@
 //! (S, L, D, φₙ of the paper's §2), a [`solve`] method returns a [`solve::Solution`],
 //! and [`results`] derives the physical fields that the [`io`] writers store.
 
-pub mod bench;
 pub mod certificate;
 
 pub mod convergence;

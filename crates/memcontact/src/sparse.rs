@@ -512,6 +512,29 @@ pub(crate) fn row_chunks<'a>(
     out
 }
 
+/// Below this many rows, loops run serially (threads cost more than they save).
+pub const VECTOR_ROWS: usize = 16_384;
+
+/// Runs `f(i, &mut x[i])` over all rows, in parallel for long vectors.
+#[inline]
+pub fn par_rows<T: Send>(x: &mut [T], f: impl Fn(usize, &mut T) + Sync + Send) {
+    if x.len() >= VECTOR_ROWS {
+        x.par_iter_mut()
+            .enumerate()
+            .with_min_len(4096)
+            .for_each(|(i, xi)| f(i, xi));
+    } else {
+        for (i, xi) in x.iter_mut().enumerate() {
+            f(i, xi);
+        }
+    }
+}
+
+/// `dst = src`, on all threads for long vectors.
+pub fn par_copy_from(dst: &mut [f64], src: &[f64]) {
+    par_rows(dst, |i, d| *d = src[i]);
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

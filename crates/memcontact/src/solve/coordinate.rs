@@ -3,7 +3,7 @@
 //! Simple and robust, but the number of sweeps grows like the square of the mesh size:
 //! meant for verification on small meshes.
 
-use super::local::sweep_forward;
+use super::relax::sweep_forward;
 use super::{IterationRecord, Method, Observer, PhaseTimer, Settings, Solution};
 use crate::error::Result;
 use crate::model::Model;

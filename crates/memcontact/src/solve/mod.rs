@@ -16,10 +16,10 @@ pub mod active_set;
 pub mod coordinate;
 pub mod line_search;
 pub mod linear;
-pub mod local;
 pub mod multigrid;
 pub mod newton;
 pub mod qp;
+pub mod relax;
 
 use crate::certificate::Certificate;
 use crate::error::{Error, Result};
@@ -415,7 +415,7 @@ impl Method {
             Method::ActiveSet => active_set::MAX_ITERATIONS,
             Method::Qp => qp::MAX_ITERATIONS as usize,
             Method::Coordinate => coordinate::MAX_SWEEPS,
-            Method::Multigrid => multigrid::MAX_ITERATIONS,
+            Method::Multigrid => multigrid::tnnmg::MAX_ITERATIONS,
         }
     }
 }

@@ -3,18 +3,18 @@
 //! φ(x, y) = 0.5 + 0.1 sin(2πx) cos(2πy), a structured N × N mesh with every square cut
 //! along the diagonal from `(x_i, y_j)` to `(x_{i+1}, y_{j+1})` (the rectangle generator
 //! builds the multigrid hierarchy itself), nodal φ, tolerance 1e-10 on the scaled KKT
-//! residual, solved by TNNMG ([`crate::solve::multigrid`]).
+//! residual, solved by TNNMG ([`memcontact::solve::multigrid`]).
 //!
 //! Every row also times one linear Poisson solve `S x = D` on the same mesh by the same
-//! multigrid V-cycle (from zero, to the same relative tolerance), as the yardstick. Only
-//! the library runs here: the CLI's `memcontact bench` prints the rows.
+//! multigrid V-cycle (from zero, to the same relative tolerance), as the yardstick. `memcontact bench` prints the rows.
 
-use crate::error::Result;
-use crate::field::FnCoefficient;
-use crate::mesh::generate::{rectangle, Diagonal, RectangleSpec};
-use crate::model::{BodyStiffness, Foundation, Model, ProblemData, Sampling};
-use crate::solve::multigrid::{self, Options};
-use crate::solve::{Method, Settings, Silent};
+use super::proc::{peak_memory, reset_peak_memory};
+use memcontact::error::Result;
+use memcontact::field::FnCoefficient;
+use memcontact::mesh::generate::{rectangle, Diagonal, RectangleSpec};
+use memcontact::model::{BodyStiffness, Foundation, Model, ProblemData, Sampling};
+use memcontact::solve::multigrid::{self, TnnmgOptions};
+use memcontact::solve::{Method, Settings, Silent};
 use std::f64::consts::PI;
 use std::time::Instant;
 
@@ -70,10 +70,10 @@ pub fn obstacle(p: [f64; 2]) -> f64 {
 
 /// The benchmark's mesh: the unit square, `n × n` cells, "right" diagonals, with the
 /// hierarchy the rectangle generator builds.
-pub fn mesh(n: usize) -> Result<crate::mesh::refine::Hierarchy> {
+pub fn mesh(n: usize) -> Result<memcontact::mesh::refine::Hierarchy> {
     let cells = n as f64 * n as f64;
-    crate::limits::check_mesh_fits(
-        crate::limits::MeshSize::simply_connected((n as f64 + 1.0).powi(2), 2.0 * cells),
+    memcontact::limits::check_mesh_fits(
+        memcontact::limits::MeshSize::simply_connected((n as f64 + 1.0).powi(2), 2.0 * cells),
         0,
         &format!("the benchmark's {n} × {n} square"),
     )?;
@@ -89,7 +89,7 @@ pub fn mesh(n: usize) -> Result<crate::mesh::refine::Hierarchy> {
 }
 
 /// The benchmark's model on `mesh` (t = 1, f = 20, h = 1000, nodal φ).
-pub fn model(mesh: &crate::mesh::Mesh, foundation: Foundation) -> Result<Model> {
+pub fn model(mesh: &memcontact::mesh::Mesh, foundation: Foundation) -> Result<Model> {
     let phi = FnCoefficient(obstacle);
     Model::assemble(
         mesh,
@@ -112,7 +112,7 @@ pub fn model(mesh: &crate::mesh::Mesh, foundation: Foundation) -> Result<Model> 
 pub fn run_bench(
     sizes: &[usize],
     foundations: &[Foundation],
-    options: &Options,
+    options: &TnnmgOptions,
     observer: &mut dyn FnMut(&BenchRow),
 ) -> Result<Vec<BenchRow>> {
     let mut rows = Vec::new();
@@ -185,76 +185,10 @@ pub fn run_bench(
     Ok(rows)
 }
 
-/// The process's peak resident set size (`VmHWM` of `/proc/self/status`), in bytes.
-pub fn peak_memory() -> Option<u64> {
-    let status = std::fs::read_to_string("/proc/self/status").ok()?;
-    let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
-    let kb: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
-    Some(kb * 1024)
-}
-
-/// CPU seconds used by the process so far, all threads (user + system, from
-/// `/proc/self/stat`, one clock tick resolution); `None` where unavailable.
-pub fn cpu_seconds() -> Option<f64> {
-    let stat = std::fs::read_to_string("/proc/self/stat").ok()?;
-    let rest = &stat[stat.rfind(')')? + 2..];
-    let f: Vec<&str> = rest.split_whitespace().collect();
-    let utime: f64 = f.get(11)?.parse().ok()?;
-    let stime: f64 = f.get(12)?.parse().ok()?;
-    Some((utime + stime) / clock_ticks())
-}
-
-/// CPU seconds the hypervisor has taken from this machine's virtual CPUs so far, all CPUs
-/// together (`steal` of `/proc/stat`): on a shared virtual machine, time that a benchmark's
-/// wall clock includes but that no code of this machine ran in. `None` where unavailable.
-pub fn stolen_seconds() -> Option<f64> {
-    let stat = std::fs::read_to_string("/proc/stat").ok()?;
-    steal_in_proc_stat(&stat, clock_ticks())
-}
-
-/// The `steal` field of the `cpu` line of a `/proc/stat` text, in seconds at `hz` ticks
-/// per second.
-fn steal_in_proc_stat(text: &str, hz: f64) -> Option<f64> {
-    let line = text.lines().find(|l| l.starts_with("cpu "))?;
-    // cpu user nice system idle iowait irq softirq steal ...
-    let ticks: f64 = line.split_whitespace().nth(8)?.parse().ok()?;
-    Some(ticks / hz)
-}
-
-/// Clock ticks per second of the `/proc` CPU times (`sysconf(_SC_CLK_TCK)`, 100 where
-/// that is unknown).
-fn clock_ticks() -> f64 {
-    #[cfg(unix)]
-    {
-        // SAFETY: `sysconf` reads a system constant.
-        let hz = unsafe { libc::sysconf(libc::_SC_CLK_TCK) };
-        if hz > 0 {
-            return hz as f64;
-        }
-    }
-    100.0
-}
-
-/// Resets the peak resident set size to the current one (Linux `clear_refs` value 5);
-/// silently does nothing where that is not possible.
-pub fn reset_peak_memory() {
-    let _ = std::fs::write("/proc/self/clear_refs", "5");
-}
-
+#[cfg(test)]
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    /// The steal field is the eighth number of the `cpu` line, not of a `cpuN` line.
-    #[test]
-    fn steal_is_read_from_the_all_cpu_line() {
-        let text = "cpu  6735783 358843 682591 2807773 36520 0 2919 9319 0 0\n\
-                    cpu0 3367891 179421 341295 1403886 18260 0 1459 4659 0 0\n\
-                    intr 1 2 3\n";
-        assert_eq!(steal_in_proc_stat(text, 100.0), Some(93.19));
-        assert_eq!(steal_in_proc_stat("cpu0 1 2 3 4 5 6 7 8\n", 100.0), None);
-        assert_eq!(steal_in_proc_stat("cpu  1 2 3\n", 100.0), None);
-    }
 
     #[test]
     fn small_benchmark_rows_are_complete() {
@@ -262,7 +196,7 @@ mod tests {
         let rows = run_bench(
             &[16, 32],
             &[Foundation::Lumped, Foundation::Consistent],
-            &Options::default(),
+            &TnnmgOptions::default(),
             &mut |_| seen += 1,
         )
         .unwrap();

@@ -1,19 +1,23 @@
 //! Benchmarks and their tables.
 //!
-//! * The standard benchmark ([`memcontact::bench`]): TNNMG on the N × N unit square
+//! * The standard benchmark ([`standard`]): TNNMG on the N × N unit square
 //!   against one linear Poisson multigrid solve.
 //! * Any case or mesh ([`run_case`]): the whole run as `memcontact solve` does it, timed
 //!   phase by phase: reading or generating the mesh, renumbering, assembly, the solver's
 //!   setup (hierarchy) and iterations, and writing the result set, with the iterations,
 //!   the peak memory and the certificate.
 
+pub mod proc;
+pub mod standard;
+
 use anyhow::{bail, Context, Result};
-use memcontact::bench::{peak_memory, reset_peak_memory, stolen_seconds, BenchRow};
 use memcontact::output::WriteOptions;
 use memcontact::problem::MeshSource;
 use memcontact::solve::multigrid::Kind;
 use memcontact::solve::{HierarchyChoice, Method, Silent};
 use memcontact::Case;
+use proc::{peak_memory, reset_peak_memory, stolen_seconds};
+use standard::BenchRow;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
