@@ -106,10 +106,10 @@ fn sweep(
     print_warnings(&base);
     let mut writer =
         SweepWriter::begin(flags.out, flags.force, case, label, case.output.vtu, true)?;
-    let total = memcontact::sweep::steps(case)?.len();
+    let total = memcontact::case::steps(case)?.len();
     let mut rows = Vec::new();
     let mut unaccepted = Vec::new();
-    let result = memcontact::sweep::run_sweep_on(
+    let result = memcontact::run::run_sweep_on(
         case,
         base,
         true,
@@ -200,7 +200,7 @@ pub fn check(case_path: &Path, sets: &[String]) -> Result<()> {
     // assembled on the mesh too, and the profile line checked against it.
     let d = Discretization::new(&case.problem, &mut Progress::new(Verbosity::Quiet))?;
     write::check_on_mesh(&case, d.mesh())?;
-    memcontact::sweep::check_on_mesh(&case, d.mesh(), true)?;
+    memcontact::run::check_on_mesh(&case, d.mesh(), true)?;
     d.check_memory(&case.settings)?;
     print_warnings(&d);
     let mesh = d.mesh();
@@ -220,7 +220,7 @@ pub fn check(case_path: &Path, sets: &[String]) -> Result<()> {
         if d.model.is_rigid() { ", rigid" } else { "" }
     );
     if case.is_sweep() {
-        let steps = memcontact::sweep::steps(&case)?;
+        let steps = memcontact::case::steps(&case)?;
         let names: Vec<&str> = steps.iter().map(|s| s.name.as_str()).collect();
         println!(
             "  steps        {} ({}): {}",

@@ -4,9 +4,11 @@
 
 use crate::progress::{Progress, Verbosity};
 use anyhow::{anyhow, bail, Context, Result};
+use memcontact::case::{BenchmarkBody, ExactSpec, ManufacturedDomain, ManufacturedForm};
 use memcontact::convergence::{
     self as study, LevelResult, ManufacturedLoad, Study, StudySettings, Sweep, Target,
 };
+use memcontact::discretization::BoundData;
 use memcontact::exact::{
     BenchmarkKind, DiskSolution, ExactSolution, Manufactured, ManufacturedCosine, ObstacleBenchmark,
 };
@@ -17,10 +19,7 @@ use memcontact::io::vtu::DataArray;
 use memcontact::mesh::refine::Hierarchy;
 use memcontact::model::{Foundation, ProblemData, Sampling};
 use memcontact::output::{input_hash, new_run_id, write_manifest, MANIFEST};
-use memcontact::problem::{
-    BenchmarkBody, ExactSpec, ManufacturedDomain, ManufacturedForm, MeshSource,
-};
-use memcontact::run::BoundData;
+use memcontact::problem::MeshSource;
 use memcontact::Case;
 use memcontact_plot as plot;
 use std::fmt::Write as _;
@@ -429,7 +428,7 @@ pub fn run(args: &Args) -> Result<()> {
             args.levels
         );
     }
-    let (mut hierarchy, warnings) = case.problem.mesh.build()?;
+    let (mut hierarchy, warnings) = memcontact::discretization::build_mesh(&case.problem.mesh)?;
     for w in &warnings {
         eprintln!("warning: {w}");
     }

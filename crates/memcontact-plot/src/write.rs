@@ -8,11 +8,12 @@
 
 use crate::bodies::{merge, BodyFields};
 use crate::{draw_all, line_plot, LinePlot, PlotData, PlotKind, PlotOptions, Series, Units};
+use memcontact::case::StepSpec;
+use memcontact::case::{PictureKind, VtuFormat};
 use memcontact::mesh::Mesh;
+use memcontact::outcome::fields::NodalFields;
 use memcontact::output::{step_label, write_result_set, SweepSet, WriteOptions};
-use memcontact::problem::{PictureKind, VtuFormat};
-use memcontact::results::NodalFields;
-use memcontact::sweep::{StepRow, StepSpec};
+use memcontact::run::StepRow;
 use memcontact::{Case, Discretization, Error, Observer, Outcome, Result, Summary};
 use std::path::Path;
 use std::time::{Duration, Instant};

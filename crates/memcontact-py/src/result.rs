@@ -4,13 +4,13 @@
 use crate::case::PyCase;
 use crate::convert::{py_err, to_py};
 use crate::mesh::{hierarchy_from_state, mesh_state, PyMesh};
+use memcontact::case::VtuFormat;
 use memcontact::certificate::Certificate;
+use memcontact::discretization::Phase;
+use memcontact::outcome::fields::{LowerFields, NodalFields};
 use memcontact::output::{input_hash, new_run_id, WriteOptions};
-use memcontact::problem::VtuFormat;
-use memcontact::results::{LowerFields, NodalFields};
-use memcontact::run::Phase;
+use memcontact::run::step_discretization;
 use memcontact::solve::{Choice, Fallback, IterationRecord, Multipliers, Silent};
-use memcontact::sweep::step_discretization;
 use memcontact::{Case, Discretization, Method, Outcome, Report, Status, Summary};
 use memcontact_plot::write::{plot_options, write_result};
 use numpy::{PyArray1, PyReadonlyArray1};

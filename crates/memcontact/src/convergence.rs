@@ -440,7 +440,7 @@ pub fn p1_norms(mesh: &Mesh, e: &[f64]) -> [f64; 3] {
 ///   cut off by its zero line.
 /// * Rigid obstacle (`u_h ≤ φ_h`, so the set above is empty): `A_h = Σ |Q_i|/3` over the
 ///   vertices that touch (`U_i = φ_i`), the nodal areas also used by
-///   [`crate::results::Totals::contact_area`].
+///   [`crate::outcome::fields::Totals::contact_area`].
 ///
 /// The radius is `√(A_h/π)`, meaningful when the contact zone is a disc.
 pub fn contact_estimate(mesh: &Mesh, model: &Model, u: &[f64]) -> ContactEstimate {

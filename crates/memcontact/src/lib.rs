@@ -3,14 +3,11 @@
 //! Contact between a stretched membrane and an elastic (tensionless Winkler) obstacle,
 //! discretised exactly as in A. Maceri & F. Maceri, "Analysis of a discrete model for the
 //! contact problem between a membrane and an elastic obstacle", Rend. Lincei 80 (1986).
-//!
-//! Data flows one way: [`field`] data and a [`mesh::Mesh`] build a [`model::Model`]
-//! (S, L, D, φₙ of the paper's §2), a [`solve`] method returns a [`solve::Solution`],
-//! and [`results`] derives the physical fields that the [`io`] writers store.
 
+pub mod case;
 pub mod certificate;
-
 pub mod convergence;
+pub mod discretization;
 pub mod error;
 pub mod errors;
 pub mod exact;
@@ -25,16 +22,15 @@ pub mod output;
 pub mod parallel;
 pub mod problem;
 pub mod quadrature;
-pub mod results;
 pub mod run;
 pub mod solve;
 pub mod sparse;
-pub mod summary;
-pub mod sweep;
 
+pub use case::Case;
+pub use discretization::Discretization;
 pub use error::{Error, Invalid, Result};
+pub use outcome::{Outcome, Report, Summary};
 pub use parallel::on_workers;
-pub use problem::{Case, Problem};
-pub use run::{run, Discretization, Outcome, Report};
+pub use problem::Problem;
+pub use run::run;
 pub use solve::{Method, Observer, Settings, Status};
-pub use summary::Summary;

@@ -10,16 +10,17 @@
 //! room for it (the CSV header lines are contracts), are bound to it by their hashes in
 //! the summary or manifest.
 
+use crate::case::StepSpec;
+use crate::case::{Case, VtuFormat};
 use crate::error::{Error, Result};
 use crate::io::csv::write_columns_csv;
 use crate::io::json::write_json;
 use crate::io::result_set::ResultSet;
 use crate::io::vtu::{write_vtu_with_field_data, DataArray, VtuEncoding};
-use crate::problem::{Case, VtuFormat};
-use crate::results::NodalFields;
-use crate::run::Outcome;
-use crate::summary::{FileRecord, Summary};
-use crate::sweep::{StepRow, StepSpec};
+use crate::outcome::fields::NodalFields;
+use crate::outcome::summary::{FileRecord, Summary};
+use crate::outcome::Outcome;
+use crate::run::StepRow;
 use std::path::Path;
 use std::time::Instant;
 

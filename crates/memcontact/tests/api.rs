@@ -2,11 +2,11 @@
 //! same case built from Rust values give the same run; `run` reports every status with the
 //! iterate and its certificate; result sets are written without the command-line tool.
 
+use memcontact::discretization::Discretization;
 use memcontact::field::{Field, Stiffness};
 use memcontact::model::Foundation;
 use memcontact::output::{write_result_set, WriteOptions};
 use memcontact::problem::{Membrane, MeshSource, MeshSpec, Obstacle, SamplingKind};
-use memcontact::run::Discretization;
 use memcontact::solve::{Method, Silent, Status};
 use memcontact::{run, Case, Problem, Settings, Summary};
 use std::time::Instant;

@@ -2,9 +2,9 @@
 //! Gmsh writes it) is solved in a renumbered order, and every output comes back in the
 //! user's numbering, equal to the answer computed without renumbering up to rounding.
 
+use memcontact::discretization::BoundData;
 use memcontact::field::Field;
 use memcontact::model::Model;
-use memcontact::run::BoundData;
 use memcontact::solve::{self, Method, Silent};
 use memcontact::{run, Case};
 use std::path::Path;

@@ -7,7 +7,7 @@ use memcontact::field::{Field, DEFAULT_KEY};
 use memcontact::mesh::generate::{self, Diagonal, PolygonSpec, RectangleSpec};
 use memcontact::mesh::refine::Hierarchy;
 use memcontact::model::{BodyStiffness, Foundation, Model, ProblemData, Sampling};
-use memcontact::results::derive;
+use memcontact::outcome::fields::derive;
 use memcontact::solve::{self, Settings, Silent};
 use memcontact_plot::result::ResultData;
 use std::collections::BTreeMap;

@@ -248,11 +248,11 @@ mod tests {
 
     #[test]
     fn nodal_data_solve_like_the_expressions_they_interpolate() {
+        use crate::discretization::Discretization;
         use crate::field::{Field, Stiffness};
         use crate::mesh::refine::Hierarchy;
         use crate::model::Foundation;
         use crate::problem::{Membrane, MeshSpec, Obstacle, Problem, SamplingKind};
-        use crate::run::Discretization;
         use crate::solve::{Settings, Silent};
         // Linear f, h, φ: the P1 interpolants are the functions themselves.
         let mesh = generate::disk([0.0, 0.0], 1.0, 0.15).unwrap();

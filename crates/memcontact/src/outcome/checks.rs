@@ -4,7 +4,7 @@
 use crate::error::{Error, Result};
 use crate::mesh::Mesh;
 use crate::model::OVERFLOW_HINT;
-use crate::results::{NodalFields, Totals};
+use crate::outcome::fields::{NodalFields, Totals};
 use crate::sparse::first_non_finite;
 
 /// Refuses a solve whose energy J(U) or certificate is not a finite number (`rigid`: an

@@ -1,4 +1,14 @@
-//! The outcome of a solve: the physical fields and totals in the user's numbering, the
-//! summary, and the checks they pass before anything is written.
+//! The outcome of a solve: the report (status, method, certificate, iterate), the physical
+//! fields and totals in the user's numbering, `summary.json`'s values, and the checks they
+//! pass before anything is written.
 
 pub mod checks;
+pub mod fields;
+mod report;
+mod solved;
+pub mod summary;
+
+pub use fields::{LowerFields, LowerTotals, NodalFields, Totals};
+pub use report::Report;
+pub use solved::Outcome;
+pub use summary::{FileRecord, Summary};

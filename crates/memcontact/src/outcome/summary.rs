@@ -2,8 +2,8 @@
 //! contract with users (scripts read them): extend, never rename.
 
 use crate::mesh::MeshQuality;
-use crate::results::Totals;
-use crate::run::Outcome;
+use crate::outcome::fields::Totals;
+use crate::outcome::Outcome;
 use crate::solve::{Choice, Fallback, IterationRecord, Status};
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;

@@ -1,0 +1,22 @@
+//! The case: what a case file (TOML), a Rust program or a Python dict says, as owned serde
+//! values. Everything deserialises into the same [`Case`]; unknown keys and bad values are
+//! refused here, before any work, with the key (and, for a file, the file and line).
+//!
+//! A [`Case`] is a [`crate::problem::Problem`], the solver [`crate::solve::Settings`], the
+//! [`OutputOptions`], the [`ExactSpec`] of a closed-form solution for convergence studies,
+//! and the steps of a load sweep or of load combinations.
+
+mod exact;
+mod file;
+mod output;
+mod overrides;
+mod sweep;
+#[cfg(test)]
+mod tests;
+
+pub use crate::io::input::CASE_FILE_CAP;
+pub use exact::{BenchmarkBody, ExactSpec, ManufacturedDomain, ManufacturedForm};
+pub use file::Case;
+pub use output::{OutputOptions, PictureKind, Units, VtuFormat};
+pub use overrides::apply_overrides;
+pub use sweep::{steps, LoadCase, StepSpec, SweepParameter, SweepSpec, MAX_STEPS};
