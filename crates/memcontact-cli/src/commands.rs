@@ -3,7 +3,7 @@
 use crate::output;
 use crate::progress::{Progress, Verbosity};
 use anyhow::{bail, Result};
-use memcontact::output::WriteOptions;
+use memcontact::write::WriteOptions;
 use memcontact::{Case, Discretization, Outcome};
 use memcontact_plot::write::{self, SweepWriter};
 use std::path::Path;

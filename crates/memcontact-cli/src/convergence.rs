@@ -5,21 +5,21 @@
 use crate::progress::{Progress, Verbosity};
 use anyhow::{anyhow, bail, Context, Result};
 use memcontact::case::{BenchmarkBody, ExactSpec, ManufacturedDomain, ManufacturedForm};
-use memcontact::convergence::{
-    self as study, LevelResult, ManufacturedLoad, Study, StudySettings, Sweep, Target,
-};
 use memcontact::discretization::BoundData;
-use memcontact::exact::{
-    BenchmarkKind, DiskSolution, ExactSolution, Manufactured, ManufacturedCosine, ObstacleBenchmark,
-};
 use memcontact::field::Stiffness as FieldStiffness;
 use memcontact::io::csv::write_columns_csv;
 use memcontact::io::result_set::ResultSet;
 use memcontact::io::vtu::DataArray;
 use memcontact::mesh::refine::Hierarchy;
 use memcontact::model::{Foundation, ProblemData, Sampling};
-use memcontact::output::{input_hash, new_run_id, write_manifest, MANIFEST};
 use memcontact::problem::MeshSource;
+use memcontact::verify::convergence::{
+    self as study, LevelResult, ManufacturedLoad, Study, StudySettings, Sweep, Target,
+};
+use memcontact::verify::exact::{
+    BenchmarkKind, DiskSolution, ExactSolution, Manufactured, ManufacturedCosine, ObstacleBenchmark,
+};
+use memcontact::write::{input_hash, new_run_id, write_manifest, MANIFEST};
 use memcontact::Case;
 use memcontact_plot as plot;
 use std::fmt::Write as _;
@@ -959,7 +959,7 @@ fn sweep_report(
         }
     );
     let r = &sweep.rows;
-    let col = |g: &dyn Fn(&memcontact::convergence::SweepRow) -> f64| -> Column {
+    let col = |g: &dyn Fn(&memcontact::verify::convergence::SweepRow) -> f64| -> Column {
         Column::F(r.iter().map(g).collect())
     };
     write_csv_columns(

@@ -12,8 +12,8 @@ use memcontact::case::StepSpec;
 use memcontact::case::{PictureKind, VtuFormat};
 use memcontact::mesh::Mesh;
 use memcontact::outcome::fields::NodalFields;
-use memcontact::output::{step_label, write_result_set, SweepSet, WriteOptions};
-use memcontact::run::StepRow;
+use memcontact::outcome::StepRow;
+use memcontact::write::{step_label, write_result_set, SweepSet, WriteOptions};
 use memcontact::{Case, Discretization, Error, Observer, Outcome, Result, Summary};
 use std::path::Path;
 use std::time::{Duration, Instant};
@@ -107,7 +107,7 @@ fn bbox_text(points: &[[f64; 2]]) -> String {
     format!("[{x0}, {x1}] × [{y0}, {y1}]")
 }
 
-/// The pictures of `options` as the `extra` files of [`memcontact::output::write_files`]:
+/// The pictures of `options` as the `extra` files of [`memcontact::write::write_files`]:
 /// drawn into the directory from the nodal fields on `mesh`; returns their names.
 pub fn pictures<'a>(
     mesh: &'a Mesh,

@@ -6,11 +6,10 @@
 
 pub mod case;
 pub mod certificate;
-pub mod convergence;
+
 pub mod discretization;
 pub mod error;
-pub mod errors;
-pub mod exact;
+
 pub mod fem;
 pub mod field;
 pub mod io;
@@ -18,13 +17,14 @@ pub mod limits;
 pub mod mesh;
 pub mod model;
 pub mod outcome;
-pub mod output;
 pub mod parallel;
 pub mod problem;
 pub mod quadrature;
 pub mod run;
 pub mod solve;
 pub mod sparse;
+pub mod verify;
+pub mod write;
 
 pub use case::Case;
 pub use discretization::Discretization;

@@ -5,9 +5,9 @@
 use memcontact::discretization::Discretization;
 use memcontact::field::{Field, Stiffness};
 use memcontact::model::Foundation;
-use memcontact::output::{write_result_set, WriteOptions};
 use memcontact::problem::{Membrane, MeshSource, MeshSpec, Obstacle, SamplingKind};
 use memcontact::solve::{Method, Silent, Status};
+use memcontact::write::{write_result_set, WriteOptions};
 use memcontact::{run, Case, Problem, Settings, Summary};
 use std::time::Instant;
 
@@ -209,7 +209,7 @@ fn a_result_set_is_written_and_read_back_without_the_cli() {
         let rec = &summary.files[name];
         assert_eq!(
             rec,
-            &memcontact::output::file_record(&out.join(name)).unwrap()
+            &memcontact::write::file_record(&out.join(name)).unwrap()
         );
     }
     // nodes.csv, read independently, holds U at the interior vertices.

@@ -11,10 +11,10 @@ pub mod proc;
 pub mod standard;
 
 use anyhow::{bail, Context, Result};
-use memcontact::output::WriteOptions;
 use memcontact::problem::MeshSource;
 use memcontact::solve::multigrid::Kind;
 use memcontact::solve::{HierarchyChoice, Method, Silent};
+use memcontact::write::WriteOptions;
 use memcontact::Case;
 use proc::{peak_memory, reset_peak_memory, stolen_seconds};
 use standard::BenchRow;

@@ -7,8 +7,10 @@ pub mod fields;
 mod report;
 mod solved;
 pub mod summary;
+pub mod sweep;
 
 pub use fields::{LowerFields, LowerTotals, NodalFields, Totals};
 pub use report::Report;
 pub use solved::Outcome;
 pub use summary::{FileRecord, Summary};
+pub use sweep::StepRow;

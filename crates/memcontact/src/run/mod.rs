@@ -15,6 +15,4 @@ mod one;
 mod sweep;
 
 pub use one::run;
-pub use sweep::{
-    apply, check_on_mesh, run_sweep, run_sweep_on, step_discretization, step_model, StepRow,
-};
+pub use sweep::{apply, check_on_mesh, run_sweep, run_sweep_on, step_discretization, step_model};

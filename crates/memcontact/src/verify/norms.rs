@@ -27,9 +27,9 @@
 //! `max_nodal` is `max_i |u(a_i) - U_i|` over all vertices, boundary vertices included.
 
 use crate::error::{Error, Result};
-use crate::exact::ExactSolution;
 use crate::mesh::Mesh;
 use crate::quadrature::{gauss_legendre, map, DEGREE5};
+use crate::verify::exact::ExactSolution;
 use rayon::prelude::*;
 use std::f64::consts::PI;
 
@@ -277,7 +277,7 @@ pub fn rates(l_n: &[f64], errors: &[f64]) -> Vec<Option<f64>> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::exact::{DiskSolution, Manufactured};
+    use crate::verify::exact::{DiskSolution, Manufactured};
     use std::collections::BTreeMap;
 
     /// A polynomial on the unit square (test only): `u = cx2 x² + cy2 y² + cx x + cy y + c0`.

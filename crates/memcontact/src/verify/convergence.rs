@@ -5,8 +5,8 @@
 //! it (the levels of a [`Hierarchy`], refined once more per level), and measures every
 //! level's error against a [`Target`]:
 //!
-//! * [`Target::Exact`]: a closed-form solution ([`crate::exact`]), with
-//!   [`crate::errors::error_norms`] (degree-5 quadrature per triangle; on a disc the gap
+//! * [`Target::Exact`]: a closed-form solution ([`crate::verify::exact`]), with
+//!   [`crate::verify::norms::error_norms`] (degree-5 quadrature per triangle; on a disc the gap
 //!   between the inscribed polygon Ω_n and Ω is integrated exactly, `u_h = 0` there);
 //! * [`Target::Finest`]: no closed form is known (a discontinuous obstacle, say): every
 //!   level is compared with the finest level's own solution (a *reference solution*); the
@@ -31,20 +31,20 @@
 //! Nothing here prints or writes files: the command-line tool formats the results.
 
 use crate::error::{Error, Result};
-use crate::errors::{error_norms, rates, ErrorNorms};
-use crate::exact::ExactSolution;
 use crate::fem::Element;
 use crate::field::Coefficient;
 use crate::mesh::refine::Hierarchy;
 use crate::mesh::{Mesh, Point};
 use crate::model::{BodyStiffness, Extensions, Model, ProblemData};
 use crate::solve::{self, Method, Settings, Silent, Solution};
+use crate::verify::exact::ExactSolution;
+use crate::verify::norms::{error_norms, rates, ErrorNorms};
 use std::time::Instant;
 
 /// The load of a manufactured solution (SPEC §4): `f = −t Δu + h (u − φ)⁺`, from the exact
 /// Laplacian of `exact` and the problem's own `h` and `φ` evaluated at the same point and
 /// region (so `h` and `φ` may be expressions or region tables); with a body below (SPEC §5)
-/// its reaction `− h_low (φ_low − u)⁺` too. It is [`crate::exact::manufactured_load`] as an
+/// its reaction `− h_low (φ_low − u)⁺` too. It is [`crate::verify::exact::manufactured_load`] as an
 /// assembly coefficient: NaN outside Ω (which the model's data checks then report), never
 /// an evaluation of the exact solution there.
 pub struct ManufacturedLoad<'a> {
@@ -165,7 +165,7 @@ pub struct Study {
     /// One row per level, coarsest first.
     pub levels: Vec<LevelResult>,
     /// Observed L² rates between consecutive levels (`None` for level 0 and where an error
-    /// is missing), from [`crate::errors::rates`].
+    /// is missing), from [`crate::verify::norms::rates`].
     pub l2_rates: Vec<Option<f64>>,
     /// Observed H¹-seminorm rates.
     pub h1_rates: Vec<Option<f64>>,
@@ -610,10 +610,10 @@ pub fn rigid_limit_sweep(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::exact::{DiskSolution, Manufactured};
     use crate::field::FnCoefficient;
     use crate::mesh::generate::{self, Diagonal, RectangleSpec};
     use crate::model::{Foundation, Sampling};
+    use crate::verify::exact::{DiskSolution, Manufactured};
 
     fn settings(levels: usize) -> StudySettings {
         StudySettings {
