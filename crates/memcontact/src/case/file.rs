@@ -4,7 +4,7 @@
 use super::exact::ExactSpec;
 use super::output::{OutputOptions, Units};
 use super::overrides::{apply_overrides, key_span, line_of, plain_types, strip_json_position};
-use super::sweep::{LoadCase, SweepSpec};
+use super::sweep::{step_list, validate_steps, LoadCase, StepSpec, SweepSpec};
 use crate::error::{Error, Invalid, Result};
 use crate::problem::{Boundary, Membrane, MeshSpec, Obstacle, Problem};
 use crate::solve::Settings;
@@ -109,7 +109,7 @@ impl Case {
         self.problem.validate()?;
         self.settings.validate()?;
         self.output.validate()?;
-        super::sweep::validate(self)?;
+        validate_steps(self.sweep.as_ref(), &self.load_cases, &self.problem)?;
         if let Some(ExactSpec::Manufactured { amplitude, .. }) = &self.exact {
             if !(amplitude.is_finite() && *amplitude != 0.0) {
                 return Err(Invalid::new(
@@ -202,4 +202,9 @@ fn read_case_text(path: &Path) -> Result<String> {
             e.utf8_error().valid_up_to()
         ),
     })
+}
+
+/// The steps of a case: its sweep's values or its load cases (empty for neither).
+pub fn steps(case: &Case) -> Result<Vec<StepSpec>> {
+    step_list(case.sweep.as_ref(), &case.load_cases)
 }

@@ -16,7 +16,9 @@ mod tests;
 
 pub use crate::io::input::CASE_FILE_CAP;
 pub use exact::{BenchmarkBody, ExactSpec, ManufacturedDomain, ManufacturedForm};
-pub use file::Case;
+pub use file::{steps, Case};
 pub use output::{OutputOptions, PictureKind, Units, VtuFormat};
 pub use overrides::apply_overrides;
-pub use sweep::{steps, LoadCase, StepSpec, SweepParameter, SweepSpec, MAX_STEPS};
+pub use sweep::{
+    step_list, validate_steps, LoadCase, StepSpec, SweepParameter, SweepSpec, MAX_STEPS,
+};

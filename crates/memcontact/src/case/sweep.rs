@@ -9,7 +9,6 @@
 //! L, the tension S, and the obstacle offset adds to φₙ. A load case with new data
 //! assembles once on the same mesh.
 
-use super::file::Case;
 use crate::error::{Error, Invalid, Result};
 use crate::field::{Field, Stiffness};
 use crate::problem::Problem;
@@ -199,24 +198,29 @@ impl LoadCase {
     }
 }
 
-/// Checks the sweep and load cases of a case.
-pub fn validate(case: &Case) -> std::result::Result<(), Invalid> {
-    if case.sweep.is_some() && !case.load_cases.is_empty() {
+/// Checks the sweep and load cases of a case (its `[sweep]`, its `[[load_case]]` entries
+/// and the base problem they modify).
+pub fn validate_steps(
+    sweep: Option<&SweepSpec>,
+    load_cases: &[LoadCase],
+    problem: &Problem,
+) -> std::result::Result<(), Invalid> {
+    if sweep.is_some() && !load_cases.is_empty() {
         return Err(Invalid::new(
             "sweep",
             "a case has either a [sweep] or [[load_case]] entries, not both",
         ));
     }
-    if let Some(s) = &case.sweep {
+    if let Some(s) = sweep {
         s.values()?;
     }
-    if case.load_cases.len() > MAX_STEPS {
+    if load_cases.len() > MAX_STEPS {
         return Err(Invalid::new(
             "load_case",
             format!("more than {MAX_STEPS} load cases"),
         ));
     }
-    for (i, lc) in case.load_cases.iter().enumerate() {
+    for (i, lc) in load_cases.iter().enumerate() {
         let key = |k: &str| format!("load_case.{i}.{k}");
         let name = lc.name.trim();
         let safe = !name.is_empty()
@@ -234,7 +238,7 @@ pub fn validate(case: &Case) -> std::result::Result<(), Invalid> {
                 ),
             ));
         }
-        if case.load_cases[..i].iter().any(|o| o.name.trim() == name) {
+        if load_cases[..i].iter().any(|o| o.name.trim() == name) {
             return Err(Invalid::new(
                 key("name"),
                 format!("\"{name}\" is used twice"),
@@ -248,7 +252,7 @@ pub fn validate(case: &Case) -> std::result::Result<(), Invalid> {
                 ));
             }
         }
-        let p = lc.problem(&case.problem);
+        let p = lc.problem(problem);
         p.validate()
             .map_err(|e| Invalid::new(lc.rename_keys(i, &e.key), lc.rename_keys(i, &e.message)))?;
     }
@@ -266,9 +270,9 @@ pub struct StepSpec {
     pub value: f64,
 }
 
-/// The steps of a case: its sweep's values or its load cases (empty for neither).
-pub fn steps(case: &Case) -> Result<Vec<StepSpec>> {
-    if let Some(s) = &case.sweep {
+/// The steps of a sweep's values or of load cases (empty for neither).
+pub fn step_list(sweep: Option<&SweepSpec>, load_cases: &[LoadCase]) -> Result<Vec<StepSpec>> {
+    if let Some(s) = sweep {
         let values = s.values().map_err(Invalid::into_error)?;
         return Ok(values
             .into_iter()
@@ -280,8 +284,7 @@ pub fn steps(case: &Case) -> Result<Vec<StepSpec>> {
             })
             .collect());
     }
-    Ok(case
-        .load_cases
+    Ok(load_cases
         .iter()
         .enumerate()
         .map(|(index, lc)| StepSpec {

@@ -1,6 +1,6 @@
 //! The heights g on the fixed part of the boundary (SPEC §5).
 
-use super::checks::bad_value;
+use super::data::bad_value;
 use super::data::Extensions;
 use crate::error::Result;
 use crate::fem::VertexTriangles;

@@ -9,6 +9,7 @@
 //! checked again with [`check_model`].
 
 use super::body::FoundationMatrix;
+use super::data::bad_value;
 use super::data::{BodyStiffness, Extensions, ProblemData};
 use super::system::Model;
 use crate::error::{Error, Result};
@@ -329,18 +330,6 @@ impl Model {
             shown.join("; ")
         )))
     }
-}
-
-/// The error for a bad value `v` of `name` at `p`.
-pub(super) fn bad_value(name: &str, v: f64, p: [f64; 2]) -> Error {
-    let what = if v.is_nan() {
-        "is NaN".to_string()
-    } else if !v.is_finite() {
-        format!("is infinite ({v})")
-    } else {
-        format!("is negative ({v})")
-    };
-    Error::Data(format!("{name} {what} at ({}, {})", p[0], p[1]))
 }
 
 /// Checks a coefficient at every triangle centroid: finite, and non-negative when asked

@@ -114,3 +114,15 @@ pub struct BodyData<'a> {
     /// How its surface is sampled.
     pub sampling: Sampling,
 }
+
+/// The error for a bad value `v` of `name` at `p`.
+pub(super) fn bad_value(name: &str, v: f64, p: [f64; 2]) -> Error {
+    let what = if v.is_nan() {
+        "is NaN".to_string()
+    } else if !v.is_finite() {
+        format!("is infinite ({v})")
+    } else {
+        format!("is negative ({v})")
+    };
+    Error::Data(format!("{name} {what} at ({}, {})", p[0], p[1]))
+}
