@@ -36,18 +36,12 @@ pub fn solve(case_path: &Path, flags: &SolveFlags) -> Result<()> {
     let case = Case::load(case_path, flags.sets)?;
     let label = case_path.display().to_string();
     let mut progress = Progress::new(flags.verbosity);
-    let discretization = Discretization::new(&case.problem, &mut progress)?;
-    // Everything that needs the mesh is checked before anything is solved.
-    write::check_on_mesh(&case, discretization.mesh())?;
     if case.is_sweep() {
-        return sweep(&label, &case, discretization, flags, progress, started);
+        return sweep(&label, &case, flags, progress, started);
     }
-    let report = discretization.solve(&case.settings, &mut progress)?;
+    // Everything that needs the mesh is checked before anything is solved.
+    let outcome = memcontact::run(&case, &mut progress)?;
     progress.finish();
-    let outcome = Outcome {
-        discretization,
-        report,
-    };
     print_warnings(&outcome.discretization);
     let accepted = outcome.report.accepted;
     if !accepted && !flags.write_unconverged {
@@ -98,48 +92,50 @@ pub fn solve(case_path: &Path, flags: &SolveFlags) -> Result<()> {
 fn sweep(
     label: &str,
     case: &Case,
-    base: Discretization,
     flags: &SolveFlags,
     mut progress: Progress,
     started: Instant,
 ) -> Result<()> {
-    print_warnings(&base);
-    let mut writer =
-        SweepWriter::begin(flags.out, flags.force, case, label, case.output.vtu, true)?;
     let total = memcontact::case::steps(case)?.len();
-    let mut rows = Vec::new();
-    let mut unaccepted = Vec::new();
-    let result = memcontact::run::run_sweep_on(
-        case,
-        base,
-        true,
-        &mut progress,
-        &mut |step, outcome, row| {
-            rows.push(row.clone());
-            if !outcome.report.accepted {
-                unaccepted.push(step.name.clone());
-                if !flags.write_unconverged {
-                    return Ok(());
-                }
-            }
-            writer.write_step(case, step, outcome, row.seconds)?;
-            Ok(())
-        },
-    );
+    // The result set begins with the first step to write: bad input found before any step
+    // is solved leaves nothing behind.
+    let mut writer: Option<SweepWriter> = None;
+    let run = memcontact::run::run_sweep(case, true, &mut progress, &mut |step, outcome, row| {
+        if step.index == 0 {
+            print_warnings(&outcome.discretization);
+        }
+        if !outcome.report.accepted && !flags.write_unconverged {
+            return Ok(());
+        }
+        let w = match &mut writer {
+            Some(w) => w,
+            None => writer.insert(SweepWriter::begin(
+                flags.out,
+                flags.force,
+                case,
+                label,
+                case.output.vtu,
+                true,
+            )?),
+        };
+        w.write_step(case, step, outcome, row.seconds)?;
+        Ok(())
+    })?;
     progress.finish();
-    // Bad input, or a step that did not converge: nothing is written unless the
-    // unconverged step was asked for.
-    let failed = match result {
-        Ok(_) => None,
-        Err(e) if unaccepted.is_empty() => return Err(e.into()),
-        Err(e) if !flags.write_unconverged => bail!(
+    // A step that did not converge: nothing is written unless the unconverged step was
+    // asked for.
+    let failed = match run.stopped {
+        None => None,
+        Some((_, e)) if !flags.write_unconverged => bail!(
             "{e}; no result files were written (pass --write-unconverged to keep the steps \
              solved and the unconverged iterate, marked as not accepted in summary.json)"
         ),
-        Err(e) => Some(e),
+        Some((step, e)) => Some((step, e)),
     };
+    let writer = writer.expect("the first step was written");
     let written = writer.steps_written();
-    writer.finish(&rows)?;
+    writer.finish(&run.rows)?;
+    let rows = &run.rows;
     println!(
         "memcontact: {label} ({}: {total} steps)",
         write::steps_kind(case)
@@ -148,7 +144,7 @@ fn sweep(
         "  {:>5} {:>16} {:>12} {:>12} {:>12} {:>12} {:>6} {:>10}",
         "step", "name", "value", "max |u|", "contact area", "force", "iters", "KKT"
     );
-    for r in &rows {
+    for r in rows {
         println!(
             "  {:>5} {:>16} {:>12.5e} {:>12.5e} {:>12.5e} {:>12.5e} {:>6} {:>10.3e}",
             r.step,
@@ -173,11 +169,11 @@ fn sweep(
         started.elapsed().as_secs_f64(),
         flags.out.display(),
     );
-    if let Some(e) = failed {
+    if let Some((step, e)) = failed {
         bail!(
             "{e}; the directories of the steps that did not converge ({}) hold their \
              unconverged iterates (summary.json: \"accepted\": false)",
-            unaccepted.join(", ")
+            step.name
         );
     }
     Ok(())
@@ -199,8 +195,7 @@ pub fn check(case_path: &Path, sets: &[String]) -> Result<()> {
     // signs, NaN), everything `solve` checks before it solves; the load cases' data are
     // assembled on the mesh too, and the profile line checked against it.
     let d = Discretization::new(&case.problem, &mut Progress::new(Verbosity::Quiet))?;
-    write::check_on_mesh(&case, d.mesh())?;
-    memcontact::run::check_on_mesh(&case, d.mesh(), true)?;
+    memcontact::run::check_case_on_mesh(&case, d.mesh(), true)?;
     d.check_memory(&case.settings)?;
     print_warnings(&d);
     let mesh = d.mesh();

@@ -26,7 +26,7 @@ use std::time::{Duration, Instant};
 pub struct ResultData {
     /// The case's label.
     pub label: String,
-    /// The case solved (for a mesh given in Python: its data, with a placeholder mesh).
+    /// The case solved (for a mesh given in Python: its data on that mesh).
     pub case: Case,
     /// The solved mesh and its levels.
     pub mesh: PyMesh,
@@ -593,6 +593,11 @@ pub fn _result_from_state(state: &Bound<'_, PyDict>) -> PyResult<PyResult_> {
         derived: None,
     };
     let mesh = PyMesh::new_from(hierarchy_from_state(&get("mesh")?)?);
+    // A mesh given as data travels as the result's mesh; the case gets it back.
+    let mut case = case;
+    if let memcontact::problem::MeshSource::Given(g) = &mut case.problem.mesh.source {
+        g.hierarchy = Some(mesh.hierarchy.clone());
+    }
     Ok(PyResult_ {
         data: Arc::new(ResultData {
             label: meta.label,

@@ -6,13 +6,13 @@ use crate::case::PyCase;
 use crate::convert::{py_err, to_py};
 use crate::mesh::PyMesh;
 use crate::result::{vtu_format, PyResult_};
-use memcontact::case::{steps, StepSpec};
+use memcontact::case::StepSpec;
 use memcontact::outcome::StepRow;
-use memcontact::run::run_sweep_on;
+use memcontact::run::run_sweep;
 use memcontact::solve::Silent;
 use memcontact::write::step_label;
-use memcontact::{Case, Discretization, Error};
-use memcontact_plot::write::{check_on_mesh, SweepWriter};
+use memcontact::{Case, Error};
+use memcontact_plot::write::SweepWriter;
 use pyo3::exceptions::{PyIndexError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
@@ -33,11 +33,11 @@ pub struct PySweep {
 /// What the solve of a sweep produced, before it becomes Python objects.
 struct Solved {
     results: Vec<PyResult_>,
+    steps: Vec<StepSpec>,
     rows: Vec<StepRow>,
     message: Option<String>,
 }
 
-/// Solves the steps of `case` in turn (the GIL is released by the caller).
 fn solve_steps(case: &Case, label: &str, warm: bool) -> memcontact::Result<Solved> {
     if !case.is_sweep() {
         return Err(Error::Data(
@@ -46,13 +46,11 @@ fn solve_steps(case: &Case, label: &str, warm: bool) -> memcontact::Result<Solve
                 .into(),
         ));
     }
-    let base = Discretization::new(&case.problem, &mut Silent)?;
-    check_on_mesh(case, base.mesh())?;
-    let mesh = PyMesh::new_from(base.user_hierarchy());
+    let mut mesh: Option<PyMesh> = None;
     let mut results = Vec::new();
-    let mut rows = Vec::new();
-    let mut unaccepted = false;
-    let outcome = run_sweep_on(case, base, warm, &mut Silent, &mut |step, outcome, row| {
+    let run = run_sweep(case, warm, &mut Silent, &mut |step, outcome, row| {
+        let mesh =
+            mesh.get_or_insert_with(|| PyMesh::new_from(outcome.discretization.user_hierarchy()));
         results.push(PyResult_::of_step(
             step_label(label, step),
             case.clone(),
@@ -61,20 +59,14 @@ fn solve_steps(case: &Case, label: &str, warm: bool) -> memcontact::Result<Solve
             row.seconds,
             step.index,
         ));
-        rows.push(row.clone());
-        unaccepted = !outcome.report.accepted;
         Ok(())
-    });
-    let message = match outcome {
-        Ok(_) => None,
-        // A step the settings do not accept ends the sweep: its result is kept.
-        Err(e) if unaccepted => Some(e.to_string()),
-        Err(e) => return Err(e),
-    };
+    })?;
     Ok(Solved {
         results,
-        rows,
-        message,
+        steps: run.steps,
+        rows: run.rows,
+        // A step the settings do not accept ends the sweep: its result is kept.
+        message: run.stopped.map(|(_, e)| e.to_string()),
     })
 }
 
@@ -88,12 +80,11 @@ pub fn sweep(py: Python<'_>, case: PyRef<'_, PyCase>, warm: bool) -> PyResult<Py
     let c = case.case.clone();
     let label = case.label.clone();
     drop(case);
-    let (solved, all_steps, c, label) = py
+    let (solved, c, label) = py
         .detach(move || {
             memcontact::on_workers(move || -> memcontact::Result<_> {
                 let solved = solve_steps(&c, &label, warm)?;
-                let all_steps = steps(&c)?;
-                Ok((solved, all_steps, c, label))
+                Ok((solved, c, label))
             })
         })
         .map_err(py_err)?;
@@ -105,7 +96,7 @@ pub fn sweep(py: Python<'_>, case: PyRef<'_, PyCase>, warm: bool) -> PyResult<Py
     Ok(PySweep {
         label,
         case: c,
-        steps: all_steps,
+        steps: solved.steps,
         results,
         rows: solved.rows,
         message: solved.message,

@@ -48,6 +48,15 @@ pub enum Error {
         /// What is wrong.
         message: String,
     },
+    /// An error with what was being done when it happened (shown as its cause).
+    #[error("{context}")]
+    Context {
+        /// What was being done.
+        context: String,
+        /// The error.
+        #[source]
+        source: Box<Error>,
+    },
     /// An input/output failure while writing results.
     #[error("{path}: {source}")]
     Io {
@@ -96,6 +105,26 @@ pub fn excerpt(text: &str) -> std::borrow::Cow<'_, str> {
             &text[..cut],
             text.chars().count()
         )),
+    }
+}
+
+impl Error {
+    /// This error as the cause of `context` (what was being done).
+    pub fn context(self, context: impl Into<String>) -> Error {
+        Error::Context {
+            context: context.into(),
+            source: Box::new(self),
+        }
+    }
+
+    /// An error about the case as a whole (no key, no file): its message alone.
+    pub fn case(message: impl Into<String>) -> Error {
+        Error::Case {
+            file: None,
+            line: None,
+            key: String::new(),
+            message: message.into(),
+        }
     }
 }
 

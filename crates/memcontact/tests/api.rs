@@ -62,8 +62,9 @@ fn toml_rust_and_json_describe_the_same_problem_and_run_alike() {
     assert_eq!(from_toml.problem, problem_in_rust());
     let json = serde_json::to_string(&from_toml).unwrap();
     assert_eq!(Case::from_json_str(&json).unwrap(), from_toml);
-    let a = run(&from_toml.problem, &from_toml.settings, &mut Silent).unwrap();
-    let b = run(&problem_in_rust(), &Settings::default(), &mut Silent).unwrap();
+    let a = run(&from_toml, &mut Silent).unwrap();
+    let b = memcontact::run::run_problem(&problem_in_rust(), &Settings::default(), &mut Silent)
+        .unwrap();
     assert_eq!(a.status(), Status::Converged);
     assert_eq!(a.report.u, b.report.u);
     assert!(a.report.certificate.kkt() <= 1e-10);
@@ -168,17 +169,13 @@ fn every_status_carries_the_iterate_and_its_certificate() {
 #[test]
 fn auto_records_its_choice() {
     let case = Case::from_toml_str(SQUARE, None).unwrap();
-    let r = run(&case.problem, &case.settings, &mut Silent)
-        .unwrap()
-        .report;
+    let r = run(&case, &mut Silent).unwrap().report;
     assert_eq!(r.requested, Method::Auto);
     assert_eq!(r.method, Method::Multigrid);
     assert_eq!(r.choice, memcontact::solve::Choice::GeometricHierarchy);
     let free =
         Case::from_toml_str(&SQUARE.replace("stiffness = 1000.0", "stiffness = 0"), None).unwrap();
-    let r = run(&free.problem, &free.settings, &mut Silent)
-        .unwrap()
-        .report;
+    let r = run(&free, &mut Silent).unwrap().report;
     assert_eq!(r.method, Method::Linear);
     assert_eq!(r.choice, memcontact::solve::Choice::LinearProblem);
 }
@@ -186,7 +183,7 @@ fn auto_records_its_choice() {
 #[test]
 fn a_result_set_is_written_and_read_back_without_the_cli() {
     let case = Case::from_toml_str(SQUARE, None).unwrap();
-    let outcome = run(&case.problem, &case.settings, &mut Silent).unwrap();
+    let outcome = run(&case, &mut Silent).unwrap();
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("result");
     let options = WriteOptions {

@@ -50,7 +50,7 @@ fn renumbered_solve_answers_in_the_users_numbering() {
     for method in ["active-set", "multigrid"] {
         for load in [None, Some(Field::Nodal(nodal.clone().into()))] {
             let case = site_case(method, load);
-            let outcome = run(&case.problem, &case.settings, &mut Silent).unwrap();
+            let outcome = run(&case, &mut Silent).unwrap();
             assert!(outcome.report.accepted, "{method}");
             // Solved in another numbering ...
             let internal = outcome.discretization.mesh();

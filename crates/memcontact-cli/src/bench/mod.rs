@@ -143,7 +143,7 @@ pub fn run_case(case: &Case, scratch: &Path, pictures: bool) -> Result<CaseRun> 
     reset_peak_memory();
     let stolen_before = stolen_seconds();
     let started = Instant::now();
-    let outcome = memcontact_plot::write::solve_case(&case, &mut Silent)?;
+    let outcome = memcontact::run(&case, &mut Silent)?;
     let t_write = Instant::now();
     let dir = scratch.join(format!("memcontact-bench-{}", std::process::id()));
     let options = WriteOptions {

@@ -17,6 +17,22 @@ pub fn build_mesh(spec: &MeshSpec) -> Result<(Hierarchy, Vec<String>)> {
     }
     let mut warnings = Vec::new();
     let mut hierarchy = match &spec.source {
+        MeshSource::Given(g) => match &g.hierarchy {
+            Some(h) => (**h).clone(),
+            None => {
+                return Err(crate::error::Error::Case {
+                    file: None,
+                    line: None,
+                    key: "mesh.given".into(),
+                    message: format!(
+                        "the mesh given as data ({}) is not attached to this case (a case read \
+                         back from its text holds only the mesh's description): give the mesh \
+                         again",
+                        g.description
+                    ),
+                })
+            }
+        },
         MeshSource::File(path) => {
             let (mesh, w) = crate::io::gmsh::read_msh(path)?;
             warnings.extend(w);
@@ -75,6 +91,7 @@ pub fn build_mesh(spec: &MeshSpec) -> Result<(Hierarchy, Vec<String>)> {
 fn expected_size(spec: &MeshSpec) -> Option<MeshSize> {
     match &spec.source {
         MeshSource::File(_) => None,
+        MeshSource::Given(g) => g.hierarchy.as_ref().map(|h| MeshSize::of(h.finest())),
         &MeshSource::Rectangle {
             nx, ny, diagonal, ..
         } => {

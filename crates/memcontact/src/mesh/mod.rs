@@ -6,6 +6,7 @@ pub mod generate;
 pub mod refine;
 pub mod regions;
 pub mod reorder;
+pub mod segment;
 
 pub use boundary::BoundaryRegions;
 

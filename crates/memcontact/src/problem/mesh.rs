@@ -2,8 +2,10 @@
 
 use crate::error::Invalid;
 use crate::mesh::generate::{self, Diagonal};
+use crate::mesh::refine::Hierarchy;
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 
 /// The largest number of uniform refinements accepted (each multiplies the triangles by
 /// four); the size of the refined mesh is checked separately against the memory available
@@ -54,6 +56,9 @@ pub enum MeshSource {
         /// Target element size.
         size: f64,
     },
+    /// A mesh given as data (arrays from a program, a mesh refined or adapted before),
+    /// shown in a case file by its description.
+    Given(GivenMesh),
     /// A constrained Delaunay mesh of a polygon with holes and named sub-regions.
     Polygon {
         /// The outer boundary.
@@ -67,6 +72,63 @@ pub enum MeshSource {
         /// Smallest angle in degrees, in (0, 30].
         min_angle: f64,
     },
+}
+
+/// A mesh given as data: its levels (shared, not copied, by the cases that hold it) and the
+/// description a case file shows in their place (`given = "…"`: counts and a hash of the
+/// vertices and triangles).
+#[derive(Debug, Clone)]
+pub struct GivenMesh {
+    /// The mesh levels, coarsest first; `None` for a case read back from its text, which
+    /// holds the description alone (the mesh must be given again to solve it).
+    pub hierarchy: Option<Arc<Hierarchy>>,
+    /// `"V vertices, T triangles, L levels, xxh3 HASH"`.
+    pub description: String,
+}
+
+impl GivenMesh {
+    /// The mesh levels `hierarchy`, described by their finest level's counts and a hash of
+    /// every level's vertices and triangles.
+    pub fn new(hierarchy: Hierarchy) -> GivenMesh {
+        GivenMesh::shared(Arc::new(hierarchy))
+    }
+
+    /// [`GivenMesh::new`] of mesh levels shared with the caller (not copied).
+    pub fn shared(hierarchy: Arc<Hierarchy>) -> GivenMesh {
+        let mut h = xxhash_rust::xxh3::Xxh3::new();
+        for m in &hierarchy.levels {
+            for p in &m.points {
+                h.update(&p[0].to_le_bytes());
+                h.update(&p[1].to_le_bytes());
+            }
+            for t in &m.triangles {
+                for v in t {
+                    h.update(&v.to_le_bytes());
+                }
+            }
+            for r in &m.regions {
+                h.update(&r.to_le_bytes());
+            }
+        }
+        let f = hierarchy.finest();
+        GivenMesh {
+            description: format!(
+                "{} vertices, {} triangles, {} level{}, xxh3 {:016x}",
+                f.n_vertices(),
+                f.n_triangles(),
+                hierarchy.depth(),
+                if hierarchy.depth() == 1 { "" } else { "s" },
+                h.digest()
+            ),
+            hierarchy: Some(hierarchy),
+        }
+    }
+}
+
+impl PartialEq for GivenMesh {
+    fn eq(&self, other: &GivenMesh) -> bool {
+        self.description == other.description
+    }
 }
 
 /// A named region polygon of the polygon generator.
@@ -85,6 +147,8 @@ pub struct RegionPolygon {
 struct MeshTable {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     file: Option<PathBuf>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    given: Option<String>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     generator: Option<String>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -150,6 +214,19 @@ impl TryFrom<MeshTable> for MeshSpec {
                 None => Ok(()),
             }
         };
+        if let Some(description) = m.given {
+            if m.file.is_some() || m.generator.is_some() {
+                return Err("a mesh given as data takes no `file` and no `generator`".into());
+            }
+            reject("a mesh given as data", &[&rect, &disk, &poly, &size])?;
+            return Ok(MeshSpec {
+                source: MeshSource::Given(GivenMesh {
+                    hierarchy: None,
+                    description,
+                }),
+                refine: m.refine,
+            });
+        }
         let source = match (m.file, m.generator.as_deref()) {
             (Some(_), Some(_)) => return Err("give either `file` or `generator`, not both".into()),
             (None, None) => {
@@ -232,6 +309,7 @@ impl From<MeshSpec> for MeshTable {
         };
         match s.source {
             MeshSource::File(p) => t.file = Some(p),
+            MeshSource::Given(g) => t.given = Some(g.description),
             MeshSource::Rectangle {
                 x0,
                 y0,
@@ -283,6 +361,14 @@ fn diagonal_name(d: Diagonal) -> &'static str {
 }
 
 impl MeshSpec {
+    /// A mesh given as data ([`GivenMesh::new`]), refined no further.
+    pub fn given(hierarchy: Hierarchy) -> MeshSpec {
+        MeshSpec {
+            source: MeshSource::Given(GivenMesh::new(hierarchy)),
+            refine: 0,
+        }
+    }
+
     /// A mesh read from a Gmsh file.
     pub fn file(path: impl Into<PathBuf>) -> MeshSpec {
         MeshSpec {
@@ -295,6 +381,7 @@ impl MeshSpec {
     pub fn kind(&self) -> &'static str {
         match self.source {
             MeshSource::File(_) => "file",
+            MeshSource::Given(_) => "given",
             MeshSource::Rectangle { .. } => "rectangle",
             MeshSource::Disk { .. } => "disk",
             MeshSource::Polygon { .. } => "polygon",
@@ -305,7 +392,7 @@ impl MeshSpec {
     /// tags (`None` for a mesh file: its physical curves are known once it is read).
     pub fn boundary_region_names(&self) -> Option<Vec<String>> {
         match &self.source {
-            MeshSource::File(_) => None,
+            MeshSource::File(_) | MeshSource::Given(_) => None,
             MeshSource::Rectangle { .. } => Some(
                 generate::RECTANGLE_SIDES
                     .iter()
@@ -345,7 +432,7 @@ impl MeshSpec {
         let finite_positive = |v: f64| v.is_finite() && v > 0.0;
         match &self.source {
             MeshSource::File(p) if p.as_os_str().is_empty() => bad("file", "is empty".into()),
-            MeshSource::File(_) => Ok(()),
+            MeshSource::File(_) | MeshSource::Given(_) => Ok(()),
             &MeshSource::Rectangle {
                 x0,
                 y0,

@@ -7,4 +7,4 @@ mod data;
 mod mesh;
 
 pub use data::{Boundary, Membrane, Obstacle, Problem, SamplingKind};
-pub use mesh::{MeshSource, MeshSpec, RegionPolygon, MAX_REFINE};
+pub use mesh::{GivenMesh, MeshSource, MeshSpec, RegionPolygon, MAX_REFINE};

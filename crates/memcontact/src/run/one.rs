@@ -1,7 +1,10 @@
 //! One run: a problem solved on its discretisation, by the method the settings name or the
 //! one `auto` picks, checked before anyone reports or writes it.
 
+use super::checks::check_case_on_mesh;
+use crate::case::Case;
 use crate::discretization::{Discretization, Phase};
+use crate::error::Error;
 use crate::error::{Invalid, Result};
 use crate::outcome::fields::derive_from;
 use crate::outcome::{Outcome, Report};
@@ -100,8 +103,42 @@ impl Discretization {
     }
 }
 
-/// Runs a problem end to end: mesh, assembly, solve.
-pub fn run(problem: &Problem, settings: &Settings, observer: &mut dyn Observer) -> Result<Outcome> {
+/// Runs a case of one step end to end (the paper's problem, or with any of its extensions):
+/// the whole case validated, the mesh built and the model assembled, everything that needs
+/// the mesh checked (regions, data on the boundary, the profile line of `[output]`), then
+/// the solve. The outcome is returned whatever the solve's status; bad input is an `Err`.
+/// A case with steps (`[sweep]`, `[[load_case]]`) is refused: [`super::run_sweep`] runs
+/// those.
+pub fn run(case: &Case, observer: &mut dyn Observer) -> Result<Outcome> {
+    if case.is_sweep() {
+        return Err(Error::Case {
+            file: None,
+            line: None,
+            key: if case.sweep.is_some() {
+                "sweep".into()
+            } else {
+                "load_case".into()
+            },
+            message: "the case has steps to solve in turn: run them as a sweep".into(),
+        });
+    }
+    case.validate().map_err(Invalid::into_error)?;
+    let discretization = Discretization::new(&case.problem, observer)?;
+    check_case_on_mesh(case, discretization.mesh(), false)?;
+    let report = discretization.solve(&case.settings, observer)?;
+    Ok(Outcome {
+        discretization,
+        report,
+    })
+}
+
+/// Runs a problem end to end (mesh, assembly, solve) with `settings`: [`run`] for a
+/// problem and settings without the rest of a case.
+pub fn run_problem(
+    problem: &Problem,
+    settings: &Settings,
+    observer: &mut dyn Observer,
+) -> Result<Outcome> {
     settings.validate().map_err(Invalid::into_error)?;
     let discretization = Discretization::new(problem, observer)?;
     let report = discretization.solve(settings, observer)?;

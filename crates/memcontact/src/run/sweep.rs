@@ -8,8 +8,9 @@
 //! L, the tension S, and the obstacle offset adds to φₙ. A load case with new data
 //! assembles once on the same mesh.
 
+use super::checks::check_case_on_mesh;
 use crate::case::{steps, Case, StepSpec, SweepParameter};
-use crate::discretization::{assemble_model, bind_and_check, Discretization};
+use crate::discretization::{assemble_model, Discretization, Phase};
 use crate::error::{Error, Result};
 use crate::mesh::refine::Hierarchy;
 use crate::mesh::Mesh;
@@ -17,26 +18,6 @@ use crate::model::{FoundationMatrix, Model};
 use crate::outcome::{Outcome, StepRow};
 use crate::solve::Observer;
 use std::time::Instant;
-
-/// Checks the load cases' data on the mesh before any step is solved: binds each load
-/// case's f, φ and h to the mesh's regions (or vertices) and checks them on the boundary;
-/// with `assemble`, also assembles each load case's model (everything its step will
-/// check). Errors name the load case's keys (`load_case.N.stiffness`, ...).
-pub fn check_on_mesh(case: &Case, mesh: &Mesh, assemble: bool) -> Result<()> {
-    for (i, lc) in case.load_cases.iter().enumerate() {
-        if !lc.assembles() {
-            continue;
-        }
-        let p = lc.problem(&case.problem);
-        let checked = if assemble {
-            assemble_model(&p, mesh).map(drop)
-        } else {
-            bind_and_check(&p, mesh).map(drop)
-        };
-        checked.map_err(|e| lc.rename_error(i, e))?;
-    }
-    Ok(())
-}
 
 /// `model` with one sweep parameter set to `value` (the base model has factor 1, the
 /// case's tension, and offset 0).
@@ -139,30 +120,51 @@ pub fn step_discretization(
     Ok(d)
 }
 
-/// Runs the steps of a case's sweep or load cases in turn, each warm-started from the
-/// previous answer (`warm = false`: every step from the usual start). `on_step` receives
-/// each step's outcome (to write it) before the next runs; a step the settings do not
-/// accept ends the sweep with its error after `on_step` has seen it.
+/// What a sweep (or a set of load cases) produced: every step of the case, the rows of the
+/// steps solved, and, when a step was not accepted, that step and the error naming how its
+/// solve ended (the sweep stopped there; the step's row is the last).
+#[derive(Debug)]
+pub struct SweepRun {
+    /// All the steps of the case, solved or not.
+    pub steps: Vec<StepSpec>,
+    /// One row per step solved, in order.
+    pub rows: Vec<StepRow>,
+    /// The step the settings did not accept, with its error.
+    pub stopped: Option<(StepSpec, Error)>,
+}
+
+impl SweepRun {
+    /// Whether every step was solved and accepted.
+    pub fn accepted(&self) -> bool {
+        self.stopped.is_none() && self.rows.len() == self.steps.len()
+    }
+}
+
+/// Runs the steps of a case's `[sweep]` or `[[load_case]]` entries in turn on one mesh,
+/// each warm-started from the previous answer (`warm = false`: every step from the usual
+/// start). The case is validated, its mesh built and every step's data checked on it
+/// before the first step is solved. `on_step` receives each step's outcome and row (to
+/// write or keep them) before the next runs; a step the settings do not accept ends the
+/// sweep after `on_step` has seen it ([`SweepRun::stopped`]). Bad input is an `Err`.
 pub fn run_sweep(
     case: &Case,
     warm: bool,
     observer: &mut dyn Observer,
     on_step: &mut dyn FnMut(&StepSpec, &Outcome, &StepRow) -> Result<()>,
-) -> Result<Vec<StepRow>> {
+) -> Result<SweepRun> {
+    case.validate().map_err(crate::error::Invalid::into_error)?;
     let base = Discretization::new(&case.problem, observer)?;
     run_sweep_on(case, base, warm, observer, on_step)
 }
 
-/// [`run_sweep`] on the base case's discretisation, built (and maybe checked further) by
-/// the caller. Every load case's data is checked on the mesh ([`check_on_mesh`]) before
-/// the first step is solved.
+/// [`run_sweep`] on the base case's discretisation, built by the caller.
 pub fn run_sweep_on(
     case: &Case,
     base: Discretization,
     warm: bool,
     observer: &mut dyn Observer,
     on_step: &mut dyn FnMut(&StepSpec, &Outcome, &StepRow) -> Result<()>,
-) -> Result<Vec<StepRow>> {
+) -> Result<SweepRun> {
     let steps = steps(case)?;
     if steps.is_empty() {
         return Err(Error::Case {
@@ -172,7 +174,7 @@ pub fn run_sweep_on(
             message: "the case has no [sweep] and no [[load_case]]".into(),
         });
     }
-    check_on_mesh(case, base.mesh(), false)?;
+    check_case_on_mesh(case, base.mesh(), false)?;
     let base_model = base.model.clone();
     let base_phases = base.phases.clone();
     let mut current = base;
@@ -187,7 +189,7 @@ pub fn run_sweep_on(
             // This step assembled its own model: its assembly time replaces the base's.
             let seconds = t0.elapsed().as_secs_f64();
             current.phases.retain(|p| p.name != "assembly");
-            current.phases.push(crate::discretization::Phase {
+            current.phases.push(Phase {
                 name: "assembly".into(),
                 seconds,
             });
@@ -210,12 +212,18 @@ pub fn run_sweep_on(
         on_step(step, &outcome, &row)?;
         rows.push(row);
         if let Some(e) = outcome.report.error() {
-            return Err(match e {
+            let e = match e {
                 Error::Solver { solver, message } => Error::Solver {
                     solver,
                     message: format!("{} ({}): {message}", step.name, step.value),
                 },
                 other => other,
+            };
+            let stopped = Some((step.clone(), e));
+            return Ok(SweepRun {
+                steps: steps.clone(),
+                rows,
+                stopped,
             });
         }
         let Outcome {
@@ -225,7 +233,11 @@ pub fn run_sweep_on(
         start = Some(report.u);
         current = discretization;
     }
-    Ok(rows)
+    Ok(SweepRun {
+        steps,
+        rows,
+        stopped: None,
+    })
 }
 
 #[cfg(test)]
@@ -334,7 +346,7 @@ stiffness = 300
         .unwrap();
         let d = Discretization::new(&c.problem, &mut Silent).unwrap();
         for assemble in [false, true] {
-            let e = check_on_mesh(&c, d.mesh(), assemble)
+            let e = super::super::checks::check_load_cases_on_mesh(&c, d.mesh(), assemble)
                 .unwrap_err()
                 .to_string();
             assert!(e.contains("load_case.1.shape") && e.contains("clay"), "{e}");
@@ -391,7 +403,8 @@ stiffness = 300
                 warm_u.push(o.report.u.clone());
                 Ok(())
             })
-            .unwrap();
+            .unwrap()
+            .rows;
             let mut k = 0;
             let cold = run_sweep(&case, false, &mut Silent, &mut |s, o, _| {
                 // Each step equals the base case solved with the scaled load.
@@ -400,7 +413,7 @@ stiffness = 300
                     None,
                 )
                 .unwrap();
-                let direct = crate::run(&scaled.problem, &scaled.settings, &mut Silent).unwrap();
+                let direct = crate::run(&scaled, &mut Silent).unwrap();
                 for (a, b) in o.report.u.iter().zip(&direct.report.u) {
                     assert!((a - b).abs() <= 1e-9 * b.abs().max(1e-3));
                 }
@@ -410,7 +423,8 @@ stiffness = 300
                 k += 1;
                 Ok(())
             })
-            .unwrap();
+            .unwrap()
+            .rows;
             assert_eq!(warm.len(), 5);
             assert_eq!(cold.len(), 5);
             // Load up, deflection up.

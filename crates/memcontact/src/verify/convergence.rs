@@ -517,7 +517,7 @@ fn positive_fraction(g: [f64; 3]) -> f64 {
 
 /// One stiffness of a [`rigid_limit_sweep`].
 #[derive(Debug, Clone, Copy, serde::Serialize)]
-pub struct SweepRow {
+pub struct RigidLimitRow {
     /// The constant stiffness h.
     pub h: f64,
     /// `max_i |U_i(h) − U_i(∞)|`.
@@ -538,9 +538,9 @@ pub struct SweepRow {
 
 /// The result of [`rigid_limit_sweep`].
 #[derive(Debug, Clone)]
-pub struct Sweep {
+pub struct RigidLimit {
     /// One row per stiffness, in the order given.
-    pub rows: Vec<SweepRow>,
+    pub rows: Vec<RigidLimitRow>,
     /// The rigid solution at every vertex.
     pub rigid_u: Vec<f64>,
     /// The contact estimate of the rigid solution.
@@ -560,7 +560,7 @@ pub fn rigid_limit_sweep(
     data: &ProblemData,
     stiffnesses: &[f64],
     solver: &Settings,
-) -> Result<Sweep> {
+) -> Result<RigidLimit> {
     if let Some(h) = stiffnesses.iter().find(|h| !(h.is_finite() && **h > 0.0)) {
         return Err(Error::Data(format!(
             "sweep stiffness h = {h} must be finite and > 0"
@@ -588,7 +588,7 @@ pub fn rigid_limit_sweep(
         let u = model.to_vertices(&s.u);
         let diff: Vec<f64> = u.iter().zip(&rigid_u).map(|(a, b)| a - b).collect();
         let [l2, h1_semi, max_nodal] = p1_norms(mesh, &diff);
-        rows.push(SweepRow {
+        rows.push(RigidLimitRow {
             h,
             max_nodal,
             h1_semi,
@@ -599,7 +599,7 @@ pub fn rigid_limit_sweep(
             solve_seconds,
         });
     }
-    Ok(Sweep {
+    Ok(RigidLimit {
         rows,
         rigid_u,
         rigid_contact,

@@ -12,6 +12,7 @@
 
 mod manifest;
 mod result;
+mod study;
 mod sweep;
 #[cfg(test)]
 mod tests;
@@ -20,5 +21,9 @@ pub use manifest::{write_manifest, Manifest, MANIFEST};
 pub use result::{
     file_record, input_hash, new_run_id, write_fields, write_files, write_result_set, WriteOptions,
     LOWER_FIELDS, NODAL_FIELDS,
+};
+pub use study::{
+    convergence_columns, h_sweep_columns, write_study, write_study_csv, StudyColumn,
+    CONVERGENCE_COLUMNS, H_SWEEP_COLUMNS,
 };
 pub use sweep::{step_label, write_sweep_csv, SweepSet};
