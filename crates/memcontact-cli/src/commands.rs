@@ -33,7 +33,8 @@ pub struct SolveFlags<'a> {
 /// `memcontact solve`.
 pub fn solve(case_path: &Path, flags: &SolveFlags) -> Result<()> {
     let started = Instant::now();
-    let case = Case::load(case_path, flags.sets)?;
+    let mut case = Case::load(case_path, flags.sets)?;
+    case.settings.cancel = crate::signals::token();
     let label = case_path.display().to_string();
     let mut progress = Progress::new(flags.verbosity);
     if case.is_sweep() {

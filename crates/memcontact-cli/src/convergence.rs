@@ -72,7 +72,8 @@ pub struct Args {
 
 /// `memcontact convergence`.
 pub fn run(args: &Args) -> Result<()> {
-    let case = Case::load(&args.case, &args.sets)?;
+    let mut case = Case::load(&args.case, &args.sets)?;
+    case.settings.cancel = crate::signals::token();
     let label = args.case.display().to_string();
     let file_name = args
         .case

@@ -9,6 +9,7 @@ mod help;
 mod output;
 mod plot_cmd;
 mod progress;
+mod signals;
 
 use clap::{Parser, Subcommand};
 use std::path::PathBuf;
@@ -155,14 +156,12 @@ fn main() -> ExitCode {
     small_pages_only();
     let cli = Cli::parse();
     if let Some(n) = cli.threads {
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(n)
-            .build_global();
-        if n == 0 || pool.is_err() {
+        if memcontact::parallel::set_threads(n).is_err() {
             eprintln!("error: --threads must be at least 1, got {n}");
             return ExitCode::FAILURE;
         }
     }
+    signals::install();
     // The whole command runs on a worker thread of the pool (see memcontact::on_workers).
     let result = memcontact::on_workers(|| match cli.command {
         Command::Solve {
@@ -214,6 +213,17 @@ fn main() -> ExitCode {
     });
     match result {
         Ok(()) => ExitCode::SUCCESS,
+        Err(e)
+            if e.chain().any(|c| {
+                matches!(
+                    c.downcast_ref::<memcontact::Error>(),
+                    Some(memcontact::Error::Cancelled)
+                )
+            }) =>
+        {
+            eprintln!("interrupted: nothing was written (an earlier result stays as it was)");
+            ExitCode::from(130)
+        }
         Err(e) => {
             eprintln!("error: {e}");
             for cause in e.chain().skip(1) {

@@ -144,9 +144,8 @@ impl PyCase {
     #[staticmethod]
     #[pyo3(signature = (path, overrides=Vec::new()))]
     fn load(py: Python<'_>, path: PathBuf, overrides: Vec<String>) -> PyResult<PyCase> {
-        let case = py
-            .detach(|| Case::load(&path, &overrides))
-            .map_err(py_err)?;
+        let case =
+            crate::convert::detached(py, || Case::load(&path, &overrides)).map_err(py_err)?;
         Ok(PyCase {
             case,
             label: path.display().to_string(),

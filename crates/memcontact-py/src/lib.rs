@@ -10,7 +10,7 @@ mod study;
 mod sweep;
 
 use case::PyCase;
-use convert::py_err;
+use convert::interruptible;
 use memcontact::solve::Silent;
 use mesh::PyMesh;
 use pyo3::exceptions::PyValueError;
@@ -42,18 +42,17 @@ fn refuse_sweep(case: &memcontact::Case) -> PyResult<()> {
 #[pyfunction]
 fn solve(py: Python<'_>, case: PyRef<'_, PyCase>) -> PyResult<PyResult_> {
     refuse_sweep(&case.case)?;
-    let c = case.case.clone();
+    let mut c = case.case.clone();
     let label = case.label.clone();
     drop(case);
-    py.detach(move || {
-        memcontact::on_workers(move || {
-            let started = Instant::now();
-            let outcome = memcontact::run(&c, &mut Silent)?;
-            let mesh = PyMesh::new_from(outcome.discretization.user_hierarchy());
-            Ok(PyResult_::new(label, c, mesh, outcome, started))
-        })
+    let cancel = memcontact::Cancel::new();
+    c.settings.cancel = cancel.clone();
+    interruptible(py, &cancel, move || {
+        let started = Instant::now();
+        let outcome = memcontact::run(&c, &mut Silent)?;
+        let mesh = PyMesh::new_from(outcome.discretization.user_hierarchy());
+        Ok(PyResult_::new(label, c, mesh, outcome, started))
     })
-    .map_err(py_err)
 }
 
 /// Solves the case a dict describes (the sections of a case file but `mesh`) on `mesh`,
@@ -70,17 +69,16 @@ fn solve_on(
     label: Option<String>,
 ) -> PyResult<PyResult_> {
     let mesh = mesh.clone();
-    let c = case::case_on_mesh(data, &mesh.hierarchy)?;
+    let mut c = case::case_on_mesh(data, &mesh.hierarchy)?;
     refuse_sweep(&c)?;
     let label = label.unwrap_or_else(|| "mesh".into());
-    py.detach(move || {
-        memcontact::on_workers(move || {
-            let started = Instant::now();
-            let outcome = memcontact::run(&c, &mut Silent)?;
-            Ok(PyResult_::new(label, c, mesh, outcome, started))
-        })
+    let cancel = memcontact::Cancel::new();
+    c.settings.cancel = cancel.clone();
+    interruptible(py, &cancel, move || {
+        let started = Instant::now();
+        let outcome = memcontact::run(&c, &mut Silent)?;
+        Ok(PyResult_::new(label, c, mesh, outcome, started))
     })
-    .map_err(py_err)
 }
 
 /// The native module.

@@ -389,27 +389,26 @@ impl PyResult_ {
         pictures: bool,
     ) -> PyResult<Bound<'py, PyAny>> {
         let vtu = vtu_format(vtu, &self.data.case)?;
-        let summary = py
-            .detach(|| {
-                let outcome = self.outcome()?;
-                let mut plots = plot_options(&self.data.case, &self.data.label);
-                if !pictures {
-                    plots.plots.clear();
-                }
-                let now = Instant::now();
-                let options = WriteOptions {
-                    label: self.data.label.clone(),
-                    vtu,
-                    force,
-                    started: now
-                        .checked_sub(Duration::from_secs_f64(self.data.seconds))
-                        .unwrap_or(now),
-                    plot_options: None,
-                    run_id: None,
-                };
-                write_result(&directory, &outcome, &self.data.case, &options, &plots)
-            })
-            .map_err(py_err)?;
+        let summary = crate::convert::detached(py, || {
+            let outcome = self.outcome()?;
+            let mut plots = plot_options(&self.data.case, &self.data.label);
+            if !pictures {
+                plots.plots.clear();
+            }
+            let now = Instant::now();
+            let options = WriteOptions {
+                label: self.data.label.clone(),
+                vtu,
+                force,
+                started: now
+                    .checked_sub(Duration::from_secs_f64(self.data.seconds))
+                    .unwrap_or(now),
+                plot_options: None,
+                run_id: None,
+            };
+            write_result(&directory, &outcome, &self.data.case, &options, &plots)
+        })
+        .map_err(py_err)?;
         to_py(py, &summary)
     }
 

@@ -78,13 +78,13 @@ pub fn convergence(
         compare,
         h_sweep: h_sweep.then(|| h_values.unwrap_or_default()),
     };
-    let (c, label) = (case.case.clone(), case.label.clone());
+    let (mut c, label) = (case.case.clone(), case.label.clone());
     drop(case);
-    let outcome = py
-        .detach(|| {
-            memcontact::on_workers(|| run_study(&c, &options, &mut |_, _| {}, &mut |_, _| {}))
-        })
-        .map_err(py_err)?;
+    let cancel = memcontact::Cancel::new();
+    c.settings.cancel = cancel.clone();
+    let outcome = crate::convert::interruptible(py, &cancel, || {
+        run_study(&c, &options, &mut |_, _| {}, &mut |_, _| {})
+    })?;
     Ok(PyStudy {
         case: c,
         label,
@@ -158,7 +158,7 @@ impl PyStudy {
             .file_name()
             .map(|n| n.to_string_lossy().into_owned())
             .unwrap_or_else(|| self.label.clone());
-        py.detach(|| {
+        crate::convert::detached(py, || {
             write_study(&directory, force, &self.case, &self.outcome, &mut |dir| {
                 if pictures {
                     memcontact_plot::write::study_pictures(dir, &self.outcome, &file_name)

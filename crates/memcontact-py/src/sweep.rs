@@ -77,17 +77,15 @@ fn solve_steps(case: &Case, label: &str, warm: bool) -> memcontact::Result<Solve
 #[pyfunction]
 #[pyo3(signature = (case, warm=true))]
 pub fn sweep(py: Python<'_>, case: PyRef<'_, PyCase>, warm: bool) -> PyResult<PySweep> {
-    let c = case.case.clone();
+    let mut c = case.case.clone();
     let label = case.label.clone();
     drop(case);
-    let (solved, c, label) = py
-        .detach(move || {
-            memcontact::on_workers(move || -> memcontact::Result<_> {
-                let solved = solve_steps(&c, &label, warm)?;
-                Ok((solved, c, label))
-            })
-        })
-        .map_err(py_err)?;
+    let cancel = memcontact::Cancel::new();
+    c.settings.cancel = cancel.clone();
+    let (solved, c, label) = crate::convert::interruptible(py, &cancel, move || {
+        let solved = solve_steps(&c, &label, warm)?;
+        Ok((solved, c, label))
+    })?;
     let results = solved
         .results
         .into_iter()
@@ -196,20 +194,19 @@ impl PySweep {
         pictures: bool,
     ) -> PyResult<Bound<'py, PyAny>> {
         let vtu = vtu_format(vtu, &self.case)?;
-        let summaries = py
-            .detach(|| -> memcontact::Result<_> {
-                let mut writer =
-                    SweepWriter::begin(&directory, force, &self.case, &self.label, vtu, pictures)?;
-                let mut summaries = Vec::with_capacity(self.results.len());
-                for (result, row) in self.results.iter().zip(&self.rows) {
-                    let outcome = result.get().outcome()?;
-                    let step = &self.steps[row.step];
-                    summaries.push(writer.write_step(&self.case, step, &outcome, row.seconds)?);
-                }
-                writer.finish(&self.rows)?;
-                Ok(summaries)
-            })
-            .map_err(py_err)?;
+        let summaries = crate::convert::detached(py, || -> memcontact::Result<_> {
+            let mut writer =
+                SweepWriter::begin(&directory, force, &self.case, &self.label, vtu, pictures)?;
+            let mut summaries = Vec::with_capacity(self.results.len());
+            for (result, row) in self.results.iter().zip(&self.rows) {
+                let outcome = result.get().outcome()?;
+                let step = &self.steps[row.step];
+                summaries.push(writer.write_step(&self.case, step, &outcome, row.seconds)?);
+            }
+            writer.finish(&self.rows)?;
+            Ok(summaries)
+        })
+        .map_err(py_err)?;
         to_py(py, &summaries)
     }
 

@@ -48,6 +48,9 @@ pub enum Error {
         /// What is wrong.
         message: String,
     },
+    /// The run was asked to stop ([`crate::parallel::Cancel`]): Ctrl-C, or its caller.
+    #[error("interrupted")]
+    Cancelled,
     /// An error with what was being done when it happened (shown as its cause).
     #[error("{context}")]
     Context {

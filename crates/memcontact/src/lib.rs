@@ -30,7 +30,7 @@ pub use case::Case;
 pub use discretization::Discretization;
 pub use error::{Error, Invalid, Result};
 pub use outcome::{Outcome, Report, Summary};
-pub use parallel::on_workers;
+pub use parallel::{on_workers, Cancel};
 pub use problem::Problem;
 pub use run::run;
 pub use solve::{Method, Observer, Settings, Status};

@@ -45,6 +45,9 @@ impl Discretization {
         let (hierarchy, warnings) = build_mesh(&problem.mesh)?;
         let t_mesh = t0.elapsed().as_secs_f64();
         observer.phase_finished("mesh", t_mesh);
+        if observer.cancelled() {
+            return Err(crate::error::Error::Cancelled);
+        }
         let mut d = Discretization::assemble(problem, hierarchy, observer)?;
         d.warnings = warnings;
         d.phases.insert(
@@ -71,6 +74,9 @@ impl Discretization {
         let (hierarchy, _) = hierarchy.reordered();
         let t_reorder = t0.elapsed().as_secs_f64();
         observer.phase_finished("reorder", t_reorder);
+        if observer.cancelled() {
+            return Err(crate::error::Error::Cancelled);
+        }
         observer.phase_started("assembly");
         let t0 = Instant::now();
         let mesh = hierarchy.finest();

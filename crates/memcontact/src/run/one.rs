@@ -123,7 +123,12 @@ pub fn run(case: &Case, observer: &mut dyn Observer) -> Result<Outcome> {
         });
     }
     case.validate().map_err(Invalid::into_error)?;
+    let observer = &mut solve::Cancellable {
+        inner: observer,
+        cancel: &case.settings.cancel,
+    };
     let discretization = Discretization::new(&case.problem, observer)?;
+    case.settings.cancel.check()?;
     check_case_on_mesh(case, discretization.mesh(), false)?;
     let report = discretization.solve(&case.settings, observer)?;
     Ok(Outcome {
@@ -140,7 +145,12 @@ pub fn run_problem(
     observer: &mut dyn Observer,
 ) -> Result<Outcome> {
     settings.validate().map_err(Invalid::into_error)?;
+    let observer = &mut solve::Cancellable {
+        inner: observer,
+        cancel: &settings.cancel,
+    };
     let discretization = Discretization::new(problem, observer)?;
+    settings.cancel.check()?;
     let report = discretization.solve(settings, observer)?;
     Ok(Outcome {
         discretization,

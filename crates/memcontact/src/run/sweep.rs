@@ -153,6 +153,10 @@ pub fn run_sweep(
     on_step: &mut dyn FnMut(&StepSpec, &Outcome, &StepRow) -> Result<()>,
 ) -> Result<SweepRun> {
     case.validate().map_err(crate::error::Invalid::into_error)?;
+    let observer = &mut crate::solve::Cancellable {
+        inner: observer,
+        cancel: &case.settings.cancel,
+    };
     let base = Discretization::new(&case.problem, observer)?;
     run_sweep_on(case, base, warm, observer, on_step)
 }
@@ -181,6 +185,7 @@ pub fn run_sweep_on(
     let mut start: Option<Vec<f64>> = None;
     let mut rows = Vec::with_capacity(steps.len());
     for step in &steps {
+        case.settings.cancel.check()?;
         observer.step_started(step.index, steps.len(), &step.name);
         let t0 = Instant::now();
         current.model = step_model(case, step, &base_model, current.mesh(), observer)?;

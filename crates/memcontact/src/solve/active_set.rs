@@ -131,6 +131,7 @@ pub fn solve(
         certificate = ev.certificate;
         let record = IterationRecord::new(iterations, &ev);
         observer.iteration(&record);
+        settings.cancel.check()?;
         history.push(record);
         if v == before {
             stalled += 1;

@@ -43,6 +43,7 @@ pub fn solve_from(
         certificate = ev.certificate;
         let record = IterationRecord::new(sweeps, &ev);
         observer.iteration(&record);
+        settings.cancel.check()?;
         history.push(record);
         if certificate.settled(settings.tolerance) || watch.stuck(&certificate) {
             break;

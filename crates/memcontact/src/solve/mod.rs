@@ -100,6 +100,10 @@ pub struct Settings {
     pub accept_rounding_floor: bool,
     /// The coarse levels of the multigrid method.
     pub hierarchy: HierarchyChoice,
+    /// Stops the solve when cancelled (checked every iteration and inside the multigrid
+    /// iteration; not part of a case file).
+    #[serde(skip)]
+    pub cancel: crate::parallel::Cancel,
 }
 
 /// Which coarse levels the multigrid method uses.
@@ -154,6 +158,7 @@ impl Default for Settings {
             max_iterations: None,
             accept_rounding_floor: true,
             hierarchy: HierarchyChoice::Auto,
+            cancel: crate::parallel::Cancel::default(),
         }
     }
 }
@@ -202,6 +207,37 @@ pub trait Observer {
     fn phase_finished(&mut self, _name: &str, _seconds: f64) {}
     /// Step `index` (0-based) of `total` of a sweep starts.
     fn step_started(&mut self, _index: usize, _total: usize, _name: &str) {}
+    /// Whether the run should stop (asked between the phases of a run).
+    fn cancelled(&self) -> bool {
+        false
+    }
+}
+
+/// An observer that also answers [`Observer::cancelled`] from a token (the runs wrap the
+/// caller's observer with their settings' token).
+pub struct Cancellable<'a> {
+    /// The caller's observer.
+    pub inner: &'a mut dyn Observer,
+    /// The token.
+    pub cancel: &'a crate::parallel::Cancel,
+}
+
+impl Observer for Cancellable<'_> {
+    fn iteration(&mut self, record: &IterationRecord) {
+        self.inner.iteration(record)
+    }
+    fn phase_started(&mut self, name: &str) {
+        self.inner.phase_started(name)
+    }
+    fn phase_finished(&mut self, name: &str, seconds: f64) {
+        self.inner.phase_finished(name, seconds)
+    }
+    fn step_started(&mut self, index: usize, total: usize, name: &str) {
+        self.inner.step_started(index, total, name)
+    }
+    fn cancelled(&self) -> bool {
+        self.cancel.is_cancelled() || self.inner.cancelled()
+    }
 }
 
 /// An observer that ignores everything.

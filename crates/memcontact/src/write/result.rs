@@ -233,6 +233,7 @@ pub fn write_files(
         || input_hash(case),
     );
     let written = written?;
+    case.settings.cancel.check()?;
     let names = extra(dir, &fields)?;
     let mut summary = Summary::new(
         &options.label,
@@ -271,6 +272,8 @@ pub fn write_result_set(
 ) -> Result<Summary> {
     let set = ResultSet::begin(target, options.force)?;
     let summary = write_files(set.dir(), outcome, case, options, extra)?;
+    // Stopped while writing: the staging directory goes, the previous result stays.
+    case.settings.cancel.check()?;
     set.commit()?;
     Ok(summary)
 }

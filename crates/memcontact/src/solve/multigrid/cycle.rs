@@ -51,6 +51,8 @@ pub struct Multigrid<'a> {
     /// Work vectors of the K-cycle's Krylov steps per level (`[v1, w1, w2]`; empty on
     /// geometric hierarchies, which use the V-cycle).
     krylov: Vec<[Vec<f64>; 3]>,
+    /// Ends [`Multigrid::fcg`] early when cancelled (the caller then stops).
+    pub cancel: crate::parallel::Cancel,
 }
 
 impl<'a> Multigrid<'a> {
@@ -81,6 +83,7 @@ impl<'a> Multigrid<'a> {
                     }
                 })
                 .collect(),
+            cancel: crate::parallel::Cancel::default(),
         }
     }
 
@@ -118,7 +121,7 @@ impl<'a> Multigrid<'a> {
                 z[i]
             }
         };
-        while steps < max_steps {
+        while steps < max_steps && !self.cancel.is_cancelled() {
             let known = self.cycle_from_zero_with_product(a, z, r, Some(az));
             let (z, az): (&[f64], &[f64]) = (z, az);
             // zᵀ A p of the previous direction, and whether z is finite: the held rows'

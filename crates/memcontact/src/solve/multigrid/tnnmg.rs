@@ -265,6 +265,7 @@ pub fn solve_with(
             timer: level_timer,
             confirm: k == top,
             check_start: k == first,
+            cancel: &settings.cancel,
         })?;
         let seconds = t0.elapsed().as_secs_f64();
         final_certificate = out.2;
@@ -435,6 +436,8 @@ pub(super) struct LevelSolve<'a, 'b> {
     /// is not checked (its residual is that of the coarser mesh, far above any tolerance):
     /// the first iteration begins at once, without a certificate pass.
     check_start: bool,
+    /// Stops the iteration when cancelled.
+    cancel: &'a crate::parallel::Cancel,
 }
 
 /// TNNMG on one level; returns the iterations, the scaled KKT residual reached and, when
@@ -453,11 +456,13 @@ pub(super) fn level_solve(ls: LevelSolve) -> Result<(usize, f64, Option<Certific
         timer,
         confirm,
         check_start,
+        cancel,
     } = ls;
     let n = model.n();
     let pattern = model.s.pattern.clone();
     let mut a = NewtonMatrix::for_model(model);
     let mut mg = Multigrid::new(levels, top);
+    mg.cancel = cancel.clone();
     mg.smoothing = options.smoothing;
     let mut delta = zeroed(n);
     let mut g = zeroed(n);
@@ -474,6 +479,7 @@ pub(super) fn level_solve(ls: LevelSolve) -> Result<(usize, f64, Option<Certific
     let mut skip_check = !check_start && max_iterations > 0;
     let mut kkt = f64::INFINITY;
     loop {
+        cancel.check()?;
         if !std::mem::take(&mut skip_check) {
             let ev = timer.time("certificate", || crate::certificate::evaluate(model, v));
             scale = ev.certificate.force_scale;
