@@ -3,6 +3,25 @@
 //! Contact between a stretched membrane and an elastic (tensionless Winkler) obstacle,
 //! discretised exactly as in A. Maceri & F. Maceri, "Analysis of a discrete model for the
 //! contact problem between a membrane and an elastic obstacle", Rend. Lincei 80 (1986).
+//!
+//! The library owns the run; data flows one way, each layer importing only those below it:
+//!
+//! ```text
+//! case ──► problem ──► discretization ──► model ──► certificate, solve ──► outcome ──► write
+//! (TOML,    (pure       (meshes, levels,     (S, L, D,   (2e/2f; every       (fields,    (VTU, CSV,
+//!  sweeps,   data,       numbering, data      φₙ, M,      formulation of      totals,     JSON: result
+//!  output)   validate)   bound to the mesh)   checks)     the paper)          summary)    sets)
+//! ```
+//!
+//! - [`mod@run`] holds the only places that run: [`run::run`] (a case of one step),
+//!   [`run::run_sweep`] (its load steps or load cases in turn), and, beside the pipeline,
+//!   [`verify::study::run_study`] (a convergence study with the exact solutions of
+//!   [`verify::exact`] and the norms of [`verify::norms`]). The command-line tool and the
+//!   Python module call these and the writers of [`mod@write`]; they run nothing themselves.
+//! - Below the pipeline: [`mesh`] (meshes, generators, refinement, renumbering), [`field`]
+//!   (the data f, φ, h and their expressions), [`fem`] (P1 elements), [`io`] (Gmsh, VTU,
+//!   CSV, JSON, atomic result sets), [`sparse`], [`quadrature`], [`limits`] (memory),
+//!   [`parallel`] (the worker pool and the cancellation token), [`error`].
 
 pub mod case;
 pub mod certificate;

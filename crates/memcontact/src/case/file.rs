@@ -99,7 +99,7 @@ impl From<Case> for CaseFile {
 
 impl Case {
     /// Whether the case has steps to solve in turn (a `[sweep]` or `[[load_case]]`
-    /// entries): then it is run by [`crate::run::run_sweep`], not [`crate::run`].
+    /// entries): then it is run by [`crate::run::run_sweep`], not [`crate::run::run`].
     pub fn is_sweep(&self) -> bool {
         self.sweep.is_some() || !self.load_cases.is_empty()
     }
@@ -172,7 +172,7 @@ impl Case {
         Ok(case)
     }
 
-    /// Reads a case file (a regular file of at most [`CASE_FILE_CAP`] bytes), applies
+    /// Reads a case file (a regular file of at most [`crate::io::input::CASE_FILE_CAP`] bytes), applies
     /// `key=value` overrides (dotted keys, TOML values; a value that is not TOML is taken
     /// as a string) and parses it; relative paths are relative to the case file.
     pub fn load(path: &Path, overrides: &[String]) -> Result<Case> {
@@ -192,7 +192,7 @@ impl Case {
     }
 }
 
-/// Reads a case file: a regular file, at most [`CASE_FILE_CAP`] bytes, UTF-8.
+/// Reads a case file: a regular file, at most [`crate::io::input::CASE_FILE_CAP`] bytes, UTF-8.
 fn read_case_text(path: &Path) -> Result<String> {
     let bytes = crate::io::input::read_input(path, crate::io::input::CASE_FILE)?;
     String::from_utf8(bytes).map_err(|e| Error::File {

@@ -41,7 +41,7 @@ impl Field {
         Field::Constant(value)
     }
 
-    /// Parses a number or an expression of `x, y` (see [`crate::expr`]); an expression that
+    /// Parses a number or an expression of `x, y` (see [`crate::field::expr`]); an expression that
     /// does not depend on the position becomes a [`Field::Constant`] (`"2*pi"`, `"-3"`).
     pub fn parse(text: &str) -> Result<Field> {
         let e = Expr::parse(text)?;

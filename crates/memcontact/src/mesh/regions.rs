@@ -12,7 +12,7 @@ pub const DEFAULT: &str = "default";
 /// than tag 0 named `"default"` (the key of every other region's value), an empty name, or
 /// a number
 /// that is another region's tag (its key would be ambiguous, and is refused by
-/// [`Field::bind`]). `tags` are the region tags of the mesh (repetitions are fine).
+/// [`crate::field::Field::bind`]). `tags` are the region tags of the mesh (repetitions are fine).
 pub fn region_name_warnings(names: &BTreeMap<u32, String>, tags: &[u32]) -> Vec<String> {
     let mut warnings = Vec::new();
     let mut present = tags.to_vec();

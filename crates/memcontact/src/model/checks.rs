@@ -27,7 +27,7 @@ pub fn assemble_checked(mesh: &Mesh, data: &ProblemData, ext: &Extensions) -> Re
     assemble_checked_on(mesh, &adj, &boundary, data, ext)
 }
 
-/// [`assemble`] given the mesh's vertex → triangles adjacency and its boundary vertices.
+/// [`assemble_checked`] given the mesh's vertex → triangles adjacency and its boundary vertices.
 pub fn assemble_checked_on(
     mesh: &Mesh,
     adj: &VertexTriangles,
@@ -203,8 +203,8 @@ fn matrix_finite(l: &FoundationMatrix) -> bool {
     }
 }
 
-/// What overflowed, in terms of the data, for the messages of [`check_solution`] and
-/// [`check_results`].
+/// What overflowed, in terms of the data, for the messages of [`crate::outcome::checks::check_solution`] and
+/// [`crate::outcome::checks::check_results`].
 pub const OVERFLOW_HINT: &str = "the data's scales (tension t, load f, stiffness h, shape φ, \
                              mesh size) overflow double precision; rescale the problem \
                              (units)";

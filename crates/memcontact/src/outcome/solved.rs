@@ -9,7 +9,7 @@ use crate::mesh::Mesh;
 use crate::solve::Status;
 use std::borrow::Cow;
 
-/// What [`run`] produced: the discretisation and the report with the iterate.
+/// What [`crate::run::run`] produced: the discretisation and the report with the iterate.
 #[derive(Debug, Clone)]
 pub struct Outcome {
     /// Mesh levels and model.

@@ -35,9 +35,13 @@ pub fn solve_from(
         let todo = check_every.min(max - sweeps);
         timer.time("sweeps", || {
             for _ in 0..todo {
+                if settings.cancel.is_cancelled() {
+                    break;
+                }
                 sweep_forward(model, &mut v);
             }
         });
+        settings.cancel.check()?;
         sweeps += todo;
         let ev = timer.time("certificate", || crate::certificate::evaluate(model, &v));
         certificate = ev.certificate;

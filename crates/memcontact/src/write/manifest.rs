@@ -16,7 +16,7 @@ pub struct Manifest {
     pub kind: String,
     /// The run id shared by the set's files.
     pub run_id: String,
-    /// The hash of the case ([`input_hash`]).
+    /// The hash of the case ([`super::input_hash`]).
     pub input_hash: String,
     /// Every other file of the set, by relative path (`/`-separated).
     pub files: std::collections::BTreeMap<String, FileRecord>,

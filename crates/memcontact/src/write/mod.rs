@@ -1,6 +1,6 @@
 //! The result files of a run, written as one atomic result set ([`crate::io::result_set::ResultSet`]):
 //! `solution.vtu` (ParaView), `nodes.csv` (one row per vertex), any extra files of the
-//! caller (pictures), and `summary.json` (the [`Summary`], with the run id, the input's hash
+//! caller (pictures), and `summary.json` (the [`crate::outcome::Summary`], with the run id, the input's hash
 //! and the size and hash of every other file, so a mixed directory is detectable). A sweep
 //! or a set of load cases is one [`SweepSet`]: a directory per step and `sweep.csv`.
 //!

@@ -85,7 +85,7 @@ pub(super) fn disk_estimate(center: Point, radius: f64, size: f64) -> Result<f64
     Ok(estimate)
 }
 
-/// The disc of [`disk`] as a hierarchy: with more than [`DELAUNAY_TRIANGLES`] triangles
+/// The disc of [`disk`] as a hierarchy: with more than [`super::DELAUNAY_TRIANGLES`] triangles
 /// expected, the disc meshed at `size · 2ᵏ` and refined uniformly `k` times (new boundary
 /// vertices on the circle), so that the finest level has element size about `size` and the
 /// coarse mesh's angles; otherwise the single mesh of [`disk`].

@@ -9,7 +9,7 @@ use crate::mesh::{Mesh, Point};
 use spade::Triangulation;
 use std::collections::BTreeMap;
 
-/// The polygon of [`polygon`] as a hierarchy: with more than [`DELAUNAY_TRIANGLES`]
+/// The polygon of [`polygon`] as a hierarchy: with more than [`super::DELAUNAY_TRIANGLES`]
 /// triangles expected, meshed at `size · 2ᵏ` and refined uniformly `k` times (regions and
 /// boundary regions inherited), so that the finest level has element size about `size` and
 /// the coarse mesh's angles (at least `min_angle`); otherwise the single mesh of

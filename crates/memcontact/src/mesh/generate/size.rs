@@ -1,17 +1,17 @@
 //! How many triangles the generators agree to build, and how a fine unstructured mesh is
 //! made coarse and refined uniformly.
 
-/// The largest number of triangles the unstructured generators ([`disk`], [`polygon`])
+/// The largest number of triangles the unstructured generators ([`super::disk`], [`super::polygon`])
 /// agree to build: Delaunay refinement of 10⁷ triangles takes minutes and GiBs.
 pub const MAX_TRIANGLES: f64 = 1e7;
 
-/// The largest number of triangles [`rectangle`] agrees to build (its finest level; all
+/// The largest number of triangles [`super::rectangle`] agrees to build (its finest level; all
 /// levels together take about 40 bytes per finest triangle).
 pub const MAX_STRUCTURED_TRIANGLES: f64 = 1.5e8;
 
 /// The unstructured generators make at most about this many triangles by Delaunay
-/// refinement: a finer mesh is made coarse and refined uniformly ([`disk_levels`],
-/// [`polygon_levels`]), which is many times faster than Delaunay refinement, keeps every
+/// refinement: a finer mesh is made coarse and refined uniformly ([`super::disk_levels`],
+/// [`super::polygon_levels`]), which is many times faster than Delaunay refinement, keeps every
 /// angle of the coarse mesh and gives multigrid its levels.
 pub const DELAUNAY_TRIANGLES: f64 = 1.5e5;
 

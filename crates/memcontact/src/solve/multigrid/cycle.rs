@@ -1,9 +1,9 @@
-//! Linear geometric multigrid on a [`Hierarchy`]: the V-cycle that computes the truncated
+//! Linear geometric multigrid on a [`crate::mesh::refine::Hierarchy`]: the V-cycle that computes the truncated
 //! Newton correction of TNNMG, and, on the untruncated stiffness matrix S, the linear
 //! Poisson solve used as the benchmark's yardstick.
 //!
 //! * Levels: the unknowns (interior vertices) of every mesh of the hierarchy that has
-//!   any; prolongations [`Transfer`] between consecutive ones.
+//!   any; prolongations [`super::transfer::Transfer`] between consecutive ones.
 //! * Operators: the finest one is given by the caller (S, or the truncated Hessian of
 //!   TNNMG, whose truncated rows and columns are zero, assembled or read from S with a
 //!   diagonal shift: [`super::operator`]); the coarser ones are the Galerkin

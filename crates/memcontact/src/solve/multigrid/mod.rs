@@ -9,7 +9,7 @@
 //!    (SPEC §3: coordinatewise optimality is global optimality, even with the consistent
 //!    L), and it puts vertices exactly on φ_i where their local minimum is the kink;
 //! 2. the **truncated Newton system** of the smooth piece of J selected by the vertex
-//!    states at the smoothed iterate ([`NewtonStates`]): `(S + E_P L E_P) δ = −∇J` with the
+//!    states at the smoothed iterate ([`crate::solve::newton::NewtonStates`]): `(S + E_P L E_P) δ = −∇J` with the
 //!    touching vertices (`V_i = φ_i`) truncated (their rows and columns zero, δ_i = 0),
 //!    solved *approximately* by one linear multigrid V-cycle ([`cycle`]) on the truncated
 //!    hierarchy: Galerkin coarse operators `PᵀAP` of the truncated matrix, recomputed every

@@ -1,4 +1,4 @@
-//! Grid transfer between consecutive levels of a [`Hierarchy`], over the *unknowns* (the
+//! Grid transfer between consecutive levels of a [`crate::mesh::refine::Hierarchy`], over the *unknowns* (the
 //! interior vertices, SPEC §2), and the Galerkin coarse operator `A_c = Pᵀ A P`.
 //!
 //! The mesh refinement says that fine vertex `v` carries `½(c[a] + c[b])` of a coarse P1

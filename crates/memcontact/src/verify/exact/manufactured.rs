@@ -11,7 +11,7 @@ pub(super) enum Shape {
 }
 
 /// Manufactured solutions (SPEC §4): smooth functions vanishing on ∂Ω, with exact gradient
-/// and Laplacian. The caller sets `f = -t Δu + h (u - φ)⁺` (see [`manufactured_load`]).
+/// and Laplacian. The caller sets `f = -t Δu + h (u - φ)⁺` (see [`super::manufactured_load`]).
 #[derive(Debug, Clone, Copy)]
 pub struct Manufactured {
     pub(super) shape: Shape,

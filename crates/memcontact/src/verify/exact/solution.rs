@@ -12,7 +12,7 @@ pub trait ExactSolution: Send + Sync {
     fn value(&self, p: [f64; 2]) -> f64;
     /// The gradient `∇u(p)`.
     fn gradient(&self, p: [f64; 2]) -> [f64; 2];
-    /// The Laplacian `Δu(p)` (a.e.: on the contact circle of a [`DiskSolution`], where
+    /// The Laplacian `Δu(p)` (a.e.: on the contact circle of a [`super::DiskSolution`], where
     /// `Δu` jumps, either one-sided value).
     fn laplacian(&self, p: [f64; 2]) -> f64;
     /// The radius of the contact disc (the set where the obstacle reacts), when the
