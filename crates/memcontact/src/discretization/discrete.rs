@@ -82,6 +82,9 @@ impl Discretization {
         let mesh = hierarchy.finest();
         // The adjacency and the boundary serve the checks, assembly and the quality report.
         let (adj, boundary) = mesh.patches();
+        if observer.cancelled() {
+            return Err(crate::error::Error::Cancelled);
+        }
         let bound = BoundData::new(problem, mesh)?;
         let data = bound.data(problem);
         let model = crate::model::assemble_checked_on(
