@@ -1,5 +1,5 @@
 //! `cargo bench -p memcontact-cli --bench tnnmg [-- N1 N2 ...] [-- --lumped|--consistent]`:
-//! the standard benchmark table of `memcontact bench` (see `memcontact::bench`). Sizes default to
+//! the standard benchmark table of `memcontact bench` (see `memcontact_cli::bench::standard`). Sizes default to
 //! 128 … 2048 cells per side. Environment: `MEMCONTACT_PHASES=1` prints the phases,
 //! `MEMCONTACT_NESTED_TOL`, `MEMCONTACT_CYCLES`, `MEMCONTACT_SMOOTHING`,
 //! `MEMCONTACT_NO_NESTED` override the TNNMG options.

@@ -1,7 +1,7 @@
 //! The `solve` and `check` commands: thin shells over the library's run.
 
-use crate::output;
 use crate::progress::{Progress, Verbosity};
+use crate::report;
 use anyhow::{bail, Result};
 use memcontact::write::WriteOptions;
 use memcontact::{Case, Discretization, Outcome};
@@ -46,12 +46,12 @@ pub fn solve(case_path: &Path, flags: &SolveFlags) -> Result<()> {
     print_warnings(&outcome.discretization);
     let accepted = outcome.report.accepted;
     if !accepted && !flags.write_unconverged {
-        eprint!("{}", output::human(&label, &outcome, None));
+        eprint!("{}", report::human(&label, &outcome, None));
         bail!(
             "{}; no result files were written (pass --write-unconverged to keep the \
              iterate, marked as not accepted in summary.json){}",
             not_converged(&outcome),
-            output::floor_note(&outcome)
+            report::floor_note(&outcome)
                 .map(|n| format!("\n{n}"))
                 .unwrap_or_default()
         );
@@ -68,9 +68,9 @@ pub fn solve(case_path: &Path, flags: &SolveFlags) -> Result<()> {
     let summary = write::write_result(flags.out, &outcome, &case, &options, &plots)?;
     print!(
         "{}",
-        output::human(&options.label, &outcome, Some((&summary, flags.out)))
+        report::human(&options.label, &outcome, Some((&summary, flags.out)))
     );
-    if let Some(note) = output::floor_note(&outcome) {
+    if let Some(note) = report::floor_note(&outcome) {
         eprintln!("{note}");
     }
     if !accepted {
@@ -203,11 +203,11 @@ pub fn check(case_path: &Path, sets: &[String]) -> Result<()> {
     println!("case {}: valid", case_path.display());
     print!(
         "{}",
-        output::mesh_report(mesh, &d.quality, d.hierarchy.depth())
+        report::mesh_report(mesh, &d.quality, d.hierarchy.depth())
     );
     print!(
         "{}",
-        output::boundary_report(mesh, &case.problem.boundary.free)
+        report::boundary_report(mesh, &case.problem.boundary.free)
     );
     println!(
         "  obstacle     {} vertices can touch (M), foundation {}{}",

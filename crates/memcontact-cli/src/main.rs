@@ -6,9 +6,9 @@ mod commands;
 mod convergence;
 mod examples;
 mod help;
-mod output;
 mod plot_cmd;
 mod progress;
+mod report;
 mod signals;
 
 use clap::{Parser, Subcommand};
