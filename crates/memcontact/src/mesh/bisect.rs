@@ -403,7 +403,10 @@ fn children(t: [u32; 3], m: [u32; 3]) -> ([[u32; 3]; 4], usize) {
     let [m0, m1, m2] = m;
     let mut out = [[0u32; 3]; 4];
     if m0 == NONE {
-        debug_assert!(m1 == NONE && m2 == NONE, "a split edge without the refinement edge");
+        debug_assert!(
+            m1 == NONE && m2 == NONE,
+            "a split edge without the refinement edge"
+        );
         out[0] = t;
         return (out, 1);
     }
@@ -577,11 +580,13 @@ mod tests {
             .count();
         assert_eq!(fb.len(), cb.len() + new_on_boundary, "boundary edges");
         if !curved {
-            let length = |m: &Mesh, e: &[[u32; 2]]| -> f64 {
-                e.iter().map(|&e| len2(m, e).sqrt()).sum()
-            };
+            let length =
+                |m: &Mesh, e: &[[u32; 2]]| -> f64 { e.iter().map(|&e| len2(m, e).sqrt()).sum() };
             let (lc, lf) = (length(coarse, &cb), length(fine, &fb));
-            assert!((lc - lf).abs() <= 1e-12 * lc, "boundary length {lc} -> {lf}");
+            assert!(
+                (lc - lf).abs() <= 1e-12 * lc,
+                "boundary length {lc} -> {lf}"
+            );
             let (ac, af) = (coarse.total_area(), fine.total_area());
             assert!((ac - af).abs() <= 1e-12 * ac, "area {ac} -> {af}");
         }
@@ -688,7 +693,10 @@ mod tests {
             labelled.region_names.clone(),
         )
         .unwrap();
-        assert_eq!(again.triangles, labelled.triangles, "Mesh::new keeps the labels");
+        assert_eq!(
+            again.triangles, labelled.triangles,
+            "Mesh::new keeps the labels"
+        );
         for (k, (&t, &l)) in m.triangles.iter().zip(&labelled.triangles).enumerate() {
             let rotations = [t, [t[1], t[2], t[0]], [t[2], t[0], t[1]]];
             assert!(rotations.contains(&l), "triangle {k} only rotated");
@@ -722,7 +730,11 @@ mod tests {
             rect(3, 3, Diagonal::Left),
         ];
         for (i, start) in starts.into_iter().enumerate() {
-            let mut m = if i < 3 { label_longest_edge(&start) } else { start };
+            let mut m = if i < 3 {
+                label_longest_edge(&start)
+            } else {
+                start
+            };
             for step in 0..6 {
                 let marked = rng.mark(m.n_triangles(), 0.15);
                 let b = bisect(&m, &marked).unwrap();
@@ -733,11 +745,18 @@ mod tests {
                 for &p in &b.parent {
                     count[p as usize] += 1;
                 }
-                assert!(marked.iter().all(|&k| count[k as usize] >= 2), "step {step}");
+                assert!(
+                    marked.iter().all(|&k| count[k as usize] >= 2),
+                    "step {step}"
+                );
                 assert!(count.iter().all(|&c| (1..=4).contains(&c)));
+                // A kept triangle keeps its labels; a child has a new vertex as its newest.
                 for (k, &p) in b.parent.iter().enumerate() {
+                    let t = b.mesh.triangles[k];
                     if count[p as usize] == 1 {
-                        assert_eq!(b.mesh.triangles[k], m.triangles[p as usize]);
+                        assert_eq!(t, m.triangles[p as usize]);
+                    } else {
+                        assert!(t[2] as usize >= m.n_vertices(), "child {k}: {t:?}");
                     }
                 }
                 assert_eq!(b.new_vertices(), b.mesh.n_vertices() - m.n_vertices());
@@ -797,11 +816,7 @@ mod tests {
     #[test]
     fn refining_towards_the_reentrant_corner_keeps_the_shapes() {
         let start = label_longest_edge(&l_shape(0.35));
-        let corner = start
-            .points
-            .iter()
-            .position(|&p| p == [1.0, 1.0])
-            .unwrap() as u32;
+        let corner = start.points.iter().position(|&p| p == [1.0, 1.0]).unwrap() as u32;
         let (angle0, shapes0) = (min_angle(&start), shapes(&start));
         let classes = 4 * start.n_triangles();
         let mut m = start.clone();
@@ -813,7 +828,11 @@ mod tests {
             check_conforming(&m, &b, false, false);
             check_nested(&m, &b);
             m = b.mesh;
-            assert!(min_angle(&m) >= 0.5 * angle0, "step {step}: {}", min_angle(&m));
+            assert!(
+                min_angle(&m) >= 0.5 * angle0,
+                "step {step}: {}",
+                min_angle(&m)
+            );
             assert!(shapes(&m) <= classes, "step {step}: {} shapes", shapes(&m));
         }
         // The corner's triangles shrank by 2^-20 at least (each step bisects them).
@@ -826,7 +845,11 @@ mod tests {
             .fold(0.0, f64::max);
         assert!(at_corner <= largest * 0.5f64.powi(20), "{at_corner}");
         // Local: far fewer triangles than uniform refinement would make.
-        assert!(m.n_triangles() < 40 * start.n_triangles(), "{}", m.n_triangles());
+        assert!(
+            m.n_triangles() < 40 * start.n_triangles(),
+            "{}",
+            m.n_triangles()
+        );
         eprintln!(
             "L shape towards the corner: {} -> {} triangles, smallest angle {angle0:.2}° -> {:.2}°, \
              shapes {shapes0} -> {} (bound {classes})",
@@ -849,7 +872,11 @@ mod tests {
             let b = bisect(&m, &marked).unwrap();
             check_conforming(&m, &b, false, false);
             m = b.mesh;
-            assert!(min_angle(&m) >= 0.5 * angle0, "step {step}: {}", min_angle(&m));
+            assert!(
+                min_angle(&m) >= 0.5 * angle0,
+                "step {step}: {}",
+                min_angle(&m)
+            );
             assert!(shapes(&m) <= classes, "step {step}: {} shapes", shapes(&m));
         }
         assert!(m.n_triangles() > 10 * start.n_triangles());
@@ -861,19 +888,21 @@ mod tests {
         let mut m = label_longest_edge(&rect(6, 4, Diagonal::Alternate));
         for k in 0..m.n_triangles() {
             let c = m.corners(k);
-            m.regions[k] = if c[0][0] + c[1][0] + c[2][0] < 3.0 * 0.7 { 1 } else { 2 };
+            m.regions[k] = if c[0][0] + c[1][0] + c[2][0] < 3.0 * 0.7 {
+                1
+            } else {
+                2
+            };
         }
         m.region_names = BTreeMap::from([(1, "soft".to_string()), (2, "hard".to_string())]);
-        let keep: Vec<bool> = m.boundary.tags.iter().map(|&t| t != 4).collect();
-        let pick = |v: &[[u32; 2]]| {
-            v.iter()
-                .zip(&keep)
-                .filter(|(_, &k)| k)
-                .map(|(e, _)| *e)
-                .collect::<Vec<_>>()
-        };
-        m.boundary.edges = pick(&m.boundary.edges);
-        m.boundary.tags = m.boundary.tags.iter().copied().filter(|&t| t != 4).collect();
+        let (edges, tags): (Vec<[u32; 2]>, Vec<u32>) = m
+            .boundary
+            .edges
+            .iter()
+            .zip(&m.boundary.tags)
+            .filter(|(_, &t)| t != 4)
+            .unzip();
+        (m.boundary.edges, m.boundary.tags) = (edges, tags);
         let per_tag = |m: &Mesh| {
             let mut l = BTreeMap::new();
             for (&e, &t) in m.boundary.edges.iter().zip(&m.boundary.tags) {
@@ -945,8 +974,7 @@ mod tests {
             let fbv = f.boundary_vertices();
             let n_old = m.n_vertices();
             let mut moved = 0;
-            for v in n_old..f.n_vertices() {
-                let [x, y] = b.refinement.parents[v];
+            for (v, &[x, y]) in b.refinement.parents.iter().enumerate().skip(n_old) {
                 let (p, q) = (m.points[x as usize], m.points[y as usize]);
                 let mid = [0.5 * (p[0] + q[0]), 0.5 * (p[1] + q[1])];
                 if fbv[v] {
@@ -1027,7 +1055,10 @@ mod tests {
         );
         let mut broken = m.clone();
         broken.regions.pop();
-        assert!(bisect(&broken, &[0]).unwrap_err().to_string().contains("region tags"));
+        assert!(bisect(&broken, &[0])
+            .unwrap_err()
+            .to_string()
+            .contains("region tags"));
         let mut broken = m.clone();
         broken.boundary.edges.push([0, 0]);
         broken.boundary.tags.push(9);
