@@ -14,7 +14,8 @@
 //! the vertex order inside each triangle; boundary regions and region tags do not depend
 //! on it. Uniform refinement ([`super::refine::refine_uniform`]) and the generators
 //! (structured rectangles, Delaunay meshes, Gmsh files) do **not** produce labelled
-//! meshes: a caller labels the start mesh of an adaptive run once with
+//! meshes (the rectangles start with a leg, not the hypotenuse): a caller labels the start
+//! mesh of an adaptive run once with
 //! [`label_longest_edge`], and must not label again between bisections (relabelling a
 //! bisected mesh throws away the newest-vertex structure that bounds the shapes).
 //!
@@ -23,10 +24,11 @@
 //! a marked edge (Binev–Dahmen–DeVore's completion, the non-recursive form of Mitchell's
 //! recursive bisection). Each marked edge is then split once, in both its triangles, so the
 //! result is conforming whatever the labels; each triangle is cut into 1 (unchanged), 2, 3
-//! or 4 triangles by at most three bisections. The labels decide the shapes: with the
-//! longest-edge labelling of the start mesh every triangle ever produced is similar to one
-//! of at most four per start triangle (Sewell, Mitchell), so the angles stay bounded below.
-//! Everything is linear in the mesh size: one edge matching (a counting sort by the smaller
+//! or 4 triangles by at most three bisections. Whatever the start labels, every triangle
+//! ever produced is similar to one of at most four per start triangle (Sewell, Mitchell),
+//! so the angles stay bounded below. The longest-edge labelling makes two neighbours whose
+//! longest edge is their common edge a compatible pair (bisected together, no closure
+//! beyond them) and keeps the classes close to the start shapes. Everything is linear in the mesh size: one edge matching (a counting sort by the smaller
 //! endpoint), a work list for the closure, one pass over the triangles.
 
 use super::refine::Refinement;
@@ -662,20 +664,20 @@ mod tests {
     /// The distinct triangle shapes up to similarity (and reflection): the edge lengths
     /// sorted and divided by the longest, equal within `1e-9`.
     fn shapes(m: &Mesh) -> usize {
-        let mut keys: Vec<[f64; 2]> = (0..m.n_triangles())
-            .map(|k| {
-                let t = m.triangles[k];
-                let mut l = [0, 1, 2].map(|e| len2(m, [t[e], t[NEXT[e]]]).sqrt());
-                l.sort_by(f64::total_cmp);
-                [l[0] / l[2], l[1] / l[2]]
-            })
-            .collect();
-        keys.sort_by(|x, y| x[0].total_cmp(&y[0]).then(x[1].total_cmp(&y[1])));
+        shapes_of(m, 0..m.n_triangles())
+    }
+
+    /// [`shapes`] among the triangles `ks` of `m`.
+    fn shapes_of(m: &Mesh, ks: impl Iterator<Item = usize>) -> usize {
         let mut reps: Vec<[f64; 2]> = Vec::new();
-        for k in keys {
-            let near = |r: &[f64; 2]| (r[0] - k[0]).abs() < 1e-9 && (r[1] - k[1]).abs() < 1e-9;
-            if !reps.iter().rev().take(64).any(near) && !reps.iter().any(near) {
-                reps.push(k);
+        for k in ks {
+            let t = m.triangles[k];
+            let mut l = [0, 1, 2].map(|e| len2(m, [t[e], t[NEXT[e]]]).sqrt());
+            l.sort_by(f64::total_cmp);
+            let key = [l[0] / l[2], l[1] / l[2]];
+            let near = |r: &[f64; 2]| (r[0] - key[0]).abs() < 1e-9 && (r[1] - key[1]).abs() < 1e-9;
+            if !reps.iter().any(near) {
+                reps.push(key);
             }
         }
         reps.len()
@@ -867,10 +869,13 @@ mod tests {
         let classes = 4 * start.n_triangles();
         let mut rng = Rng(12345);
         let mut m = start.clone();
+        // The start triangle of every triangle.
+        let mut root: Vec<u32> = (0..start.n_triangles() as u32).collect();
         for step in 0..10 {
             let marked = rng.mark(m.n_triangles(), 0.2);
             let b = bisect(&m, &marked).unwrap();
             check_conforming(&m, &b, false, false);
+            root = b.parent.iter().map(|&p| root[p as usize]).collect();
             m = b.mesh;
             assert!(
                 min_angle(&m) >= 0.5 * angle0,
@@ -880,6 +885,29 @@ mod tests {
             assert!(shapes(&m) <= classes, "step {step}: {} shapes", shapes(&m));
         }
         assert!(m.n_triangles() > 10 * start.n_triangles());
+        // At most four similarity classes among the descendants of each start triangle.
+        let mut family = vec![Vec::new(); start.n_triangles()];
+        for (k, &r) in root.iter().enumerate() {
+            family[r as usize].push(k);
+        }
+        let deep = family.iter().filter(|f| f.len() >= 16).count();
+        assert!(
+            2 * deep > family.len(),
+            "{deep} start triangles refined deeply"
+        );
+        for (r, f) in family.iter().enumerate() {
+            let n = shapes_of(&m, f.iter().copied());
+            assert!(n <= 4, "start triangle {r}: {n} shapes among {}", f.len());
+        }
+        eprintln!(
+            "L shape, random marking: {} -> {} triangles, smallest angle {angle0:.2}° -> {:.2}°, \
+             shapes {} -> {} (bound {classes})",
+            start.n_triangles(),
+            m.n_triangles(),
+            min_angle(&m),
+            shapes(&start),
+            shapes(&m)
+        );
     }
 
     #[test]
