@@ -1061,8 +1061,14 @@ mod tests {
         // Large enough for the parallel edge matching (≥ 2^16 vertices).
         let m = label_longest_edge(&rect(300, 240, Diagonal::Alternate));
         let marked = Rng(5).mark(m.n_triangles(), 0.05);
-        let one = crate::on_threads(1, || bisect(&m, &marked).unwrap());
-        let two = crate::on_threads(3, || bisect(&m, &marked).unwrap());
+        let on = |threads| {
+            rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap()
+                .install(|| bisect(&m, &marked).unwrap())
+        };
+        let (one, two) = (on(1), on(3));
         assert_eq!(one.mesh.triangles, two.mesh.triangles);
         assert_eq!(one.mesh.points, two.mesh.points);
         assert_eq!(one.parent, two.parent);
