@@ -40,6 +40,9 @@ pub fn solve(case_path: &Path, flags: &SolveFlags) -> Result<()> {
     if case.is_sweep() {
         return sweep(&label, &case, flags, progress, started);
     }
+    if case.adapt.is_some() {
+        return crate::adapt_cmd::adapt(&label, &case, flags, progress, started);
+    }
     // Everything that needs the mesh is checked before anything is solved.
     let outcome = memcontact::run(&case, &mut progress)?;
     progress.finish();
@@ -64,6 +67,8 @@ pub fn solve(case_path: &Path, flags: &SolveFlags) -> Result<()> {
         started,
         plot_options: None,
         run_id: None,
+        cell_data: Vec::new(),
+        adapt: None,
     };
     let summary = write::write_result(flags.out, &outcome, &case, &options, &plots)?;
     print!(

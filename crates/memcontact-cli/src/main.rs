@@ -1,6 +1,7 @@
 //! `memcontact`: the command-line tool. Parses arguments, reads the case, runs the library,
 //! prints a summary and writes the outputs. All the numerics live in the library.
 
+mod adapt_cmd;
 mod bench_cmd;
 mod commands;
 mod convergence;

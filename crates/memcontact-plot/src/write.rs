@@ -111,6 +111,41 @@ pub fn pictures<'a>(
     }
 }
 
+/// The file name of the mesh picture of an adaptive run.
+pub const MESH_PICTURE: &str = "mesh.png";
+
+/// The pictures of an adaptive run's final step (the `extra` files of
+/// [`memcontact::write::AdaptSet::finish`]): those of `options`, and, when it draws any,
+/// `mesh.png`, the final mesh's edges with the outline of the contact zone.
+pub fn adapt_pictures<'a>(
+    mesh: &'a Mesh,
+    options: &'a PlotOptions,
+) -> impl FnMut(&Path, &NodalFields) -> Result<Vec<String>> + 'a {
+    let mut maps = pictures(mesh, options);
+    move |dir: &Path, fields: &NodalFields| {
+        let mut names = maps(dir, fields)?;
+        if options.plots.is_empty() {
+            return Ok(names);
+        }
+        let contact: Vec<bool> = (0..fields.state.len())
+            .map(|v| {
+                fields.state[v] >= 0 || fields.lower.as_ref().is_some_and(|l| l.state[v] >= 0)
+            })
+            .collect();
+        let title = format!("Mesh: {}", options.title.as_deref().unwrap_or(""));
+        crate::mesh_plot(
+            &dir.join(MESH_PICTURE),
+            &mesh.points,
+            &mesh.triangles,
+            &contact,
+            &title,
+            &options.units,
+        )?;
+        names.push(MESH_PICTURE.to_string());
+        Ok(names)
+    }
+}
+
 /// Writes the result set of `outcome` into `target` atomically: the library's files, the
 /// pictures of `plots`, and `summary.json` recording `plots` (so they can be redrawn).
 /// `options.plot_options` is replaced by `plots`. Returns the summary written.
@@ -197,6 +232,8 @@ impl SweepWriter {
             plot_options: serde_json::to_value(&plots).ok(),
             // The set's own run id (SweepSet::write_step).
             run_id: None,
+            cell_data: Vec::new(),
+            adapt: None,
         };
         let mesh = outcome.mesh();
         let mut draw = pictures(&mesh, &plots);

@@ -405,6 +405,8 @@ impl PyResult_ {
                     .unwrap_or(now),
                 plot_options: None,
                 run_id: None,
+                cell_data: Vec::new(),
+                adapt: None,
             };
             write_result(&directory, &outcome, &self.data.case, &options, &plots)
         })

@@ -28,6 +28,7 @@ pub mod certificate;
 
 pub mod discretization;
 pub mod error;
+pub mod estimate;
 
 pub mod fem;
 pub mod field;

@@ -193,6 +193,8 @@ fn a_result_set_is_written_and_read_back_without_the_cli() {
         started: Instant::now(),
         plot_options: None,
         run_id: None,
+        cell_data: Vec::new(),
+        adapt: None,
     };
     let written =
         write_result_set(&out, &outcome, &case, &options, &mut |_, _| Ok(vec![])).unwrap();

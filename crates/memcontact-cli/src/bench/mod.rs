@@ -153,6 +153,8 @@ pub fn run_case(case: &Case, scratch: &Path, pictures: bool) -> Result<CaseRun> 
         started,
         plot_options: None,
         run_id: None,
+        cell_data: Vec::new(),
+        adapt: None,
     };
     let plots = memcontact_plot::write::plot_options(&case, "bench");
     let written = memcontact_plot::write::write_result(&dir, &outcome, &case, &options, &plots);

@@ -1,6 +1,7 @@
 //! [`Case`]: the sections of a case file as one value, read from TOML or JSON, validated
 //! once.
 
+use super::adapt::AdaptSpec;
 use super::exact::ExactSpec;
 use super::output::{OutputOptions, Units};
 use super::overrides::{apply_overrides, key_span, line_of, plain_types, strip_json_position};
@@ -32,6 +33,8 @@ pub struct Case {
     pub sweep: Option<SweepSpec>,
     /// `[[load_case]]`: named combinations overriding the case's data.
     pub load_cases: Vec<LoadCase>,
+    /// `[adapt]`: adaptive refinement of the mesh.
+    pub adapt: Option<AdaptSpec>,
 }
 
 /// The serde shape of [`Case`]: one field per section.
@@ -57,6 +60,8 @@ struct CaseFile {
     sweep: Option<SweepSpec>,
     #[serde(default, rename = "load_case", skip_serializing_if = "Vec::is_empty")]
     load_cases: Vec<LoadCase>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    adapt: Option<AdaptSpec>,
 }
 
 impl From<CaseFile> for Case {
@@ -75,6 +80,7 @@ impl From<CaseFile> for Case {
             units: c.units,
             sweep: c.sweep,
             load_cases: c.load_cases,
+            adapt: c.adapt,
         }
     }
 }
@@ -93,6 +99,7 @@ impl From<Case> for CaseFile {
             units: c.units,
             sweep: c.sweep,
             load_cases: c.load_cases,
+            adapt: c.adapt,
         }
     }
 }
@@ -110,6 +117,17 @@ impl Case {
         self.settings.validate()?;
         self.output.validate()?;
         validate_steps(self.sweep.as_ref(), &self.load_cases, &self.problem)?;
+        if let Some(a) = &self.adapt {
+            a.validate()?;
+            if self.is_sweep() {
+                return Err(Invalid::new(
+                    "adapt",
+                    "a case has either [adapt] or steps ([sweep], [[load_case]]), not both: \
+                     the steps of a sweep would each refine their own mesh (solve the steps \
+                     on a fixed mesh, or adapt one case at a time)",
+                ));
+            }
+        }
         if let Some(ExactSpec::Manufactured { amplitude, .. }) = &self.exact {
             if !(amplitude.is_finite() && *amplitude != 0.0) {
                 return Err(Invalid::new(

@@ -6,6 +6,7 @@
 //! [`OutputOptions`], the [`ExactSpec`] of a closed-form solution for convergence studies,
 //! and the steps of a load sweep or of load combinations.
 
+mod adapt;
 mod exact;
 mod file;
 mod output;
@@ -15,6 +16,7 @@ mod sweep;
 mod tests;
 
 pub use crate::io::input::CASE_FILE_CAP;
+pub use adapt::AdaptSpec;
 pub use exact::{BenchmarkBody, ExactSpec, ManufacturedDomain, ManufacturedForm};
 pub use file::{steps, Case};
 pub use output::{OutputOptions, PictureKind, Units, VtuFormat};

@@ -38,6 +38,9 @@ pub struct OutputOptions {
     /// the middle of the domain).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub profile: Option<[[f64; 2]; 2]>,
+    /// With `[adapt]`: also write each step's result set, in `step-K/`.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub keep_steps: bool,
 }
 
 /// A picture `solve` can draw.

@@ -190,6 +190,30 @@ pub struct Summary {
     /// Area where the body below lies under the membrane but the membrane is clear of it.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub liftoff_area_low: Option<f64>,
+    /// The adaptive loop's totals (with `[adapt]`).
+    #[serde(default, flatten, skip_serializing_if = "Option::is_none")]
+    pub adapt: Option<AdaptTotals>,
+}
+
+/// The totals of an adaptive loop, in `summary.json` beside the final step's values.
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct AdaptTotals {
+    /// Steps solved (the start mesh's solve is step 0).
+    pub adapt_steps: usize,
+    /// The final step's estimator η.
+    pub adapt_estimator: f64,
+    /// The start mesh's vertices.
+    pub adapt_start_vertices: usize,
+    /// Iterations of all steps together.
+    pub adapt_iterations: usize,
+    /// Seconds of all steps together (refinement, assembly, solve, estimate).
+    pub adapt_seconds: f64,
+    /// Why the loop stopped: `tolerance`, `steps`, `max_vertices`, `not_accepted`,
+    /// `estimator_not_finite`.
+    pub adapt_stop: String,
+    /// The data given per vertex that were interpolated (P1) onto the new vertices.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub adapt_interpolated: Vec<String>,
 }
 
 impl Summary {
@@ -291,6 +315,7 @@ impl Summary {
             total_contact_force_low: totals.lower.map(|t| t.total_contact_force_low),
             max_pressure_low: totals.lower.map(|t| t.max_pressure_low),
             liftoff_area_low: totals.lower.map(|t| t.liftoff_area_low),
+            adapt: None,
         }
         .with_boundary(outcome, quality)
     }

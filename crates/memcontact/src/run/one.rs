@@ -123,6 +123,14 @@ pub fn run(case: &Case, observer: &mut dyn Observer) -> Result<Outcome> {
         });
     }
     case.validate().map_err(Invalid::into_error)?;
+    if case.adapt.is_some() {
+        return Err(Error::Case {
+            file: None,
+            line: None,
+            key: "adapt".into(),
+            message: "the case refines its mesh adaptively: run its adaptive loop".into(),
+        });
+    }
     let observer = &mut solve::Cancellable {
         inner: observer,
         cancel: &case.settings.cancel,

@@ -10,6 +10,7 @@
 //! room for it (the CSV header lines are contracts), are bound to it by their hashes in
 //! the summary or manifest.
 
+mod adapt;
 mod manifest;
 mod result;
 mod study;
@@ -17,6 +18,7 @@ mod sweep;
 #[cfg(test)]
 mod tests;
 
+pub use adapt::{adapt_totals, write_adapt_csv, AdaptSet, ADAPT_CSV};
 pub use manifest::{write_manifest, Manifest, MANIFEST};
 pub use result::{
     file_record, input_hash, new_run_id, write_fields, write_files, write_result_set, WriteOptions,

@@ -50,6 +50,11 @@ pub struct WriteOptions {
     /// The run id the files carry (`None`: a fresh one, [`new_run_id`]); the steps of a
     /// sweep share their sweep's.
     pub run_id: Option<String>,
+    /// Further cell data of `solution.vtu`, one value per triangle in the user's order
+    /// (the adaptive loop's `estimator`).
+    pub cell_data: Vec<(String, Vec<f64>)>,
+    /// The adaptive loop's totals for `summary.json` (with `[adapt]`).
+    pub adapt: Option<crate::outcome::summary::AdaptTotals>,
 }
 
 /// A fresh random run identifier (32 hex digits).
@@ -142,6 +147,7 @@ pub fn write_fields(
     fields: &NodalFields,
     vtu: VtuFormat,
     run_id: &str,
+    cell_data: &[(String, Vec<f64>)],
 ) -> Result<Vec<(String, FileRecord)>> {
     let mesh = outcome.mesh();
     let region: Vec<i32> = mesh.regions.iter().map(|&r| r as i32).collect();
@@ -191,7 +197,13 @@ pub fn write_fields(
                 &dir.join("solution.vtu"),
                 &mesh,
                 &vtu_points,
-                &[("region", DataArray::I32(&region))],
+                &std::iter::once(("region", DataArray::I32(&region)))
+                    .chain(
+                        cell_data
+                            .iter()
+                            .map(|(n, v)| (n.as_str(), DataArray::F64(v))),
+                    )
+                    .collect::<Vec<_>>(),
                 match vtu {
                     VtuFormat::Binary => VtuEncoding::Binary,
                     VtuFormat::Ascii => VtuEncoding::Ascii,
@@ -229,7 +241,7 @@ pub fn write_files(
     let run_id = options.run_id.clone().unwrap_or_else(new_run_id);
     // The input's hash reads the mesh file again: alongside the writing, not after it.
     let (written, hash) = rayon::join(
-        || write_fields(dir, outcome, &fields, options.vtu, &run_id),
+        || write_fields(dir, outcome, &fields, options.vtu, &run_id, &options.cell_data),
         || input_hash(case),
     );
     let written = written?;
@@ -244,6 +256,7 @@ pub fn write_files(
     summary.run_id = run_id;
     summary.input_hash = hash;
     summary.plot_options = options.plot_options.clone();
+    summary.adapt = options.adapt.clone();
     // The fields' files were hashed as they were written; the extra files (pictures) are
     // read back, side by side.
     let records: Vec<FileRecord> = {

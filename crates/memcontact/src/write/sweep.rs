@@ -75,6 +75,8 @@ impl SweepSet {
         })?;
         let options = WriteOptions {
             run_id: Some(self.run_id.clone()),
+            cell_data: Vec::new(),
+            adapt: None,
             ..options.clone()
         };
         let summary = write_files(&dir, outcome, case, &options, extra)?;
