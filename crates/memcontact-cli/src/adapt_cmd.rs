@@ -8,7 +8,7 @@ use crate::report;
 use anyhow::{bail, Result};
 use memcontact::outcome::{AdaptRow, Outcome};
 use memcontact::solve::{IterationRecord, Observer};
-use memcontact::write::{AdaptSet, WriteOptions};
+use memcontact::write::{AdaptHistory, AdaptSet, WriteOptions};
 use memcontact::Case;
 use memcontact_plot::write::{adapt_pictures, pictures, plot_options};
 use std::cell::RefCell;
@@ -112,10 +112,15 @@ pub fn adapt(
     let set = set.expect("step 0 began the set");
     let start_vertices = run.rows.first().map_or(0, |r| r.vertices);
     let mesh = outcome.mesh();
+    let history = AdaptHistory {
+        rows: &run.rows,
+        indicators: &run.indicators,
+        totals: &run.totals(),
+    };
     let summary = set.finish(
         case,
-        &run,
-        start_vertices,
+        outcome,
+        history,
         &options,
         &mut adapt_pictures(&mesh, &plots),
     )?;

@@ -106,6 +106,11 @@ const EXAMPLES: &[Example] = &[
         ],
     },
     Example {
+        name: "roof-corner",
+        about: "an L-shaped roof pushed up against a foam cushion, refined adaptively ([adapt])",
+        files: &[("roof-corner.toml", include_str!("../../../examples/roof-corner.toml"))],
+    },
+    Example {
         name: "liner-slope",
         about: "a geomembrane liner on a slope, meshed in Gmsh: heights per physical curve, a free crest, soils above and below",
         files: &[

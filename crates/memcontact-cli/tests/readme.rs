@@ -67,6 +67,14 @@ fn samples(section: &str) -> BTreeMap<&'static str, &'static str> {
             ("plot", "true"),
             ("allowable_pressure", "5.0"),
             ("profile", "[[0.0, 0.5], [1.0, 0.5]]"),
+            ("keep_steps", "true"),
+        ],
+        "adapt" => vec![
+            ("max_vertices", "5000"),
+            ("steps", "4"),
+            ("theta", "0.6"),
+            ("free_boundary_rings", "2"),
+            ("tolerance", "1e-3"),
         ],
         "units" => vec![("length", "\"m\""), ("force", "\"kN\"")],
         other => panic!("no samples for {other}"),
@@ -77,7 +85,7 @@ fn samples(section: &str) -> BTreeMap<&'static str, &'static str> {
 fn every_key_the_readme_lists_is_accepted_by_check_and_documented() {
     let dir = tmp_in("readme", "keys");
     let sections = [
-        "membrane", "obstacle", "lower", "boundary", "solver", "output", "units",
+        "membrane", "obstacle", "lower", "boundary", "solver", "output", "units", "adapt",
     ];
     let mut case = String::from("[mesh]\ngenerator = \"rectangle\"\nnx = 16\n");
     for section in sections {

@@ -900,7 +900,10 @@ pub fn mesh_plot(
     furniture(&mut canvas, &l, units, title, None, &mut boxes);
     let entries = vec![
         (Swatch::Line([90, 90, 90], 1.0), "mesh edges".to_string()),
-        (Swatch::Line(OUTLINE, 2.2), "contact zone outline".to_string()),
+        (
+            Swatch::Line(OUTLINE, 2.2),
+            "contact zone outline".to_string(),
+        ),
         (Swatch::None, format!("{} vertices", points.len())),
         (Swatch::None, format!("{} triangles", triangles.len())),
     ];

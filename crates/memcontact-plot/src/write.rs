@@ -128,9 +128,7 @@ pub fn adapt_pictures<'a>(
             return Ok(names);
         }
         let contact: Vec<bool> = (0..fields.state.len())
-            .map(|v| {
-                fields.state[v] >= 0 || fields.lower.as_ref().is_some_and(|l| l.state[v] >= 0)
-            })
+            .map(|v| fields.state[v] >= 0 || fields.lower.as_ref().is_some_and(|l| l.state[v] >= 0))
             .collect();
         let title = format!("Mesh: {}", options.title.as_deref().unwrap_or(""));
         crate::mesh_plot(

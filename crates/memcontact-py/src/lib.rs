@@ -2,6 +2,7 @@
 //! meshes as NumPy arrays, solves and sweeps with the GIL released, results that pickle. The
 //! typed Python package `memcontact` wraps it.
 
+mod adapt;
 mod case;
 mod convert;
 mod mesh;
@@ -19,8 +20,14 @@ use pyo3::types::PyDict;
 use result::PyResult_;
 use std::time::Instant;
 
-/// A case with steps is refused by `solve` (which would solve its base case alone).
+/// A case with steps is refused by `solve` (which would solve its base case alone), and so
+/// is a case with `[adapt]` (its loop is `adapt`).
 fn refuse_sweep(case: &memcontact::Case) -> PyResult<()> {
+    if case.adapt.is_some() {
+        return Err(PyValueError::new_err(
+            "the case has [adapt]: run its adaptive loop with memcontact.adapt(case)",
+        ));
+    }
     if !case.is_sweep() {
         return Ok(());
     }
@@ -89,10 +96,13 @@ fn _memcontact(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<PyResult_>()?;
     m.add_class::<sweep::PySweep>()?;
     m.add_class::<study::PyStudy>()?;
+    m.add_class::<adapt::PyAdapt>()?;
     m.add_function(wrap_pyfunction!(solve, m)?)?;
     m.add_function(wrap_pyfunction!(sweep::sweep, m)?)?;
     m.add_function(wrap_pyfunction!(study::convergence, m)?)?;
     m.add_function(wrap_pyfunction!(solve_on, m)?)?;
+    m.add_function(wrap_pyfunction!(adapt::adapt, m)?)?;
+    m.add_function(wrap_pyfunction!(adapt::adapt_on, m)?)?;
     m.add_function(wrap_pyfunction!(mesh::rectangle, m)?)?;
     m.add_function(wrap_pyfunction!(mesh::disk, m)?)?;
     m.add_function(wrap_pyfunction!(mesh::polygon, m)?)?;

@@ -130,6 +130,11 @@ impl PyResult_ {
         }
     }
 
+    /// What the result holds.
+    pub fn data(&self) -> &ResultData {
+        &self.data
+    }
+
     /// The outcome, rebuilt (assembled again on the stored mesh) when the result was
     /// unpickled.
     pub fn outcome(&self) -> memcontact::Result<Arc<Outcome>> {

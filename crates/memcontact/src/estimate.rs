@@ -64,8 +64,7 @@ pub fn estimate(
     for (i, &v) in model.dofs.vertex.iter().enumerate() {
         let v = v as usize;
         rho[v] = -residual[i] / mass[v];
-        rigid[v] = model.rigid_at(i)
-            || model.lower.as_ref().is_some_and(|b| b.rigid_at(i));
+        rigid[v] = model.rigid_at(i) || model.lower.as_ref().is_some_and(|b| b.rigid_at(i));
     }
     let grads: Vec<[f64; 2]> = (0..mesh.n_triangles())
         .into_par_iter()
@@ -94,7 +93,9 @@ pub fn estimate(
                 .max(crate::mesh::dist(c[1], c[2]))
                 .max(crate::mesh::dist(c[2], c[0]));
             let (mut r2, mut comp) = (0.0, 0.0);
-            let any_rigid = tri.iter().any(|&v| rigid[v as usize] && rho[v as usize] > 0.0);
+            let any_rigid = tri
+                .iter()
+                .any(|&v| rigid[v as usize] && rho[v as usize] > 0.0);
             for (b, w) in DEGREE5 {
                 let p = map(&c, &b);
                 let rho_p: f64 = (0..3).map(|a| b[a] * rho[tri[a] as usize]).sum();
@@ -191,20 +192,25 @@ mod tests {
         .clone()
     }
 
+    /// Tension `t`, no load, no body (h = 0 under a far obstacle).
+    fn unloaded(t: f64) -> ProblemData<'static> {
+        ProblemData {
+            tension: t,
+            load: &0.0,
+            shape: &10.0,
+            stiffness: BodyStiffness::Elastic(&0.0),
+            foundation: Foundation::Consistent,
+            sampling: Sampling::Nodal,
+        }
+    }
+
     /// A P1 problem solved exactly: u = 1 + 2x − y (its heights on the boundary), no load,
     /// no body. The indicators vanish to rounding.
     #[test]
     fn indicators_vanish_for_a_solution_in_the_p1_space() {
         let mesh = grid(12);
         let g = FnCoefficient(|p: [f64; 2]| 1.0 + 2.0 * p[0] - p[1]);
-        let data = ProblemData {
-            tension: 2.0,
-            load: &0.0,
-            shape: &10.0,
-            stiffness: BodyStiffness::Elastic(&0.0),
-            foundation: Foundation::Consistent,
-            sampling: Sampling::Nodal,
-        };
+        let data = unloaded(2.0);
         let free: Vec<String> = Vec::new();
         let ext = Extensions {
             boundary: Some(crate::model::BoundaryData {
@@ -220,15 +226,67 @@ mod tests {
         let ind = estimate(&mesh, &model, &0.0, &10.0, &[], &u).unwrap();
         assert!(ind.total < 1e-12, "{}", ind.total);
         // A load breaks it: the indicator sees the residual.
-        let loaded = ProblemData {
-            load: &1.0,
-            ..data
-        };
+        let loaded = ProblemData { load: &1.0, ..data };
         let model = Model::assemble_with(&mesh, &loaded, &ext).unwrap();
         let u = crate::solve::linear::solve(&model, &crate::solve::Settings::default())
             .unwrap()
             .u;
         let ind = estimate(&mesh, &model, &1.0, &10.0, &[], &u).unwrap();
         assert!(ind.total > 1e-3, "{}", ind.total);
+    }
+
+    /// The free-edge term is exactly `Σ h_E ‖t ∂u/∂n‖²_E / t` over the free edges: for the
+    /// P1 function u = 1 + 2x − y with the top side free (∂u/∂n = −1 there), listing the
+    /// top edges as free adds `t Σ h_E² = t/n` to η², whatever else the indicators hold.
+    #[test]
+    fn the_free_edge_term_is_the_flux_through_the_free_edges() {
+        let n = 10;
+        let mesh = grid(n);
+        let g = FnCoefficient(|p: [f64; 2]| 1.0 + 2.0 * p[0] - p[1]);
+        let t = 3.0;
+        let data = unloaded(t);
+        let free = vec!["top".to_string()];
+        let ext = Extensions {
+            boundary: Some(crate::model::BoundaryData {
+                free: &free,
+                height: &g,
+            }),
+            ..Extensions::default()
+        };
+        let model = Model::assemble_with(&mesh, &data, &ext).unwrap();
+        let u: Vec<f64> = model
+            .dofs
+            .vertex
+            .iter()
+            .map(|&v| g.at(mesh.points[v as usize], 0))
+            .collect();
+        let top: Vec<[u32; 2]> = (0..mesh.n_triangles())
+            .flat_map(|k| {
+                let tri = mesh.triangles[k];
+                (0..3).map(move |e| [tri[e], tri[(e + 1) % 3]])
+            })
+            .filter(|&[a, b]| {
+                mesh.points[a as usize][1] == 1.0 && mesh.points[b as usize][1] == 1.0
+            })
+            .collect();
+        assert_eq!(top.len(), n);
+        let without = estimate(&mesh, &model, &0.0, &10.0, &[], &u).unwrap();
+        let with = estimate(&mesh, &model, &0.0, &10.0, &top, &u).unwrap();
+        let added = with.total.powi(2) - without.total.powi(2);
+        let expected = t / n as f64;
+        assert!((added - expected).abs() < 1e-12, "{added} vs {expected}");
+    }
+
+    /// Indicators that overflow are an error naming the triangle, not a silent infinity
+    /// (the adaptive loop then stops, keeping the step before).
+    #[test]
+    fn an_overflowing_indicator_is_an_error() {
+        let mesh = grid(4);
+        let data = unloaded(1.0);
+        let model = Model::assemble_with(&mesh, &data, &Extensions::default()).unwrap();
+        let mut u = vec![0.0; model.n()];
+        u[0] = 1e200;
+        let e = estimate(&mesh, &model, &0.0, &10.0, &[], &u).unwrap_err();
+        assert!(e.to_string().contains("triangle"), "{e}");
     }
 }

@@ -20,6 +20,11 @@ The same cases as the ``memcontact`` command-line tool, from Python::
     s.rows                            # the rows of sweep.csv
     s.write("out/roof-sweep")         # a directory per step, sweep.csv, sweep.png
 
+    a = mc.adapt("examples/roof-corner.toml")   # a case with [adapt]
+    a.rows                            # the rows of adapt.csv, one per step
+    a.result.u, a.mesh                # the final step's result and mesh
+    a.write("out/roof-corner")        # the final files, adapt.csv, mesh.png
+
 Solves run with the GIL released. Bad data raises ``ValueError`` naming the key; a solve
 that does not reach its tolerance raises :class:`SolverError`, whose ``result`` holds the
 iterate, its status and its certificate.
@@ -45,17 +50,19 @@ from typing import (
 import numpy as np
 
 from . import _memcontact as _native
-from ._memcontact import Case, Mesh, Result, Study, Sweep
+from ._memcontact import Adapt, Case, Mesh, Result, Study, Sweep
 
 __version__: str = _native.__version__
 
 __all__ = [
+    "Adapt",
     "Case",
     "Mesh",
     "Result",
     "Study",
     "Sweep",
     "SolverError",
+    "adapt",
     "convergence",
     "load_case",
     "rectangle",
@@ -238,8 +245,44 @@ def solve(case: CaseLike) -> Result:
 
     Raises ``ValueError`` for bad data and :class:`SolverError` (with the result) when the
     certificate does not reach the tolerance. A case with a ``[sweep]`` or
-    ``[[load_case]]`` entries raises ``ValueError``: solve its steps with :func:`sweep`."""
+    ``[[load_case]]`` entries raises ``ValueError``: solve its steps with :func:`sweep`;
+    so does a case with ``[adapt]``: run its loop with :func:`adapt`."""
     return _check(_native.solve(_as_case(case)))
+
+
+def adapt(case: CaseLike, *, mesh: Optional[Mesh] = None, check: bool = True) -> Adapt:
+    """Runs the adaptive loop of a case with an ``[adapt]`` section, as ``memcontact
+    solve`` does (solve, estimate, mark, refine by newest-vertex bisection, solve again
+    from the previous answer), with the GIL released; Ctrl-C stops it.
+
+    ``case`` is a :class:`Case`, a dict in the case file's schema or the path of a case
+    file. With ``mesh``, ``case`` is a dict of the sections but ``mesh`` and the loop
+    starts from that :class:`Mesh`; its data may then be NumPy arrays of one value per
+    vertex, which are interpolated (P1) onto the new vertices (``interpolated`` names
+    them).
+
+    Returns an :class:`Adapt`: ``rows`` (the rows of ``adapt.csv``: step, vertices,
+    unknowns, estimator, energy, contact_area, iterations, kkt_residual, seconds),
+    ``result`` (the final step's :class:`Result`), ``mesh`` (the final mesh),
+    ``estimator`` (η_T per triangle of it), ``stop``, ``totals`` and
+    ``write(directory)``, which writes the command-line tool's files.
+
+    Raises ``ValueError`` for bad data (``[adapt]`` settings included: ``theta`` outside
+    (0, 1], ``steps`` < 1, ``max_vertices`` below the start mesh) and for a case without
+    ``[adapt]`` or with a ``[sweep]`` or load cases. A step the settings do not accept
+    ends the loop: with ``check`` that raises :class:`SolverError` (its ``result`` is that
+    step's); ``check=False`` returns the loop instead."""
+    if mesh is not None:
+        if not isinstance(case, Mapping):
+            raise TypeError("with mesh, give the case's data as a dict (its sections but mesh)")
+        a = _native.adapt_on(mesh, dict(case), "mesh")
+    else:
+        a = _native.adapt(_as_case(case))
+    for note in a.result.warnings:
+        warnings.warn(note, stacklevel=2)
+    if check and not a.accepted:
+        raise SolverError(a.message or "a step of the adaptive loop was not accepted", a.result)
+    return a
 
 
 def sweep(case: CaseLike, warm: bool = True, *, check: bool = True) -> Sweep:

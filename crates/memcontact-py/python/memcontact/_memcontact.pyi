@@ -187,7 +187,63 @@ class Study:
     ) -> List[str]: ...
     def __len__(self) -> int: ...
 
+class Adapt:
+    """The steps of an adaptive loop (a case with ``[adapt]``) and its final result."""
+
+    @property
+    def rows(self) -> List[Dict[str, Any]]:
+        """The rows of ``adapt.csv`` (step, vertices, unknowns, estimator, energy,
+        contact_area, iterations, kkt_residual, seconds), one per step."""
+        ...
+    @property
+    def columns(self) -> List[str]: ...
+    @property
+    def result(self) -> Result:
+        """The last step's result, on the final mesh."""
+        ...
+    @property
+    def mesh(self) -> Mesh:
+        """The final mesh (every step's mesh is one of its levels)."""
+        ...
+    @property
+    def estimator(self) -> npt.NDArray[np.float64]:
+        """η_T of the last step, one per triangle of the final mesh."""
+        ...
+    @property
+    def totals(self) -> Dict[str, Any]:
+        """The loop's totals as in ``summary.json`` (``adapt_steps``, ``adapt_stop``, ...)."""
+        ...
+    @property
+    def stop(self) -> str:
+        """Why the loop stopped: ``tolerance``, ``steps``, ``max_vertices``,
+        ``not_accepted`` or ``estimator_not_finite``."""
+        ...
+    @property
+    def interpolated(self) -> List[str]:
+        """The data given per vertex that were interpolated onto new vertices."""
+        ...
+    @property
+    def message(self) -> Optional[str]: ...
+    @property
+    def accepted(self) -> bool: ...
+    @property
+    def case(self) -> Case: ...
+    def write(
+        self,
+        directory: Union[str, PathLike[str]],
+        force: bool = False,
+        vtu: Optional[str] = None,
+        pictures: bool = True,
+    ) -> Dict[str, Any]:
+        """Writes the command-line tool's result set (the final step's files with the
+        estimator per triangle, ``adapt.csv``, ``mesh.png``) atomically; returns the
+        summary."""
+        ...
+    def __len__(self) -> int: ...
+
 def solve(case: Case) -> Result: ...
+def adapt(case: Case) -> Adapt: ...
+def adapt_on(mesh: Mesh, data: Mapping[str, Any], label: Optional[str] = None) -> Adapt: ...
 def convergence(
     case: Case,
     levels: int,

@@ -19,7 +19,8 @@ pub struct AdaptSpec {
     #[serde(default = "default_theta")]
     pub theta: f64,
     /// The triangles holding both contact and non-contact vertices, and this many rings of
-    /// neighbours, are refined besides (0: none).
+    /// neighbours, are refined besides (0: none); at most as many as the Dörfler set holds,
+    /// the largest first.
     #[serde(default = "default_rings")]
     pub free_boundary_rings: usize,
     /// Stop once the estimator η is at most this (energy-norm units).

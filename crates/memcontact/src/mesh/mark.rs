@@ -138,6 +138,41 @@ pub fn free_boundary(mesh: &Mesh, contact: &[bool], rings: usize) -> Result<Vec<
         .collect())
 }
 
+/// At most `count` triangles of `set` that are not in `besides` (both sorted, without
+/// repeats): the largest by area, the lower index first among equal areas. The adaptive
+/// loop bounds the free-boundary marks by the Dörfler set's size with it, so the free
+/// boundary is refined at most as fast as the bulk and the energy error keeps its rate.
+/// Returns sorted indices.
+pub fn largest(mesh: &Mesh, set: &[u32], besides: &[u32], count: usize) -> Vec<u32> {
+    let mut rest: Vec<u32> = set
+        .iter()
+        .copied()
+        .filter(|k| besides.binary_search(k).is_err())
+        .collect();
+    if rest.len() > count {
+        let key = |&k: &u32| (std::cmp::Reverse(OrdArea(mesh.area(k as usize))), k);
+        rest.sort_unstable_by_key(key);
+        rest.truncate(count);
+        rest.sort_unstable();
+    }
+    rest
+}
+
+/// An area ordered by `f64::total_cmp`, for sorting keys.
+#[derive(PartialEq)]
+struct OrdArea(f64);
+impl Eq for OrdArea {}
+impl PartialOrd for OrdArea {
+    fn partial_cmp(&self, other: &Self) -> Option<std::cmp::Ordering> {
+        Some(self.cmp(other))
+    }
+}
+impl Ord for OrdArea {
+    fn cmp(&self, other: &Self) -> std::cmp::Ordering {
+        self.0.total_cmp(&other.0)
+    }
+}
+
 /// The union of marked sets (any order, repeats allowed): sorted indices without repeats,
 /// e.g. the Dörfler set and the free-boundary set of one step.
 pub fn union(sets: &[&[u32]]) -> Vec<u32> {

@@ -58,8 +58,7 @@ impl Report {
         self.phases
             .iter()
             .filter(|p| p.name == name)
-            .map(|p| p.seconds)
-            .sum()
+            .fold(0.0, |total, p| total + p.seconds)
     }
 
     /// The error naming how the solve ended, when the settings do not accept it.

@@ -6,7 +6,10 @@
 //!   rigid ones and rigid regions, a body below, free edges).
 //! - **Mark**: Dörfler's bulk criterion on η_T² with fraction θ, together with the
 //!   triangles on the free boundary (those holding both contact and non-contact vertices,
-//!   of either body) and `free_boundary_rings` rings of neighbours.
+//!   of either body) and `free_boundary_rings` rings of neighbours, at most as many of
+//!   these as the Dörfler set holds (the largest first): the free boundary is refined as
+//!   fast as the bulk and no faster, so its strip never takes over the vertex budget and
+//!   the energy error keeps the rate of Dörfler marking.
 //! - **Refine**: newest-vertex bisection ([`crate::mesh::bisect`]) of the mesh in the
 //!   user's numbering (the start mesh labelled by its longest edges once): conforming,
 //!   nested and shape-regular, regions and boundary regions carried, new vertices on the
@@ -24,6 +27,7 @@ use crate::estimate::estimate;
 use crate::field::{Field, Stiffness};
 use crate::mesh::boundary::FixedBoundary;
 use crate::mesh::{bisect, mark, Mesh, VertexTriangles};
+use crate::outcome::summary::AdaptTotals;
 use crate::outcome::{AdaptRow, Outcome};
 use crate::problem::Problem;
 use crate::solve::{Cancellable, Observer};
@@ -72,8 +76,30 @@ pub struct AdaptRun {
     pub error: Option<Error>,
     /// The keys of the data given per vertex that were interpolated onto new vertices.
     pub interpolated: Vec<String>,
+    /// The case's problem with its data on the final mesh (per-vertex arrays
+    /// interpolated): what the last step solved.
+    pub problem: Problem,
     /// Seconds of the whole loop.
     pub seconds: f64,
+}
+
+/// What the loop tells its caller after every step: the step's row, its outcome and its
+/// η_T² in the user's triangle order. An error stops the loop with that error.
+pub type OnStep<'a> = dyn FnMut(&AdaptRow, &Outcome, &[f64]) -> Result<()> + 'a;
+
+impl AdaptRun {
+    /// The loop's totals for `summary.json`.
+    pub fn totals(&self) -> AdaptTotals {
+        AdaptTotals {
+            adapt_steps: self.rows.len(),
+            adapt_estimator: self.rows.last().map_or(f64::NAN, |r| r.estimator),
+            adapt_start_vertices: self.rows.first().map_or(0, |r| r.vertices),
+            adapt_iterations: self.rows.iter().map(|r| r.iterations).sum(),
+            adapt_seconds: self.seconds,
+            adapt_stop: self.stop.name().to_string(),
+            adapt_interpolated: self.interpolated.clone(),
+        }
+    }
 }
 
 /// Runs the adaptive loop of `case` (which needs an `[adapt]` section). `on_step` sees
@@ -82,7 +108,7 @@ pub struct AdaptRun {
 pub fn run_adapt(
     case: &Case,
     observer: &mut dyn Observer,
-    on_step: &mut dyn FnMut(&AdaptRow, &Outcome, &[f64]) -> Result<()>,
+    on_step: &mut OnStep<'_>,
 ) -> Result<AdaptRun> {
     case.validate().map_err(Invalid::into_error)?;
     let Some(spec) = case.adapt.clone() else {
@@ -183,16 +209,17 @@ pub fn run_adapt(
         let mesh = hierarchy.finest();
         let eta2 = &kept.as_ref().expect("kept").1;
         let bulk = mark::dorfler(eta2, spec.theta)?;
-        let mut sets = vec![bulk];
+        let mut marked = bulk.clone();
         let rings = spec.free_boundary_rings;
         if rings > 0 {
-            sets.push(mark::free_boundary(mesh, &contact_up, rings)?);
+            let mut sets = vec![mark::free_boundary(mesh, &contact_up, rings)?];
             if let Some(low) = &contact_low {
                 sets.push(mark::free_boundary(mesh, low, rings)?);
             }
+            let refs: Vec<&[u32]> = sets.iter().map(Vec::as_slice).collect();
+            let free = mark::largest(mesh, &mark::union(&refs), &bulk, bulk.len());
+            marked = mark::union(&[&bulk, &free]);
         }
-        let refs: Vec<&[u32]> = sets.iter().map(Vec::as_slice).collect();
-        let marked = mark::union(&refs);
         let b = bisect::bisect(mesh, &marked)?;
         if spec
             .max_vertices
@@ -214,6 +241,7 @@ pub fn run_adapt(
         stop,
         error,
         interpolated,
+        problem,
         seconds: started.elapsed().as_secs_f64(),
     })
 }

@@ -9,7 +9,6 @@ use crate::error::Result;
 use crate::io::result_set::ResultSet;
 use crate::outcome::summary::AdaptTotals;
 use crate::outcome::{AdaptRow, NodalFields, Outcome, Summary};
-use crate::run::AdaptRun;
 use std::path::Path;
 
 /// The name of the table of steps.
@@ -38,17 +37,17 @@ pub fn write_adapt_csv(path: &Path, rows: &[AdaptRow]) -> Result<()> {
     crate::io::write_atomic(path, |w| w.write_all(text.as_bytes())).map(|_| ())
 }
 
-/// The adaptive totals of `run` for `summary.json`.
-pub fn adapt_totals(run: &AdaptRun, start_vertices: usize) -> AdaptTotals {
-    AdaptTotals {
-        adapt_steps: run.rows.len(),
-        adapt_estimator: run.rows.last().map_or(f64::NAN, |r| r.estimator),
-        adapt_start_vertices: start_vertices,
-        adapt_iterations: run.rows.iter().map(|r| r.iterations).sum(),
-        adapt_seconds: run.seconds,
-        adapt_stop: run.stop.name().to_string(),
-        adapt_interpolated: run.interpolated.clone(),
-    }
+/// What the final result set of an adaptive run records besides its last step: the rows
+/// of `adapt.csv`, η_T² of the last step (per triangle, user order) and the totals for
+/// `summary.json`.
+#[derive(Debug, Clone, Copy)]
+pub struct AdaptHistory<'a> {
+    /// One row per step solved.
+    pub rows: &'a [AdaptRow],
+    /// η_T² of the last step kept.
+    pub indicators: &'a [f64],
+    /// The totals of the loop.
+    pub totals: &'a AdaptTotals,
 }
 
 /// An adaptive run's result set being written (nothing is in place until
@@ -94,12 +93,13 @@ impl AdaptSet {
 
     /// Writes the final step's files at the top of the set (`solution.vtu` with the
     /// estimator per triangle, `nodes.csv`, `extra`'s pictures, `adapt.csv`, and
-    /// `summary.json` with the adaptive totals) and moves the set into place.
+    /// `summary.json` with the adaptive totals) for the last step `outcome`, and moves the
+    /// set into place.
     pub fn finish(
         self,
         case: &Case,
-        run: &AdaptRun,
-        start_vertices: usize,
+        outcome: &Outcome,
+        history: AdaptHistory<'_>,
         options: &WriteOptions,
         extra: &mut dyn FnMut(&Path, &NodalFields) -> Result<Vec<String>>,
     ) -> Result<Summary> {
@@ -107,13 +107,13 @@ impl AdaptSet {
             run_id: Some(self.run_id.clone()),
             cell_data: vec![(
                 "estimator".into(),
-                run.indicators.iter().map(|e| e.sqrt()).collect(),
+                history.indicators.iter().map(|e| e.sqrt()).collect(),
             )],
-            adapt: Some(adapt_totals(run, start_vertices)),
+            adapt: Some(history.totals.clone()),
             ..options.clone()
         };
-        let summary = write_files(self.set.dir(), &run.outcome, case, &options, &mut |dir, f| {
-            write_adapt_csv(&dir.join(ADAPT_CSV), &run.rows)?;
+        let summary = write_files(self.set.dir(), outcome, case, &options, &mut |dir, f| {
+            write_adapt_csv(&dir.join(ADAPT_CSV), history.rows)?;
             let mut names = extra(dir, f)?;
             names.push(ADAPT_CSV.to_string());
             Ok(names)

@@ -18,7 +18,7 @@ mod sweep;
 #[cfg(test)]
 mod tests;
 
-pub use adapt::{adapt_totals, write_adapt_csv, AdaptSet, ADAPT_CSV};
+pub use adapt::{write_adapt_csv, AdaptHistory, AdaptSet, ADAPT_CSV};
 pub use manifest::{write_manifest, Manifest, MANIFEST};
 pub use result::{
     file_record, input_hash, new_run_id, write_fields, write_files, write_result_set, WriteOptions,

@@ -241,7 +241,16 @@ pub fn write_files(
     let run_id = options.run_id.clone().unwrap_or_else(new_run_id);
     // The input's hash reads the mesh file again: alongside the writing, not after it.
     let (written, hash) = rayon::join(
-        || write_fields(dir, outcome, &fields, options.vtu, &run_id, &options.cell_data),
+        || {
+            write_fields(
+                dir,
+                outcome,
+                &fields,
+                options.vtu,
+                &run_id,
+                &options.cell_data,
+            )
+        },
         || input_hash(case),
     );
     let written = written?;
