@@ -13,7 +13,7 @@ VENV=target/test-venv
 rm -rf "$VENV"
 "$PYTHON" -m venv "$VENV"
 "$VENV/bin/python" -m pip install --quiet --upgrade pip
-"$VENV/bin/python" -m pip install --quiet ./crates/memcontact-py pytest dask distributed
+"$VENV/bin/python" -m pip install --quiet ./crates/memcontact-py pytest dask distributed meshio
 TARGET="$(cargo metadata --format-version 1 --no-deps | "$VENV/bin/python" -c 'import json, sys; print(json.load(sys.stdin)["target_directory"])')"
 cd crates/memcontact-py
 MEMCONTACT_BIN="$TARGET/release/memcontact" "../../$VENV/bin/python" -m pytest -q -p no:cacheprovider tests
