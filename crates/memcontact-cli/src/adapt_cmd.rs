@@ -2,9 +2,10 @@
 //! per step, and its result set (the final step's files, `adapt.csv`, `mesh.png`, and with
 //! `[output] keep_steps` every step's files in `step-NNN/`).
 
-use crate::commands::{print_warnings, SolveFlags};
 use crate::progress::Progress;
 use crate::report;
+use crate::report::print_warnings;
+use crate::solve_flags::SolveFlags;
 use anyhow::{bail, Result};
 use memcontact::outcome::{AdaptRow, Outcome};
 use memcontact::solve::{IterationRecord, Observer};

@@ -1,34 +1,14 @@
 //! The `solve` and `check` commands: thin shells over the library's run.
 
 use crate::progress::{Progress, Verbosity};
-use crate::report;
+use crate::report::{self, print_warnings};
+pub use crate::solve_flags::SolveFlags;
 use anyhow::{bail, Result};
 use memcontact::write::WriteOptions;
 use memcontact::{Case, Discretization, Outcome};
 use memcontact_plot::write::{self, SweepWriter};
 use std::path::Path;
 use std::time::Instant;
-
-/// Prints the mesh reader's warnings.
-pub fn print_warnings(d: &Discretization) {
-    for w in &d.warnings {
-        eprintln!("warning: {w}");
-    }
-}
-
-/// How `memcontact solve` writes its results.
-pub struct SolveFlags<'a> {
-    /// The output directory.
-    pub out: &'a Path,
-    /// `--set` overrides.
-    pub sets: &'a [String],
-    /// How much progress to show.
-    pub verbosity: Verbosity,
-    /// Replace an output directory holding other files.
-    pub force: bool,
-    /// Write the result files of a solve that did not converge (marked in summary.json).
-    pub write_unconverged: bool,
-}
 
 /// `memcontact solve`.
 pub fn solve(case_path: &Path, flags: &SolveFlags) -> Result<()> {

@@ -11,6 +11,7 @@ mod plot_cmd;
 mod progress;
 mod report;
 mod signals;
+mod solve_flags;
 
 use clap::{Parser, Subcommand};
 use std::path::PathBuf;

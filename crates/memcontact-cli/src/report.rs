@@ -2,9 +2,16 @@
 //! the library's (`memcontact::write`), with their pictures (`memcontact_plot::write`).
 
 use memcontact::mesh::{Mesh, MeshQuality};
-use memcontact::{Outcome, Summary};
+use memcontact::{Discretization, Outcome, Summary};
 use std::fmt::Write as _;
 use std::path::Path;
+
+/// Prints the mesh reader's warnings.
+pub fn print_warnings(d: &Discretization) {
+    for w in &d.warnings {
+        eprintln!("warning: {w}");
+    }
+}
 
 /// The mesh report of `check` and `solve`.
 pub fn mesh_report(mesh: &Mesh, q: &MeshQuality, levels: usize) -> String {
