@@ -14,11 +14,14 @@
 //! ```
 //!
 //! - [`mod@run`] holds the only places that run: [`run::run`] (a case of one step),
-//!   [`run::run_sweep`] (its load steps or load cases in turn), and, beside the pipeline,
+//!   [`run::run_sweep`] (its load steps or load cases in turn), [`run::run_adapt`] (the
+//!   adaptive loop: solve, [`estimate`], mark and bisect in [`mesh`], solve again), and,
+//!   beside the pipeline,
 //!   [`verify::study::run_study`] (a convergence study with the exact solutions of
 //!   [`verify::exact`] and the norms of [`verify::norms`]). The command-line tool and the
 //!   Python module call these and the writers of [`mod@write`]; they run nothing themselves.
-//! - Below the pipeline: [`mesh`] (meshes, generators, refinement, renumbering), [`field`]
+//! - Below the pipeline: [`mesh`] (meshes, generators, refinement, bisection and marking,
+//!   renumbering), [`field`]
 //!   (the data f, φ, h and their expressions), [`fem`] (P1 elements), [`io`] (Gmsh, VTU,
 //!   CSV, JSON, atomic result sets), [`sparse`], [`quadrature`], [`limits`] (memory),
 //!   [`parallel`] (the worker pool and the cancellation token), [`error`].
