@@ -252,3 +252,26 @@ fn a_gmsh_mesh_with_boundary_regions_adapts_and_keeps_them() {
         "the domain is the same: {area} vs {area0}"
     );
 }
+
+#[test]
+fn the_lumped_foundation_adapts_too() {
+    let out = tmp_in("adapt", "lumped");
+    let o = run(&[
+        "solve",
+        &example(),
+        "-o",
+        out.to_str().unwrap(),
+        "-q",
+        "--set",
+        "obstacle.foundation=lumped",
+        "--set",
+        "adapt.max_vertices=5000",
+    ]);
+    assert!(o.status.success(), "{}", text(&o));
+    let rows = adapt_rows(&out);
+    assert!(rows.len() >= 5);
+    assert!(rows.iter().all(|r| num(r, "kkt_residual") <= 1e-10));
+    let (first, last) = (&rows[0], rows.last().unwrap());
+    assert!(num(last, "estimator") < num(first, "estimator") / 3.0);
+    assert_eq!(summary(&out)["foundation"], "lumped");
+}
