@@ -183,6 +183,9 @@ pub fn check(case_path: &Path, sets: &[String]) -> Result<()> {
     let d = Discretization::new(&case.problem, &mut Progress::new(Verbosity::Quiet))?;
     memcontact::run::check_case_on_mesh(&case, d.mesh(), true)?;
     d.check_memory(&case.settings)?;
+    if let Some(a) = &case.adapt {
+        memcontact::run::check_adapt_on_mesh(a, d.mesh())?;
+    }
     print_warnings(&d);
     let mesh = d.mesh();
     println!("case {}: valid", case_path.display());
@@ -208,6 +211,25 @@ pub fn check(case_path: &Path, sets: &[String]) -> Result<()> {
             steps.len(),
             write::steps_kind(&case),
             names.join(", ")
+        );
+    }
+    if let Some(a) = &case.adapt {
+        println!(
+            "  adaptive     from this mesh, at most {} steps{}, θ = {}, free-boundary rings {}{}",
+            a.steps,
+            a.max_vertices
+                .map(|m| format!(
+                    " and {m} vertices (about {} to solve)",
+                    memcontact::limits::human_bytes(memcontact::limits::run_bytes(
+                        memcontact::limits::MeshSize::simply_connected(m as f64, 2.0 * m as f64)
+                    ))
+                ))
+                .unwrap_or_default(),
+            a.theta,
+            a.free_boundary_rings,
+            a.tolerance
+                .map(|t| format!(", until the estimator is at most {t:e}"))
+                .unwrap_or_default()
         );
     }
     let (method, choice) = d.auto_choice();

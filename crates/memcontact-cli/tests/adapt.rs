@@ -171,7 +171,31 @@ fn bad_adapt_settings_are_refused_naming_the_key_and_nothing_is_written() {
         assert!(text(&o).contains(key), "{set}: {}", text(&o));
         assert!(!text(&o).contains("panicked"), "{set}: {}", text(&o));
         assert!(!out.exists(), "{set}: something was written");
+        // `check` finds the same, and says nothing is valid.
+        let o = run(&["check", &example(), "--set", set]);
+        assert!(!o.status.success(), "check accepted {set}");
+        assert!(
+            text(&o).contains(key) && !text(&o).contains(": valid"),
+            "{set}: {}",
+            text(&o)
+        );
     }
+    // A mesh of more vertices than memory or 32-bit indices allow is refused up front.
+    let o = run(&[
+        "check",
+        &example(),
+        "--set",
+        "adapt.max_vertices=100000000000",
+    ]);
+    assert!(!o.status.success());
+    assert!(text(&o).contains("adapt.max_vertices"), "{}", text(&o));
+    let o = run(&["check", &example()]);
+    assert!(o.status.success(), "{}", text(&o));
+    assert!(
+        text(&o).contains("adaptive     from this mesh, at most 20 steps and 30000 vertices"),
+        "{}",
+        text(&o)
+    );
     // [adapt] with the steps of a sweep or load cases: refused with the reason.
     let base = std::fs::read_to_string(example()).unwrap();
     for (name, extra) in [

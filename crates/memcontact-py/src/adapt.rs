@@ -164,7 +164,7 @@ impl PyAdapt {
     }
 
     /// Why the loop stopped: `tolerance`, `steps`, `max_vertices`, `not_accepted` or
-    /// `estimator_not_finite`.
+    /// `estimator_not_finite` or `memory`.
     #[getter]
     fn stop(&self) -> String {
         self.totals.adapt_stop.clone()

@@ -216,7 +216,7 @@ class Adapt:
     @property
     def stop(self) -> str:
         """Why the loop stopped: ``tolerance``, ``steps``, ``max_vertices``,
-        ``not_accepted`` or ``estimator_not_finite``."""
+        ``not_accepted``, ``estimator_not_finite`` or ``memory``."""
         ...
     @property
     def interpolated(self) -> List[str]:

@@ -209,7 +209,7 @@ pub struct AdaptTotals {
     /// Seconds of all steps together (refinement, assembly, solve, estimate).
     pub adapt_seconds: f64,
     /// Why the loop stopped: `tolerance`, `steps`, `max_vertices`, `not_accepted`,
-    /// `estimator_not_finite`.
+    /// `estimator_not_finite`, `memory`.
     pub adapt_stop: String,
     /// The data given per vertex that were interpolated (P1) onto the new vertices.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]

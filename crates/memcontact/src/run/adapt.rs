@@ -20,7 +20,7 @@
 //!   so ([`AdaptRun::interpolated`]).
 
 use super::checks::check_case_on_mesh;
-use crate::case::Case;
+use crate::case::{AdaptSpec, Case};
 use crate::discretization::{build_mesh, BoundData, Discretization};
 use crate::error::{Error, Invalid, Result};
 use crate::estimate::estimate;
@@ -46,6 +46,8 @@ pub enum AdaptStop {
     NotAccepted,
     /// A step's estimator was not a finite number (the step before it is the last).
     EstimatorNotFinite,
+    /// The next mesh would not fit in the memory available (the error says how much).
+    Memory,
 }
 
 impl AdaptStop {
@@ -57,6 +59,7 @@ impl AdaptStop {
             AdaptStop::MaxVertices => "max_vertices",
             AdaptStop::NotAccepted => "not_accepted",
             AdaptStop::EstimatorNotFinite => "estimator_not_finite",
+            AdaptStop::Memory => "memory",
         }
     }
 }
@@ -72,7 +75,8 @@ pub struct AdaptRun {
     pub indicators: Vec<f64>,
     /// Why the loop stopped.
     pub stop: AdaptStop,
-    /// The error that stopped it (a solve not accepted, an estimator not finite).
+    /// The error that stopped it (a solve not accepted, an estimator not finite, a mesh
+    /// beyond the memory available).
     pub error: Option<Error>,
     /// The keys of the data given per vertex that were interpolated onto new vertices.
     pub interpolated: Vec<String>,
@@ -128,20 +132,7 @@ pub fn run_adapt(
     // The refinement edge of every triangle: its longest (once, on the start mesh).
     let labelled = bisect::label_longest_edge(hierarchy.finest());
     *hierarchy.levels.last_mut().expect("a level") = labelled;
-    let start_vertices = hierarchy.finest().n_vertices();
-    if let Some(max) = spec.max_vertices {
-        if max < start_vertices {
-            return Err(Error::Case {
-                file: None,
-                line: None,
-                key: "adapt.max_vertices".into(),
-                message: format!(
-                    "is {max}, below the start mesh's {start_vertices} vertices: raise it, or \
-                     start from a coarser mesh"
-                ),
-            });
-        }
-    }
+    check_adapt_on_mesh(&spec, hierarchy.finest())?;
     let mut problem = case.problem.clone();
     let mut interpolated = Vec::new();
     let mut start: Option<Vec<f64>> = None;
@@ -227,6 +218,13 @@ pub fn run_adapt(
         {
             break (AdaptStop::MaxVertices, None);
         }
+        if let Err(e) = crate::limits::check_mesh_fits(
+            crate::limits::MeshSize::of(&b.mesh),
+            0,
+            &format!("the adaptive loop's step {}", step + 1),
+        ) {
+            break (AdaptStop::Memory, Some(e));
+        }
         start = Some(b.refinement.prolongate(&u_user));
         interpolate_nodal(&mut problem, &b.refinement, &mut interpolated);
         hierarchy.levels.push(b.mesh);
@@ -244,6 +242,34 @@ pub fn run_adapt(
         problem,
         seconds: started.elapsed().as_secs_f64(),
     })
+}
+
+/// The checks of `[adapt]` that need the start mesh: `max_vertices` at least its vertices,
+/// and a mesh of `max_vertices` vertices within the memory available. `check` and the
+/// loop call it.
+pub fn check_adapt_on_mesh(spec: &AdaptSpec, start: &Mesh) -> Result<()> {
+    let Some(max) = spec.max_vertices else {
+        return Ok(());
+    };
+    let start_vertices = start.n_vertices();
+    if max < start_vertices {
+        return Err(Error::Case {
+            file: None,
+            line: None,
+            key: "adapt.max_vertices".into(),
+            message: format!(
+                "is {max}, below the start mesh's {start_vertices} vertices: raise it, or \
+                 start from a coarser mesh"
+            ),
+        });
+    }
+    // A triangulation has about twice as many triangles as vertices.
+    let m = max as f64;
+    crate::limits::check_mesh_fits(
+        crate::limits::MeshSize::simply_connected(m, 2.0 * m),
+        0,
+        &format!("adapt.max_vertices = {max}"),
+    )
 }
 
 /// η_T² of a solved step, per triangle in the user's order.
