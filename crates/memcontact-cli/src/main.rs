@@ -1,6 +1,7 @@
 //! `memcontact`: the command-line tool. Parses arguments, reads the case, runs the library,
 //! prints a summary and writes the outputs. All the numerics live in the library.
 
+mod alloc_trace;
 mod bench_cmd;
 mod commands;
 mod convergence;
@@ -17,7 +18,8 @@ use std::process::ExitCode;
 /// mimalloc keeps freed memory for reuse: the solver's large work vectors are not handed
 /// back to the kernel and faulted in again page by page on every allocation.
 #[global_allocator]
-static ALLOCATOR: mimalloc::MiMalloc = mimalloc::MiMalloc;
+static ALLOCATOR: alloc_trace::Tracing<mimalloc::MiMalloc> =
+    alloc_trace::Tracing(mimalloc::MiMalloc);
 
 /// Contact between a stretched membrane and an elastic (Winkler) obstacle: the discrete
 /// model of Maceri & Maceri (1986), solved exactly and certified.
@@ -153,6 +155,7 @@ fn small_pages_only() {
 
 fn main() -> ExitCode {
     small_pages_only();
+    alloc_trace::enable();
     let cli = Cli::parse();
     if let Some(n) = cli.threads {
         let pool = rayon::ThreadPoolBuilder::new()
