@@ -145,6 +145,7 @@ pub fn run_case(case: &Case, scratch: &Path, pictures: bool) -> Result<CaseRun> 
     let options = WriteOptions {
         label: "bench".into(),
         vtu: case.output.vtu,
+        csv: case.output.writes_csv(),
         force: true,
         started,
         plot_options: None,

@@ -65,6 +65,7 @@ pub fn solve(case_path: &Path, flags: &SolveFlags) -> Result<()> {
     let options = WriteOptions {
         label,
         vtu: case.output.vtu,
+        csv: case.output.writes_csv(),
         force: flags.force,
         started,
         plot_options: None,
@@ -88,6 +89,9 @@ pub fn solve(case_path: &Path, flags: &SolveFlags) -> Result<()> {
     }
     // The process ends right after this: returning the (possibly gigabytes of) mesh
     // levels and matrices to the allocator page by page would only delay the exit.
+    if flags.verbosity == Verbosity::Verbose {
+        crate::alloc_trace::report("end of solve command");
+    }
     std::mem::forget(outcome);
     Ok(())
 }

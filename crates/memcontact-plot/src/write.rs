@@ -240,6 +240,7 @@ impl SweepWriter {
         let options = WriteOptions {
             label,
             vtu: self.vtu,
+            csv: case.output.writes_csv(),
             force: false,
             started: now
                 .checked_sub(Duration::from_secs_f64(seconds.max(0.0)))

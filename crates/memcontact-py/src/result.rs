@@ -400,6 +400,7 @@ impl PyResult_ {
                 let options = WriteOptions {
                     label: self.data.label.clone(),
                     vtu,
+                    csv: self.data.case.output.writes_csv(),
                     force,
                     started: now
                         .checked_sub(Duration::from_secs_f64(self.data.seconds))

@@ -51,6 +51,8 @@ pub struct WriteOptions {
     pub label: String,
     /// The encoding of `solution.vtu`.
     pub vtu: VtuFormat,
+    /// Write `nodes.csv` (`[output] csv`).
+    pub csv: bool,
     /// Replace a directory that holds files other than a memcontact result.
     pub force: bool,
     /// When the run started (for `time_total_s`).
@@ -151,6 +153,7 @@ pub fn write_fields(
     outcome: &Outcome,
     fields: &NodalFields,
     vtu: VtuFormat,
+    csv: bool,
     run_id: &str,
 ) -> Result<Vec<(String, FileRecord)>> {
     let mesh = outcome.mesh();
@@ -209,12 +212,13 @@ pub fn write_fields(
                 &[("run_id", run_id)],
             )
         },
-        || write_columns_csv(&dir.join("nodes.csv"), &columns),
+        || csv.then(|| write_columns_csv(&dir.join("nodes.csv"), &columns)),
     );
-    Ok(vec![
-        ("solution.vtu".to_string(), vtu_written?.into()),
-        ("nodes.csv".to_string(), csv_written?.into()),
-    ])
+    let mut files = vec![("solution.vtu".to_string(), vtu_written?.into())];
+    if let Some(written) = csv_written {
+        files.push(("nodes.csv".to_string(), written?.into()));
+    }
+    Ok(files)
 }
 
 /// Writes the files of `outcome` into the directory `dir` (which must exist and is not
@@ -239,7 +243,7 @@ pub fn write_files(
     let run_id = options.run_id.clone().unwrap_or_else(new_run_id);
     // The input's hash reads the mesh file again: alongside the writing, not after it.
     let (written, hash) = rayon::join(
-        || write_fields(dir, outcome, &fields, options.vtu, &run_id),
+        || write_fields(dir, outcome, &fields, options.vtu, options.csv, &run_id),
         || input_hash(case),
     );
     let written = written?;

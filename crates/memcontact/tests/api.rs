@@ -192,6 +192,7 @@ fn a_result_set_is_written_and_read_back_without_the_cli() {
     let options = WriteOptions {
         label: "square".into(),
         vtu: case.output.vtu,
+        csv: case.output.writes_csv(),
         force: false,
         started: Instant::now(),
         plot_options: None,
