@@ -129,6 +129,11 @@ pub enum NewtonMatrix {
     /// the diagonal and in the truncated rows and columns: the diagonal added to S alone,
     /// read with S as a [`Shifted`](super::multigrid::operator::Shifted) operator (one vector instead of a copy of S's values).
     Diagonal(Vec<f64>),
+    /// The paper's model (no body below, no rigid regions) with a lumped foundation: the
+    /// diagonal added to S is `l_i` on the penetrating unknowns, read from the model and
+    /// the states ([`LumpedShifted`](super::multigrid::operator::LumpedShifted)); nothing
+    /// is stored.
+    Implicit,
 }
 
 impl NewtonMatrix {
@@ -137,6 +142,8 @@ impl NewtonMatrix {
         let consistent = |l: &FoundationMatrix| matches!(l, FoundationMatrix::Consistent(_));
         if consistent(&model.l) || model.lower.as_ref().is_some_and(|b| consistent(&b.l)) {
             NewtonMatrix::Assembled(Csr::zeros(model.s.pattern.clone()))
+        } else if !model.is_extended() && matches!(model.l, FoundationMatrix::Lumped(_)) {
+            NewtonMatrix::Implicit
         } else {
             NewtonMatrix::Diagonal(zeroed(model.n()))
         }
@@ -156,6 +163,7 @@ impl NewtonMatrix {
         let target = match self {
             NewtonMatrix::Assembled(a) => Hessian::Rows(a, rows),
             NewtonMatrix::Diagonal(d) => Hessian::Diagonal(d),
+            NewtonMatrix::Implicit => Hessian::None,
         };
         newton_system_into(model, v, st, target, g, r)
     }
@@ -167,6 +175,8 @@ enum Hessian<'x> {
     Rows(&'x mut Csr, Option<&'x [bool]>),
     /// The diagonal added to S (lumped and rigid foundations only), zero on truncated rows.
     Diagonal(&'x mut [f64]),
+    /// Not stored (the gradient and `r` only).
+    None,
 }
 
 /// [`newton_system`] into either form of the Hessian.
@@ -326,6 +336,25 @@ fn newton_system_with<const EXT: bool>(
                     .for_each(work);
             }
         }
+        Hessian::None => {
+            type Block<'a> = (&'a mut [f64], &'a mut [f64]);
+            let work = |(block, (gc, rc)): (usize, Block)| {
+                for (k, (gi, ri)) in gc.iter_mut().zip(rc).enumerate() {
+                    gradient(block * CHUNK + k, gi, ri);
+                }
+            };
+            if v.len() >= PAR_ROWS {
+                g.par_chunks_mut(CHUNK)
+                    .zip(r.par_chunks_mut(CHUNK))
+                    .enumerate()
+                    .for_each(work);
+            } else {
+                g.chunks_mut(CHUNK)
+                    .zip(r.chunks_mut(CHUNK))
+                    .enumerate()
+                    .for_each(work);
+            }
+        }
         Hessian::Diagonal(d) => {
             type Block<'a> = (&'a mut [f64], (&'a mut [f64], &'a mut [f64]));
             let work = |(block, (dc, (gc, rc))): (usize, Block)| {
@@ -481,6 +510,20 @@ mod tests {
                     let op = crate::solve::multigrid::operator::Shifted {
                         s: &model.s,
                         shift: d,
+                        held: &st.truncated,
+                    };
+                    let mut vals = vec![0.0; a.val.len()];
+                    crate::solve::multigrid::operator::values_into(&op, &mut vals);
+                    for (p, q) in vals.iter().zip(&a.val) {
+                        assert!((p - q).abs() <= 1e-12 * q.abs(), "{p} against {q}");
+                    }
+                }
+                (NewtonMatrix::Implicit, Foundation::Lumped) => {
+                    let FoundationMatrix::Lumped(l) = &model.l else { unreachable!() };
+                    let op = crate::solve::multigrid::operator::LumpedShifted {
+                        s: &model.s,
+                        l,
+                        penetrating: &st.penetrating,
                         held: &st.truncated,
                     };
                     let mut vals = vec![0.0; a.val.len()];
