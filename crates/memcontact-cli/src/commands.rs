@@ -36,13 +36,39 @@ pub fn solve(case_path: &Path, flags: &SolveFlags) -> Result<()> {
     let case = Case::load(case_path, flags.sets)?;
     let label = case_path.display().to_string();
     let mut progress = Progress::new(flags.verbosity);
-    let discretization = Discretization::new(&case.problem, &mut progress)?;
+    let mut discretization = Discretization::new(&case.problem, &mut progress)?;
     // Everything that needs the mesh is checked before anything is solved.
     write::check_on_mesh(&case, discretization.mesh())?;
     if case.is_sweep() {
         return sweep(&label, &case, discretization, flags, progress, started);
     }
+    // PROTOTYPE (issue 36): a single solve needs of the coarser mesh levels only their
+    // vertex counts and the refinement relations (multigrid's transfers), and nothing of
+    // them once solved; nor does writing need S. Released before the phase that does not
+    // need them (one solve: nothing else reads them).
+    let thin = std::env::var_os("MEMCONTACT_NO_RELEASE").is_none();
+    if thin {
+        let last = discretization.hierarchy.levels.len() - 1;
+        for m in &mut discretization.hierarchy.levels[..last] {
+            m.triangles = Vec::new();
+            m.regions = Vec::new();
+        }
+    }
     let report = discretization.solve(&case.settings, &mut progress)?;
+    if thin && report.derived.is_some() {
+        let last = discretization.hierarchy.levels.len() - 1;
+        for m in &mut discretization.hierarchy.levels[..last] {
+            m.points = Vec::new();
+        }
+        discretization.hierarchy.refinements = Vec::new();
+        discretization.model.s = memcontact::sparse::Csr {
+            pattern: std::sync::Arc::new(memcontact::sparse::Pattern {
+                row_ptr: vec![0],
+                col: Vec::new(),
+            }),
+            val: Vec::new(),
+        };
+    }
     progress.finish();
     let outcome = Outcome {
         discretization,
