@@ -20,6 +20,17 @@ use std::sync::Arc;
 /// Below this many rows, loops run serially (threads cost more than they save).
 pub(crate) const PAR_ROWS: usize = 16_384;
 
+/// The weights a fine unknown can have for its two parents.
+const WEIGHTS: [[f32; 2]; 4] = [[0.0, 0.0], [1.0, 0.0], [0.5, 0.5], [0.5, 0.0]];
+
+/// The index of `w` in [`WEIGHTS`].
+fn weight_code(w: [f32; 2]) -> u8 {
+    WEIGHTS
+        .iter()
+        .position(|&x| x == w)
+        .expect("prolongation weights are 0, ½ or 1") as u8
+}
+
 /// The prolongation `P` from a coarse level's unknowns to a fine level's unknowns.
 #[derive(Debug, Clone)]
 pub struct Transfer {
@@ -29,16 +40,16 @@ pub struct Transfer {
     /// the first with weight 0, so that loops need no branch; a fine unknown with no
     /// interior parent at all has weights `[0, 0]`.
     pub parents: Vec<[u32; 2]>,
-    /// The weights of `parents` (½ and ½, or 1 and 0, or 0 where a parent was dropped).
-    /// Single precision holds them exactly, in half the memory.
-    pub weights: Vec<[f32; 2]>,
+    /// The weights of `parents` (½ and ½, or 1 and 0, or 0 where a parent was dropped), as
+    /// an index into [`WEIGHTS`]: one byte per fine unknown instead of eight.
+    weight_code: Vec<u8>,
     /// Columns of P: the children of coarse unknown `I` are
     /// `children[child_ptr[I]..child_ptr[I + 1]]`, in increasing order.
     pub child_ptr: Vec<usize>,
     /// Fine unknowns, grouped by coarse parent.
     pub children: Vec<u32>,
-    /// `P[child, I]` for every entry of `children` (exact in single precision).
-    pub child_weights: Vec<f32>,
+    /// `P[child, I]` for every entry of `children`: 1 (code 0) or ½ (code 1).
+    child_code: Vec<u8>,
     /// Every fine unknown has at most one parent (an aggregation): the second parents
     /// need not be visited.
     pub single_parent: bool,
@@ -122,17 +133,39 @@ impl Transfer {
             [0, 1].map(|s| (w[s] != 0.0).then_some((p[s], (v as u32, w[s]))))
         });
         let children = entries.par_iter().with_min_len(4096).map(|e| e.0).collect();
-        let child_weights = entries.par_iter().with_min_len(4096).map(|e| e.1).collect();
+        let child_code = entries
+            .par_iter()
+            .with_min_len(4096)
+            .map(|e| {
+                let w = e.1;
+                assert!(w == 1.0 || w == 0.5, "a child's weight is 1 or ½, not {w}");
+                (w == 0.5) as u8
+            })
+            .collect();
+        drop(entries);
         let single_parent = weights.par_iter().with_min_len(4096).all(|w| w[1] == 0.0);
+        let weight_code = weights.par_iter().with_min_len(4096).map(|&w| weight_code(w)).collect();
         Transfer {
             n_coarse,
             parents,
-            weights,
+            weight_code,
             child_ptr,
             children,
-            child_weights,
+            child_code,
             single_parent,
         }
+    }
+
+    /// The weights of fine unknown `v`'s two parents.
+    #[inline(always)]
+    pub fn weights(&self, v: usize) -> [f32; 2] {
+        WEIGHTS[self.weight_code[v] as usize]
+    }
+
+    /// `P[children[k], I]` for the entry `k` of the columns.
+    #[inline(always)]
+    fn child_weight(&self, k: usize) -> f32 {
+        [1.0, 0.5][self.child_code[k] as usize]
     }
 
     /// Number of fine unknowns (rows of P).
@@ -144,7 +177,7 @@ impl Transfer {
     #[inline]
     fn row(&self, v: usize, xc: &[f64]) -> f64 {
         let [a, b] = self.parents[v];
-        let [wa, wb] = self.weights[v];
+        let [wa, wb] = self.weights(v);
         f64::from(wa) * xc[a as usize] + f64::from(wb) * xc[b as usize]
     }
 
@@ -170,7 +203,7 @@ impl Transfer {
         par_rows(rc, |i, r| {
             let mut s = 0.0;
             for k in self.child_ptr[i]..self.child_ptr[i + 1] {
-                s += f64::from(self.child_weights[k]) * rf[self.children[k] as usize];
+                s += f64::from(self.child_weight(k)) * rf[self.children[k] as usize];
             }
             *r = s;
         });
@@ -182,7 +215,7 @@ impl Transfer {
         (0..self.n_coarse)
             .map(|i| {
                 (self.child_ptr[i]..self.child_ptr[i + 1])
-                    .find(|&k| self.child_weights[k] == 1.0)
+                    .find(|&k| self.child_weight(k) == 1.0)
                     .map_or(self.children[self.child_ptr[i]], |k| self.children[k])
             })
             .collect()
@@ -209,7 +242,7 @@ impl Transfer {
                 for &v in &self.children[self.child_ptr[i]..self.child_ptr[i + 1]] {
                     let v = v as usize;
                     for &w in &fine.col[fine.row_ptr[v]..fine.row_ptr[v + 1]] {
-                        let (p, wt) = (self.parents[w as usize], self.weights[w as usize]);
+                        let (p, wt) = (self.parents[w as usize], self.weights(w as usize));
                         for s in 0..2 {
                             if wt[s] != 0.0 && seen[p[s] as usize] != i as u32 {
                                 seen[p[s] as usize] = i as u32;
@@ -273,7 +306,7 @@ impl Transfer {
                 if !A::PLAIN && op.held(v) {
                     continue; // a zero row
                 }
-                let wv = f64::from(self.child_weights[c]);
+                let wv = f64::from(self.child_weight(c));
                 let (s, e) = (fpat.row_ptr[v], fpat.row_ptr[v + 1]);
                 for (&w, &a) in fpat.col[s..e].iter().zip(&fine.val[s..e]) {
                     let a = entry(op, v, w as usize, a);
@@ -283,7 +316,7 @@ impl Transfer {
                     let a = a * wv;
                     let w = w as usize;
                     let [p0, p1] = self.parents[w];
-                    let [w0, w1] = self.weights[w].map(f64::from);
+                    let [w0, w1] = self.weights(w).map(f64::from);
                     if w0 != 0.0 {
                         vals[marker[p0 as usize] as usize] += a * w0;
                         // A dropped second parent repeats the first with weight 0.
