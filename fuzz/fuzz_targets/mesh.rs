@@ -11,7 +11,7 @@ use libfuzzer_sys::fuzz_target;
 use memcontact::field::Field;
 use memcontact::mesh::refine::Hierarchy;
 use memcontact::mesh::Mesh;
-use memcontact::model::{Foundation, Model, ProblemData, Sampling, Stiffness};
+use memcontact::model::{Foundation, Model, ProblemData, Sampling, BodyStiffness};
 use memcontact::solve::{self, Method, Settings, Silent};
 use std::collections::BTreeMap;
 
@@ -64,7 +64,7 @@ fuzz_target!(|data: &[u8]| {
         tension: 1.0,
         load: &load,
         shape: &shape,
-        stiffness: Stiffness::Elastic(&h),
+        stiffness: BodyStiffness::Elastic(&h),
         foundation: Foundation::Consistent,
         sampling: Sampling::Nodal,
     };

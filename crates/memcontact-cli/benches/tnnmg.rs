@@ -1,16 +1,16 @@
 //! `cargo bench -p memcontact-cli --bench tnnmg [-- N1 N2 ...] [-- --lumped|--consistent]`:
-//! the standard benchmark table of `memcontact bench` (see `memcontact::bench`). Sizes default to
+//! the standard benchmark table of `memcontact bench` (see `memcontact_cli::bench::standard`). Sizes default to
 //! 128 … 2048 cells per side. Environment: `MEMCONTACT_PHASES=1` prints the phases,
 //! `MEMCONTACT_NESTED_TOL`, `MEMCONTACT_CYCLES`, `MEMCONTACT_SMOOTHING`,
 //! `MEMCONTACT_NO_NESTED` override the TNNMG options.
 
-use memcontact::bench::{run_bench, BenchRow};
+use memcontact_cli::bench::standard::{run_bench, BenchRow};
 
 /// The allocator of the `memcontact` binary, so that the kernels are timed as it runs them.
 #[global_allocator]
 static ALLOCATOR: mimalloc::MiMalloc = mimalloc::MiMalloc;
 use memcontact::model::Foundation;
-use memcontact::solve::multigrid::Options;
+use memcontact::solve::multigrid::TnnmgOptions;
 
 /// `-- --micro N`: times the kernels of one TNNMG iteration on the N × N benchmark mesh
 /// and its geometric levels (with `--mesh FILE` instead of N: on a Gmsh mesh renumbered as
@@ -28,7 +28,7 @@ fn micro(args: &[String]) {
         }
         None => {
             let n = args.iter().find_map(|a| a.parse().ok()).unwrap_or(1024);
-            memcontact::bench::mesh(n).unwrap()
+            memcontact_cli::bench::standard::mesh(n).unwrap()
         }
     };
     let coarsening = if h.levels.len() > 1 {
@@ -37,8 +37,9 @@ fn micro(args: &[String]) {
         Coarsening::Algebraic
     };
     for f in [Foundation::Lumped, Foundation::Consistent] {
-        let m = memcontact::bench::model(h.finest(), f).unwrap();
-        let t = kernel_timings(&m, coarsening, 10).unwrap();
+        let m = memcontact_cli::bench::standard::model(h.finest(), f).unwrap();
+        let cpu = || memcontact_cli::bench::proc::cpu_seconds().unwrap_or(f64::NAN);
+        let t = kernel_timings(&m, coarsening, 10, &cpu).unwrap();
         println!("{}:                      wall ms   cpu ms", f.name());
         for (name, ms, cpu) in t {
             println!("  {name:<24} {ms:8.2} {cpu:8.2}");
@@ -63,18 +64,22 @@ fn assembly(args: &[String]) {
                 .iter()
                 .find_map(|a| a.parse().ok())
                 .unwrap_or(1024usize);
-            memcontact::bench::mesh(n).unwrap().finest().clone()
+            memcontact_cli::bench::standard::mesh(n)
+                .unwrap()
+                .finest()
+                .clone()
         }
     };
     let reps = 5;
     let time = |name: &str, f: &mut dyn FnMut()| {
-        let c0 = memcontact::bench::cpu_seconds().unwrap_or(f64::NAN);
+        let c0 = memcontact_cli::bench::proc::cpu_seconds().unwrap_or(f64::NAN);
         let t0 = std::time::Instant::now();
         for _ in 0..reps {
             f();
         }
         let wall = t0.elapsed().as_secs_f64() * 1e3 / reps as f64;
-        let cpu = (memcontact::bench::cpu_seconds().unwrap_or(f64::NAN) - c0) * 1e3 / reps as f64;
+        let cpu = (memcontact_cli::bench::proc::cpu_seconds().unwrap_or(f64::NAN) - c0) * 1e3
+            / reps as f64;
         println!("  {name:<28} {wall:8.1} {cpu:8.1}");
     };
     println!(
@@ -117,7 +122,7 @@ fn assembly(args: &[String]) {
     });
     for f in [Foundation::Lumped, Foundation::Consistent] {
         time(&format!("model ({})", f.name()), &mut || {
-            std::hint::black_box(memcontact::bench::model(&mesh, f).unwrap());
+            std::hint::black_box(memcontact_cli::bench::standard::model(&mesh, f).unwrap());
         });
     }
 }
@@ -146,7 +151,7 @@ fn main() {
     println!("{}", memcontact_cli::bench::square_header());
     let phases = std::env::var_os("MEMCONTACT_PHASES").is_some();
     let mut print = |r: &BenchRow| println!("{}", memcontact_cli::bench::square_row(r, phases));
-    let mut options = Options::default();
+    let mut options = TnnmgOptions::default();
     if let Some(t) = std::env::var("MEMCONTACT_NESTED_TOL")
         .ok()
         .and_then(|t| t.parse().ok())

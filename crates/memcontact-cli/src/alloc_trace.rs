@@ -1,4 +1,4 @@
-//! PROFILING AID (issue 36, branch `prof`; not meant for main): the global allocator
+//! A profiling aid, compiled only with the `alloc-trace` feature: the global allocator
 //! wrapped with a count of live bytes and, when `MEMCONTACT_ALLOC_TRACE` is set, a table of
 //! the live allocations of at least 1 MiB with the backtrace that made them. The table is
 //! copied whenever the live bytes reach a new peak (in steps of 16 MiB), so that the
@@ -123,7 +123,9 @@ fn site(bt: &std::backtrace::Backtrace) -> String {
     let mut out = Vec::new();
     for line in text.lines() {
         let l = line.trim();
-        let Some(name) = l.split_once(": ").map(|x| x.1) else { continue };
+        let Some(name) = l.split_once(": ").map(|x| x.1) else {
+            continue;
+        };
         if !name.starts_with("memcontact") || name.contains("alloc_trace") {
             continue;
         }
@@ -171,7 +173,11 @@ pub fn report(label: &str) {
             list.len()
         );
         for (s, (bytes, count)) in v {
-            eprintln!("[alloc]   {:9.1} MiB {:4}x  {s}", bytes as f64 / 1048576.0, count);
+            eprintln!(
+                "[alloc]   {:9.1} MiB {:4}x  {s}",
+                bytes as f64 / 1048576.0,
+                count
+            );
         }
     });
 }

@@ -3,9 +3,10 @@
 //! 1e-10), solved by TNNMG, with one linear Poisson multigrid solve as the yardstick.
 
 use anyhow::{bail, Result};
-use memcontact::bench::{run_bench, stolen_seconds, BenchRow};
 use memcontact::model::Foundation;
-use memcontact::solve::multigrid::Options;
+use memcontact::solve::multigrid::TnnmgOptions;
+use memcontact_cli::bench::proc::stolen_seconds;
+use memcontact_cli::bench::standard::{run_bench, BenchRow};
 use memcontact_cli::bench::{square_header, square_row, stolen_note};
 
 /// Runs the benchmark for `sizes` (cells per side) and the chosen foundations, printing
@@ -33,6 +34,6 @@ pub fn run(sizes: &[usize], foundation: &str, phases: bool) -> Result<()> {
         stolen_before = now;
         println!("{}{}", square_row(r, phases), stolen_note(stolen));
     };
-    run_bench(sizes, &foundations, &Options::default(), &mut print)?;
+    run_bench(sizes, &foundations, &TnnmgOptions::default(), &mut print)?;
     Ok(())
 }

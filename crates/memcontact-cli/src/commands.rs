@@ -1,9 +1,9 @@
 //! The `solve` and `check` commands: thin shells over the library's run.
 
-use crate::output;
 use crate::progress::{Progress, Verbosity};
+use crate::report;
 use anyhow::{bail, Result};
-use memcontact::output::WriteOptions;
+use memcontact::write::WriteOptions;
 use memcontact::{Case, Discretization, Outcome};
 use memcontact_plot::write::{self, SweepWriter};
 use std::path::Path;
@@ -33,56 +33,28 @@ pub struct SolveFlags<'a> {
 /// `memcontact solve`.
 pub fn solve(case_path: &Path, flags: &SolveFlags) -> Result<()> {
     let started = Instant::now();
-    let case = Case::load(case_path, flags.sets)?;
+    let mut case = Case::load(case_path, flags.sets)?;
+    case.settings.cancel = crate::signals::token();
     let label = case_path.display().to_string();
     let mut progress = Progress::new(flags.verbosity);
-    let mut discretization = Discretization::new(&case.problem, &mut progress)?;
-    // Everything that needs the mesh is checked before anything is solved.
-    write::check_on_mesh(&case, discretization.mesh())?;
     if case.is_sweep() {
-        return sweep(&label, &case, discretization, flags, progress, started);
+        return sweep(&label, &case, flags, progress, started);
     }
-    // PROTOTYPE (issue 36): a single solve needs of the coarser mesh levels only their
-    // vertex counts and the refinement relations (multigrid's transfers), and nothing of
-    // them once solved; nor does writing need S. Released before the phase that does not
-    // need them (one solve: nothing else reads them).
-    let thin = std::env::var_os("MEMCONTACT_NO_RELEASE").is_none();
-    if thin {
-        let last = discretization.hierarchy.levels.len() - 1;
-        for m in &mut discretization.hierarchy.levels[..last] {
-            m.triangles = Vec::new();
-            m.regions = Vec::new();
-        }
+    if case.adapt.is_some() {
+        return crate::adapt_cmd::adapt(&label, &case, flags, progress, started);
     }
-    let report = discretization.solve(&case.settings, &mut progress)?;
-    if thin && report.derived.is_some() {
-        let last = discretization.hierarchy.levels.len() - 1;
-        for m in &mut discretization.hierarchy.levels[..last] {
-            m.points = Vec::new();
-        }
-        discretization.hierarchy.refinements = Vec::new();
-        discretization.model.s = memcontact::sparse::Csr {
-            pattern: std::sync::Arc::new(memcontact::sparse::Pattern {
-                row_ptr: vec![0],
-                col: Vec::new(),
-            }),
-            val: Vec::new(),
-        };
-    }
+    // Everything that needs the mesh is checked before anything is solved.
+    let outcome = memcontact::run(&case, &mut progress)?;
     progress.finish();
-    let outcome = Outcome {
-        discretization,
-        report,
-    };
     print_warnings(&outcome.discretization);
     let accepted = outcome.report.accepted;
     if !accepted && !flags.write_unconverged {
-        eprint!("{}", output::human(&label, &outcome, None));
+        eprint!("{}", report::human(&label, &outcome, None));
         bail!(
             "{}; no result files were written (pass --write-unconverged to keep the \
              iterate, marked as not accepted in summary.json){}",
             not_converged(&outcome),
-            output::floor_note(&outcome)
+            report::floor_note(&outcome)
                 .map(|n| format!("\n{n}"))
                 .unwrap_or_default()
         );
@@ -91,18 +63,19 @@ pub fn solve(case_path: &Path, flags: &SolveFlags) -> Result<()> {
     let options = WriteOptions {
         label,
         vtu: case.output.vtu,
-        csv: case.output.writes_csv(),
         force: flags.force,
         started,
         plot_options: None,
         run_id: None,
+        cell_data: Vec::new(),
+        adapt: None,
     };
     let summary = write::write_result(flags.out, &outcome, &case, &options, &plots)?;
     print!(
         "{}",
-        output::human(&options.label, &outcome, Some((&summary, flags.out)))
+        report::human(&options.label, &outcome, Some((&summary, flags.out)))
     );
-    if let Some(note) = output::floor_note(&outcome) {
+    if let Some(note) = report::floor_note(&outcome) {
         eprintln!("{note}");
     }
     if !accepted {
@@ -115,9 +88,6 @@ pub fn solve(case_path: &Path, flags: &SolveFlags) -> Result<()> {
     }
     // The process ends right after this: returning the (possibly gigabytes of) mesh
     // levels and matrices to the allocator page by page would only delay the exit.
-    if flags.verbosity == Verbosity::Verbose {
-        crate::alloc_trace::report("end of solve command");
-    }
     std::mem::forget(outcome);
     Ok(())
 }
@@ -128,48 +98,50 @@ pub fn solve(case_path: &Path, flags: &SolveFlags) -> Result<()> {
 fn sweep(
     label: &str,
     case: &Case,
-    base: Discretization,
     flags: &SolveFlags,
     mut progress: Progress,
     started: Instant,
 ) -> Result<()> {
-    print_warnings(&base);
-    let mut writer =
-        SweepWriter::begin(flags.out, flags.force, case, label, case.output.vtu, true)?;
-    let total = memcontact::sweep::steps(case)?.len();
-    let mut rows = Vec::new();
-    let mut unaccepted = Vec::new();
-    let result = memcontact::sweep::run_sweep_on(
-        case,
-        base,
-        true,
-        &mut progress,
-        &mut |step, outcome, row| {
-            rows.push(row.clone());
-            if !outcome.report.accepted {
-                unaccepted.push(step.name.clone());
-                if !flags.write_unconverged {
-                    return Ok(());
-                }
-            }
-            writer.write_step(case, step, outcome, row.seconds)?;
-            Ok(())
-        },
-    );
+    let total = memcontact::case::steps(case)?.len();
+    // The result set begins with the first step to write: bad input found before any step
+    // is solved leaves nothing behind.
+    let mut writer: Option<SweepWriter> = None;
+    let run = memcontact::run::run_sweep(case, true, &mut progress, &mut |step, outcome, row| {
+        if step.index == 0 {
+            print_warnings(&outcome.discretization);
+        }
+        if !outcome.report.accepted && !flags.write_unconverged {
+            return Ok(());
+        }
+        let w = match &mut writer {
+            Some(w) => w,
+            None => writer.insert(SweepWriter::begin(
+                flags.out,
+                flags.force,
+                case,
+                label,
+                case.output.vtu,
+                true,
+            )?),
+        };
+        w.write_step(case, step, outcome, row.seconds)?;
+        Ok(())
+    })?;
     progress.finish();
-    // Bad input, or a step that did not converge: nothing is written unless the
-    // unconverged step was asked for.
-    let failed = match result {
-        Ok(_) => None,
-        Err(e) if unaccepted.is_empty() => return Err(e.into()),
-        Err(e) if !flags.write_unconverged => bail!(
+    // A step that did not converge: nothing is written unless the unconverged step was
+    // asked for.
+    let failed = match run.stopped {
+        None => None,
+        Some((_, e)) if !flags.write_unconverged => bail!(
             "{e}; no result files were written (pass --write-unconverged to keep the steps \
              solved and the unconverged iterate, marked as not accepted in summary.json)"
         ),
-        Err(e) => Some(e),
+        Some((step, e)) => Some((step, e)),
     };
+    let writer = writer.expect("the first step was written");
     let written = writer.steps_written();
-    writer.finish(&rows)?;
+    writer.finish(&run.rows)?;
+    let rows = &run.rows;
     println!(
         "memcontact: {label} ({}: {total} steps)",
         write::steps_kind(case)
@@ -178,7 +150,7 @@ fn sweep(
         "  {:>5} {:>16} {:>12} {:>12} {:>12} {:>12} {:>6} {:>10}",
         "step", "name", "value", "max |u|", "contact area", "force", "iters", "KKT"
     );
-    for r in &rows {
+    for r in rows {
         println!(
             "  {:>5} {:>16} {:>12.5e} {:>12.5e} {:>12.5e} {:>12.5e} {:>6} {:>10.3e}",
             r.step,
@@ -203,11 +175,11 @@ fn sweep(
         started.elapsed().as_secs_f64(),
         flags.out.display(),
     );
-    if let Some(e) = failed {
+    if let Some((step, e)) = failed {
         bail!(
             "{e}; the directories of the steps that did not converge ({}) hold their \
              unconverged iterates (summary.json: \"accepted\": false)",
-            unaccepted.join(", ")
+            step.name
         );
     }
     Ok(())
@@ -229,19 +201,18 @@ pub fn check(case_path: &Path, sets: &[String]) -> Result<()> {
     // signs, NaN), everything `solve` checks before it solves; the load cases' data are
     // assembled on the mesh too, and the profile line checked against it.
     let d = Discretization::new(&case.problem, &mut Progress::new(Verbosity::Quiet))?;
-    write::check_on_mesh(&case, d.mesh())?;
-    memcontact::sweep::check_on_mesh(&case, d.mesh(), true)?;
+    memcontact::run::check_case_on_mesh(&case, d.mesh(), true)?;
     d.check_memory(&case.settings)?;
     print_warnings(&d);
     let mesh = d.mesh();
     println!("case {}: valid", case_path.display());
     print!(
         "{}",
-        output::mesh_report(mesh, &d.quality, d.hierarchy.depth())
+        report::mesh_report(mesh, &d.quality, d.hierarchy.depth())
     );
     print!(
         "{}",
-        output::boundary_report(mesh, &case.problem.boundary.free)
+        report::boundary_report(mesh, &case.problem.boundary.free)
     );
     println!(
         "  obstacle     {} vertices can touch (M), foundation {}{}",
@@ -250,7 +221,7 @@ pub fn check(case_path: &Path, sets: &[String]) -> Result<()> {
         if d.model.is_rigid() { ", rigid" } else { "" }
     );
     if case.is_sweep() {
-        let steps = memcontact::sweep::steps(&case)?;
+        let steps = memcontact::case::steps(&case)?;
         let names: Vec<&str> = steps.iter().map(|s| s.name.as_str()).collect();
         println!(
             "  steps        {} ({}): {}",
@@ -266,11 +237,11 @@ pub fn check(case_path: &Path, sets: &[String]) -> Result<()> {
         method.name(),
         choice.reason()
     );
-    let (available, source) = memcontact::resources::available_memory();
+    let (available, source) = memcontact::limits::available_memory();
     println!(
         "  memory       about {} to solve ({} available: {source})",
-        memcontact::resources::human_bytes(d.memory_estimate(&case.settings)),
-        memcontact::resources::human_bytes(available as f64)
+        memcontact::limits::human_bytes(d.memory_estimate(&case.settings)),
+        memcontact::limits::human_bytes(available as f64)
     );
     Ok(())
 }

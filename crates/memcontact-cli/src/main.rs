@@ -1,15 +1,18 @@
 //! `memcontact`: the command-line tool. Parses arguments, reads the case, runs the library,
 //! prints a summary and writes the outputs. All the numerics live in the library.
 
+mod adapt_cmd;
+#[cfg(feature = "alloc-trace")]
 mod alloc_trace;
 mod bench_cmd;
 mod commands;
 mod convergence;
 mod examples;
 mod help;
-mod output;
 mod plot_cmd;
 mod progress;
+mod report;
+mod signals;
 
 use clap::{Parser, Subcommand};
 use std::path::PathBuf;
@@ -17,6 +20,13 @@ use std::process::ExitCode;
 
 /// mimalloc keeps freed memory for reuse: the solver's large work vectors are not handed
 /// back to the kernel and faulted in again page by page on every allocation.
+#[cfg(not(feature = "alloc-trace"))]
+#[global_allocator]
+static ALLOCATOR: mimalloc::MiMalloc = mimalloc::MiMalloc;
+
+/// With the `alloc-trace` feature (a profiling aid, off by default): mimalloc with a count
+/// of live bytes and a table of the large allocations alive at the peak.
+#[cfg(feature = "alloc-trace")]
 #[global_allocator]
 static ALLOCATOR: alloc_trace::Tracing<mimalloc::MiMalloc> =
     alloc_trace::Tracing(mimalloc::MiMalloc);
@@ -155,17 +165,16 @@ fn small_pages_only() {
 
 fn main() -> ExitCode {
     small_pages_only();
+    #[cfg(feature = "alloc-trace")]
     alloc_trace::enable();
     let cli = Cli::parse();
     if let Some(n) = cli.threads {
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(n)
-            .build_global();
-        if n == 0 || pool.is_err() {
+        if memcontact::parallel::set_threads(n).is_err() {
             eprintln!("error: --threads must be at least 1, got {n}");
             return ExitCode::FAILURE;
         }
     }
+    signals::install();
     // The whole command runs on a worker thread of the pool (see memcontact::on_workers).
     let result = memcontact::on_workers(|| match cli.command {
         Command::Solve {
@@ -217,6 +226,17 @@ fn main() -> ExitCode {
     });
     match result {
         Ok(()) => ExitCode::SUCCESS,
+        Err(e)
+            if e.chain().any(|c| {
+                matches!(
+                    c.downcast_ref::<memcontact::Error>(),
+                    Some(memcontact::Error::Cancelled)
+                )
+            }) =>
+        {
+            eprintln!("interrupted: nothing was written (an earlier result stays as it was)");
+            ExitCode::from(130)
+        }
         Err(e) => {
             eprintln!("error: {e}");
             for cause in e.chain().skip(1) {

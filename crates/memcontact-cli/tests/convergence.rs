@@ -1,7 +1,7 @@
 //! End-to-end tests of `memcontact convergence`: the binary on small cases, checking the
 //! table, the CSV and PNG it writes, the exit code, and the errors for bad `[exact]` input.
 //! (The rates themselves are tested on the library function, in
-//! `memcontact::convergence`.)
+//! `memcontact::verify::convergence`.)
 
 use std::path::{Path, PathBuf};
 

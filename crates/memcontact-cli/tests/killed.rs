@@ -48,7 +48,7 @@ fn complete(dir: &Path) -> Result<String, String> {
         return Err(format!("files {present:?}, summary lists {expected:?}"));
     }
     for (name, record) in files {
-        let actual = memcontact::output::file_record(&dir.join(name)).map_err(|e| e.to_string())?;
+        let actual = memcontact::write::file_record(&dir.join(name)).map_err(|e| e.to_string())?;
         if record["bytes"] != actual.bytes || record["xxh3"] != actual.xxh3.as_str() {
             return Err(format!("{name} is not the file summary.json lists"));
         }

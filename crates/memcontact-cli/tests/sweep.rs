@@ -156,7 +156,7 @@ fn a_load_factor_sweep_writes_a_directory_per_step_and_sweep_csv() {
                 std::fs::read(&path).unwrap() == *old,
                 "{name} redrawn differs"
             );
-            let record = memcontact::output::file_record(&path).unwrap();
+            let record = memcontact::write::file_record(&path).unwrap();
             assert_eq!(files[&name]["xxh3"], record.xxh3, "{name}");
             assert_eq!(files[&name]["bytes"], record.bytes, "{name}");
         }

@@ -41,7 +41,9 @@ pub use axes::{hatch_color, HATCH_SPACING};
 pub use canvas::{Canvas, PixelRect};
 pub use lines::{line_plot, LinePlot, Series};
 pub use loglog::loglog_plot;
-pub use maps::{field_plot, MapLayout, Picture, CONTACT, NOT_COVERED, OUTLINE, PRESSURE_OUTLINE};
+pub use maps::{
+    field_plot, mesh_plot, MapLayout, Picture, CONTACT, NOT_COVERED, OUTLINE, PRESSURE_OUTLINE,
+};
 pub use raster::MapTransform;
 
 use memcontact::{Error, Result};

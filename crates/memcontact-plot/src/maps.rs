@@ -820,3 +820,100 @@ pub fn field_plot(
     );
     canvas.write_png(path)
 }
+
+/// The mesh picture of an adaptive run (`mesh.png`): every edge of the mesh, the
+/// boundary, and the outline of the contact zone (`contact`: per vertex, in contact with
+/// a body), titled `title`, with the vertex and triangle counts in the legend.
+pub fn mesh_plot(
+    path: &Path,
+    points: &[[f64; 2]],
+    triangles: &[[u32; 3]],
+    contact: &[bool],
+    title: &str,
+    units: &Units,
+) -> Result<()> {
+    if contact.len() != points.len()
+        || triangles.is_empty()
+        || points
+            .iter()
+            .any(|p| !(p[0].is_finite() && p[1].is_finite()))
+        || triangles
+            .iter()
+            .any(|t| t.iter().any(|&v| v as usize >= points.len()))
+    {
+        return Err(Error::Data(format!(
+            "mesh picture {}: {} contact flags, {} points, {} triangles (a triangle out of \
+             range or a non-finite coordinate?)",
+            path.display(),
+            contact.len(),
+            points.len(),
+            triangles.len()
+        )));
+    }
+    let mut b = [
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+    ];
+    for p in points {
+        b = [
+            b[0].min(p[0]),
+            b[1].max(p[0]),
+            b[2].min(p[1]),
+            b[3].max(p[1]),
+        ];
+    }
+    let (bx, by) = (
+        crate::colormap::widen(b[0], b[1]),
+        crate::colormap::widen(b[2], b[3]),
+    );
+    let l = MapLayout::of(points, triangles, [bx.0, bx.1, by.0, by.1]);
+    let mut canvas = Canvas::new(MAP_WIDTH, MAP_HEIGHT);
+    let mut boxes = Vec::new();
+    // The contact zone, lightly filled, under the edges.
+    let inside = indicator(points.len(), |v| contact[v]);
+    let f = &l.frags;
+    fill(&mut canvas, &l, |k, _, _| {
+        if f.interp(k, triangles, &inside) > 0.5 {
+            [253, 226, 200]
+        } else {
+            [255, 255, 255]
+        }
+    });
+    // Every inside edge once (its two triangles run along it in opposite directions);
+    // the boundary is drawn after.
+    let mut edges = Coverage::new(canvas.width, canvas.height, l.frame);
+    let width = (0.4 * l.vertex_spacing).clamp(0.25, 1.0);
+    for t in triangles {
+        for e in 0..3 {
+            let (a, b) = (t[e], t[(e + 1) % 3]);
+            if a < b {
+                edges.segment(l.pv[a as usize], l.pv[b as usize], width);
+            }
+        }
+    }
+    canvas.composite(&edges, [90, 90, 90], 0.85);
+    draw_boundary(&mut canvas, &l);
+    let outline = level_mask(&canvas, &l, triangles, &inside, 0.5, 2.2, false);
+    canvas.composite(&outline, OUTLINE, 1.0);
+    furniture(&mut canvas, &l, units, title, None, &mut boxes);
+    let entries = vec![
+        (Swatch::Line([90, 90, 90], 1.0), "mesh edges".to_string()),
+        (
+            Swatch::Line(OUTLINE, 2.2),
+            "contact zone outline".to_string(),
+        ),
+        (Swatch::None, format!("{} vertices", points.len())),
+        (Swatch::None, format!("{} triangles", triangles.len())),
+    ];
+    axes::legend(
+        &mut canvas,
+        COLUMN.0,
+        BAR.y0 + 60,
+        COLUMN.1,
+        &entries,
+        &mut boxes,
+    );
+    canvas.write_png(path)
+}

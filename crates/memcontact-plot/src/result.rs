@@ -141,7 +141,7 @@ pub fn load(dir: &Path) -> Result<Loaded> {
             // The pictures must be drawn from this run's solution.vtu: a directory mixing
             // the files of two runs is refused.
             if let Some(record) = json.pointer("/files/solution.vtu") {
-                let actual = memcontact::output::file_record(&vtu_path)?;
+                let actual = memcontact::write::file_record(&vtu_path)?;
                 if record.get("xxh3").and_then(|h| h.as_str()) != Some(actual.xxh3.as_str()) {
                     return Err(file_err(format!(
                         "is not the solution.vtu that summary.json lists (run {}): the \

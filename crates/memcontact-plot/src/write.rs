@@ -1,5 +1,5 @@
 //! Result sets with their pictures, as `memcontact solve` writes them and the Python
-//! module's `write` writes them too: the library's files ([`memcontact::output`]) plus
+//! module's `write` writes them too: the library's files ([`memcontact::write`]) plus
 //! the pictures of the case's `[output]` section, and for a sweep or load cases a
 //! directory per step, `sweep.csv` and the force-deflection picture `sweep.png`.
 //!
@@ -8,12 +8,15 @@
 
 use crate::bodies::{merge, BodyFields};
 use crate::{draw_all, line_plot, LinePlot, PlotData, PlotKind, PlotOptions, Series, Units};
+use memcontact::case::StepSpec;
+use memcontact::case::{PictureKind, VtuFormat};
 use memcontact::mesh::Mesh;
-use memcontact::output::{step_label, write_result_set, SweepSet, WriteOptions};
-use memcontact::problem::{PictureKind, VtuFormat};
-use memcontact::results::NodalFields;
-use memcontact::sweep::{StepRow, StepSpec};
-use memcontact::{Case, Discretization, Error, Observer, Outcome, Result, Summary};
+use memcontact::outcome::fields::NodalFields;
+use memcontact::outcome::StepRow;
+use memcontact::verify::convergence::LevelResult;
+use memcontact::verify::study::{StudyOutcome, StudyResult};
+use memcontact::write::{step_label, write_result_set, SweepSet, WriteOptions};
+use memcontact::{Case, Error, Outcome, Result, Summary};
 use std::path::Path;
 use std::time::{Duration, Instant};
 
@@ -53,60 +56,7 @@ pub fn plot_options(case: &Case, label: &str) -> PlotOptions {
     }
 }
 
-/// Solves a case of one step (no `[sweep]`, no `[[load_case]]`): the mesh and assembly,
-/// the picture options checked on the mesh ([`check_on_mesh`]) before anything is solved,
-/// then the solve. The outcome is returned whatever the solve's status.
-pub fn solve_case(case: &Case, observer: &mut dyn Observer) -> Result<Outcome> {
-    let discretization = Discretization::new(&case.problem, observer)?;
-    check_on_mesh(case, discretization.mesh())?;
-    let report = discretization.solve(&case.settings, observer)?;
-    Ok(Outcome {
-        discretization,
-        report,
-    })
-}
-
-/// Checks the picture options of `case` against the mesh before anything is solved: a
-/// given profile line must cross the mesh (else `profile.png` could not be drawn).
-pub fn check_on_mesh(case: &Case, mesh: &Mesh) -> Result<()> {
-    let Some([a, b]) = case.output.profile else {
-        return Ok(());
-    };
-    if !crate::profile::crosses(&mesh.points, &mesh.triangles, a, b) {
-        return Err(Error::Case {
-            file: None,
-            line: None,
-            key: "output.profile".into(),
-            message: format!(
-                "the line from ({}, {}) to ({}, {}) does not cross the mesh (its bounding \
-                 box is {})",
-                a[0],
-                a[1],
-                b[0],
-                b[1],
-                bbox_text(&mesh.points)
-            ),
-        });
-    }
-    Ok(())
-}
-
-/// `[x0, x1] × [y0, y1]` of the points.
-fn bbox_text(points: &[[f64; 2]]) -> String {
-    let (mut x0, mut x1, mut y0, mut y1) = (
-        f64::INFINITY,
-        f64::NEG_INFINITY,
-        f64::INFINITY,
-        f64::NEG_INFINITY,
-    );
-    for p in points {
-        (x0, x1) = (x0.min(p[0]), x1.max(p[0]));
-        (y0, y1) = (y0.min(p[1]), y1.max(p[1]));
-    }
-    format!("[{x0}, {x1}] × [{y0}, {y1}]")
-}
-
-/// The pictures of `options` as the `extra` files of [`memcontact::output::write_files`]:
+/// The pictures of `options` as the `extra` files of [`memcontact::write::write_files`]:
 /// drawn into the directory from the nodal fields on `mesh`; returns their names.
 pub fn pictures<'a>(
     mesh: &'a Mesh,
@@ -158,6 +108,39 @@ pub fn pictures<'a>(
             .iter()
             .filter_map(|f| f.file_name().map(|n| n.to_string_lossy().into_owned()))
             .collect())
+    }
+}
+
+/// The file name of the mesh picture of an adaptive run.
+pub const MESH_PICTURE: &str = "mesh.png";
+
+/// The pictures of an adaptive run's final step (the `extra` files of
+/// [`memcontact::write::AdaptSet::finish`]): those of `options`, and, when it draws any,
+/// `mesh.png`, the final mesh's edges with the outline of the contact zone.
+pub fn adapt_pictures<'a>(
+    mesh: &'a Mesh,
+    options: &'a PlotOptions,
+) -> impl FnMut(&Path, &NodalFields) -> Result<Vec<String>> + 'a {
+    let mut maps = pictures(mesh, options);
+    move |dir: &Path, fields: &NodalFields| {
+        let mut names = maps(dir, fields)?;
+        if options.plots.is_empty() {
+            return Ok(names);
+        }
+        let contact: Vec<bool> = (0..fields.state.len())
+            .map(|v| fields.state[v] >= 0 || fields.lower.as_ref().is_some_and(|l| l.state[v] >= 0))
+            .collect();
+        let title = format!("Mesh: {}", options.title.as_deref().unwrap_or(""));
+        crate::mesh_plot(
+            &dir.join(MESH_PICTURE),
+            &mesh.points,
+            &mesh.triangles,
+            &contact,
+            &title,
+            &options.units,
+        )?;
+        names.push(MESH_PICTURE.to_string());
+        Ok(names)
     }
 }
 
@@ -240,7 +223,6 @@ impl SweepWriter {
         let options = WriteOptions {
             label,
             vtu: self.vtu,
-            csv: case.output.writes_csv(),
             force: false,
             started: now
                 .checked_sub(Duration::from_secs_f64(seconds.max(0.0)))
@@ -248,6 +230,8 @@ impl SweepWriter {
             plot_options: serde_json::to_value(&plots).ok(),
             // The set's own run id (SweepSet::write_step).
             run_id: None,
+            cell_data: Vec::new(),
+            adapt: None,
         };
         let mesh = outcome.mesh();
         let mut draw = pictures(&mesh, &plots);
@@ -290,3 +274,92 @@ pub fn sweep_picture(path: &Path, title: &str, units: &Units, rows: &[StepRow]) 
         },
     )
 }
+
+/// The pictures of a convergence study, drawn into `dir` (the `pictures` of
+/// [`memcontact::write::write_study`]): `convergence.png` (the L² and H¹ errors of every
+/// variant against l_n, reference slopes 1 and 2) or, for the rigid-limit sweep,
+/// `h_sweep.png` (the distances to the rigid solution against h, reference slopes −½ and
+/// −1). `file_name` (the case file's name) titles them. Returns the names written.
+pub fn study_pictures(dir: &Path, outcome: &StudyOutcome, file_name: &str) -> Result<Vec<String>> {
+    match &outcome.result {
+        StudyResult::Convergence(studies) => {
+            let mut series = Vec::new();
+            for (v, s) in studies {
+                let suffix = if v.name.is_empty() {
+                    String::new()
+                } else {
+                    format!(" ({})", v.name)
+                };
+                let pts = |f: &dyn Fn(&LevelResult) -> Option<f64>| -> Vec<(f64, f64)> {
+                    s.levels
+                        .iter()
+                        .filter_map(|r| f(r).map(|e| (r.l_n, e)))
+                        .collect()
+                };
+                series.push((
+                    format!("L² error{suffix}"),
+                    pts(&|r| r.errors.map(|e| e.l2)),
+                ));
+                series.push((
+                    format!("H¹ error{suffix}"),
+                    pts(&|r| r.errors.map(|e| e.h1_semi)),
+                ));
+            }
+            crate::loglog_plot(
+                &dir.join(CONVERGENCE_PICTURE),
+                &format!("Convergence: {file_name}"),
+                "mesh size lₙ",
+                if outcome.exact.is_some() {
+                    "error against the exact solution"
+                } else {
+                    "error against the reference solution"
+                },
+                &series,
+                &[1.0, 2.0],
+            )?;
+            Ok(vec![CONVERGENCE_PICTURE.to_string()])
+        }
+        StudyResult::RigidLimit {
+            sweep,
+            exact_distance,
+            ..
+        } => {
+            let mut series = vec![
+                (
+                    "max nodal |u_h(h) − u_h(∞)|".to_string(),
+                    sweep.rows.iter().map(|r| (r.h, r.max_nodal)).collect(),
+                ),
+                (
+                    "H¹ seminorm".to_string(),
+                    sweep.rows.iter().map(|r| (r.h, r.h1_semi)).collect(),
+                ),
+            ];
+            if exact_distance.iter().any(Option::is_some) {
+                series.push((
+                    "exact max |u(h) − u(∞)|".to_string(),
+                    sweep
+                        .rows
+                        .iter()
+                        .zip(exact_distance)
+                        .filter_map(|(r, c)| c.map(|c| (r.h, c)))
+                        .collect(),
+                ));
+            }
+            crate::loglog_plot(
+                &dir.join(H_SWEEP_PICTURE),
+                &format!("Rigid limit: {file_name}"),
+                "stiffness h",
+                "distance to the rigid solution",
+                &series,
+                &[-0.5, -1.0],
+            )?;
+            Ok(vec![H_SWEEP_PICTURE.to_string()])
+        }
+    }
+}
+
+/// The file name of a convergence study's picture.
+pub const CONVERGENCE_PICTURE: &str = "convergence.png";
+
+/// The file name of a rigid-limit sweep's picture.
+pub const H_SWEEP_PICTURE: &str = "h_sweep.png";

@@ -2,11 +2,16 @@
 //! file or a dict, with the same schema and the same errors.
 
 use crate::convert::{dict_case_err, py_err, to_py, to_toml};
+use memcontact::field::{Field, Stiffness};
+use memcontact::mesh::refine::Hierarchy;
+use memcontact::problem::{GivenMesh, MeshSource};
 use memcontact::Case;
+use numpy::PyReadonlyArray1;
 use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyTuple};
 use std::path::PathBuf;
+use std::sync::Arc;
 
 /// A case: the problem (mesh, membrane, obstacle), the solver settings, the output options
 /// and the exact solution, exactly as a case file holds them. Immutable.
@@ -32,6 +37,77 @@ pub fn case_from_dict(data: &Bound<'_, PyAny>) -> PyResult<Case> {
     let text = toml::to_string(&value)
         .map_err(|e| PyValueError::new_err(format!("cannot read the case: {e}")))?;
     Case::from_toml_str(&text, None).map_err(dict_case_err)
+}
+
+/// The keys of a case whose data may be given as NumPy arrays of one value per vertex.
+const NODAL_KEYS: [(&str, &str); 6] = [
+    ("membrane", "load"),
+    ("obstacle", "shape"),
+    ("obstacle", "stiffness"),
+    ("boundary", "height"),
+    ("lower", "shape"),
+    ("lower", "stiffness"),
+];
+
+/// The case a dict describes on a mesh given as data (`MeshSource::Given`): the dict has
+/// the sections of a case file but `mesh`. NumPy arrays at the keys of [`NODAL_KEYS`] are
+/// the data's values at the mesh's vertices (`Field::Nodal`), taken as they are instead of
+/// going through the case file's text.
+pub fn case_on_mesh(data: &Bound<'_, PyDict>, mesh: &Arc<Hierarchy>) -> PyResult<Case> {
+    if data.contains("mesh")? {
+        return Err(PyValueError::new_err(
+            "mesh: the mesh is given as the mesh argument, not in the case's data",
+        ));
+    }
+    let mut nodal: Vec<(&str, &str, Arc<[f64]>)> = Vec::new();
+    let mut value = to_toml(data, "")?;
+    let table = value.as_table_mut().expect("a dict is a table");
+    for (section, key) in NODAL_KEYS {
+        let Some(array) = data
+            .get_item(section)?
+            .and_then(|s| s.cast_into::<PyDict>().ok())
+            .and_then(|s| s.get_item(key).ok().flatten())
+            .filter(|v| v.hasattr("dtype").unwrap_or(false))
+        else {
+            continue;
+        };
+        let values: PyReadonlyArray1<'_, f64> = array.extract().map_err(|_| {
+            PyValueError::new_err(format!(
+                "{section}.{key}: nodal values must be a one-dimensional float64 array"
+            ))
+        })?;
+        nodal.push((section, key, values.as_array().iter().copied().collect()));
+        // The schema's check of the key sees a number; the values are set below.
+        if let Some(toml::Value::Table(s)) = table.get_mut(section) {
+            s.insert(key.into(), toml::Value::Float(0.0));
+        }
+    }
+    let given = GivenMesh::shared(mesh.clone());
+    let mut mesh_table = toml::Table::new();
+    mesh_table.insert(
+        "given".into(),
+        toml::Value::String(given.description.clone()),
+    );
+    table.insert("mesh".into(), toml::Value::Table(mesh_table));
+    let text = toml::to_string(&value)
+        .map_err(|e| PyValueError::new_err(format!("cannot read the case: {e}")))?;
+    let mut case = Case::from_toml_str(&text, None).map_err(dict_case_err)?;
+    case.problem.mesh.source = MeshSource::Given(given);
+    for (section, key, values) in nodal {
+        let field = Field::Nodal(values);
+        let p = &mut case.problem;
+        match (section, key, p.lower.as_mut()) {
+            ("membrane", "load", _) => p.membrane.load = field,
+            ("obstacle", "shape", _) => p.obstacle.shape = field,
+            ("obstacle", "stiffness", _) => p.obstacle.stiffness = Stiffness::Elastic(field),
+            ("boundary", "height", _) => p.boundary.height = field,
+            ("lower", "shape", Some(low)) => low.shape = field,
+            ("lower", "stiffness", Some(low)) => low.stiffness = Stiffness::Elastic(field),
+            _ => unreachable!("NODAL_KEYS lists the keys matched here"),
+        }
+    }
+    case.validate().map_err(|e| dict_case_err(e.into_error()))?;
+    Ok(case)
 }
 
 /// The TOML text of a Python value (for `--set`-style overrides).
@@ -68,9 +144,8 @@ impl PyCase {
     #[staticmethod]
     #[pyo3(signature = (path, overrides=Vec::new()))]
     fn load(py: Python<'_>, path: PathBuf, overrides: Vec<String>) -> PyResult<PyCase> {
-        let case = py
-            .detach(|| Case::load(&path, &overrides))
-            .map_err(py_err)?;
+        let case =
+            crate::convert::detached(py, || Case::load(&path, &overrides)).map_err(py_err)?;
         Ok(PyCase {
             case,
             label: path.display().to_string(),

@@ -157,3 +157,47 @@ pub fn to_py<'py, T: serde::Serialize>(py: Python<'py>, value: &T) -> PyResult<B
         .map_err(|e| PyValueError::new_err(format!("cannot convert to Python: {e}")))?;
     json_to_py(py, &v)
 }
+
+/// Runs `f` with the GIL released on the library's worker threads (the pool of this
+/// process: a process forked from one that has solved builds its own).
+pub fn detached<T: Send>(py: Python<'_>, f: impl FnOnce() -> T + Send) -> T {
+    py.detach(|| memcontact::on_workers(f))
+}
+
+/// Runs `f` like [`detached`] while this thread checks Python's signals every 50 ms: on
+/// Ctrl-C (a KeyboardInterrupt, or whatever the signal handlers raise) `cancel` is set, the
+/// run stops within its iteration, and the exception is raised.
+pub fn interruptible<T: Send>(
+    py: Python<'_>,
+    cancel: &memcontact::Cancel,
+    f: impl FnOnce() -> memcontact::Result<T> + Send,
+) -> PyResult<T> {
+    use std::sync::mpsc;
+    use std::time::Duration;
+    std::thread::scope(|s| {
+        let (tx, rx) = mpsc::channel();
+        s.spawn(move || {
+            let _ = tx.send(memcontact::on_workers(f));
+        });
+        let mut rx = rx;
+        loop {
+            let (got, back) = py.detach(move || (rx.recv_timeout(Duration::from_millis(50)), rx));
+            rx = back;
+            match got {
+                Ok(result) => return result.map_err(py_err),
+                Err(mpsc::RecvTimeoutError::Disconnected) => {
+                    return Err(pyo3::exceptions::PyRuntimeError::new_err(
+                        "the run's thread ended without an answer",
+                    ))
+                }
+                Err(mpsc::RecvTimeoutError::Timeout) => {}
+            }
+            if let Err(e) = py.check_signals() {
+                cancel.cancel();
+                // The run stops at its next check; its error is the interruption.
+                let _ = py.detach(move || rx.recv());
+                return Err(e);
+            }
+        }
+    })
+}

@@ -362,8 +362,8 @@ impl PyMesh {
                 memcontact::problem::MAX_REFINE
             )));
         }
-        let base = memcontact::resources::MeshSize::of(self.finest());
-        memcontact::resources::check_mesh_fits(
+        let base = memcontact::limits::MeshSize::of(self.finest());
+        memcontact::limits::check_mesh_fits(
             base,
             times,
             &format!(
@@ -373,7 +373,7 @@ impl PyMesh {
         )
         .map_err(|e| PyValueError::new_err(e.to_string()))?;
         let mut h = (*self.hierarchy).clone();
-        py.detach(|| h.refine(times));
+        crate::convert::detached(py, || h.refine(times));
         Ok(PyMesh::new_from(h))
     }
 
@@ -554,7 +554,7 @@ pub fn rectangle(
         ny: ny.unwrap_or(nx),
         diagonal,
     };
-    let h = py.detach(|| generate::rectangle(&spec)).map_err(py_err)?;
+    let h = crate::convert::detached(py, || generate::rectangle(&spec)).map_err(py_err)?;
     Ok(PyMesh::new_from(h))
 }
 
@@ -571,9 +571,10 @@ pub fn disk(
     size: Option<f64>,
 ) -> PyResult<PyMesh> {
     let size = size.unwrap_or(radius / 8.0);
-    let h = py
-        .detach(|| generate::disk_levels([center.0, center.1], radius, size))
-        .map_err(py_err)?;
+    let h = crate::convert::detached(py, || {
+        generate::disk_levels([center.0, center.1], radius, size)
+    })
+    .map_err(py_err)?;
     Ok(PyMesh::new_from(h))
 }
 
@@ -616,17 +617,14 @@ pub fn polygon(
         size,
         min_angle,
     };
-    let h = py
-        .detach(|| generate::polygon_levels(&spec))
-        .map_err(py_err)?;
+    let h = crate::convert::detached(py, || generate::polygon_levels(&spec)).map_err(py_err)?;
     Ok(PyMesh::new_from(h))
 }
 
 /// Reads a Gmsh mesh (MSH 2.2 or 4.1, ASCII or binary): the mesh and the reader's warnings.
 #[pyfunction]
 pub fn read_gmsh(py: Python<'_>, path: PathBuf) -> PyResult<(PyMesh, Vec<String>)> {
-    let (mesh, warnings) = py
-        .detach(|| memcontact::io::gmsh::read_msh(&path))
-        .map_err(py_err)?;
+    let (mesh, warnings) =
+        crate::convert::detached(py, || memcontact::io::gmsh::read_msh(&path)).map_err(py_err)?;
     Ok((PyMesh::new_from(Hierarchy::single(mesh)), warnings))
 }

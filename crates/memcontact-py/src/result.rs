@@ -4,13 +4,13 @@
 use crate::case::PyCase;
 use crate::convert::{py_err, to_py};
 use crate::mesh::{hierarchy_from_state, mesh_state, PyMesh};
-use memcontact::model::Certificate;
-use memcontact::output::{input_hash, new_run_id, WriteOptions};
-use memcontact::problem::VtuFormat;
-use memcontact::results::{LowerFields, NodalFields};
-use memcontact::run::Phase;
+use memcontact::case::VtuFormat;
+use memcontact::certificate::Certificate;
+use memcontact::discretization::Phase;
+use memcontact::outcome::fields::{LowerFields, NodalFields};
+use memcontact::run::step_discretization;
 use memcontact::solve::{Choice, Fallback, IterationRecord, Multipliers, Silent};
-use memcontact::sweep::step_discretization;
+use memcontact::write::{input_hash, new_run_id, WriteOptions};
 use memcontact::{Case, Discretization, Method, Outcome, Report, Status, Summary};
 use memcontact_plot::write::{plot_options, write_result};
 use numpy::{PyArray1, PyReadonlyArray1};
@@ -26,7 +26,7 @@ use std::time::{Duration, Instant};
 pub struct ResultData {
     /// The case's label.
     pub label: String,
-    /// The case solved (for a mesh given in Python: its data, with a placeholder mesh).
+    /// The case solved (for a mesh given in Python: its data on that mesh).
     pub case: Case,
     /// The solved mesh and its levels.
     pub mesh: PyMesh,
@@ -389,28 +389,28 @@ impl PyResult_ {
         pictures: bool,
     ) -> PyResult<Bound<'py, PyAny>> {
         let vtu = vtu_format(vtu, &self.data.case)?;
-        let summary = py
-            .detach(|| {
-                let outcome = self.outcome()?;
-                let mut plots = plot_options(&self.data.case, &self.data.label);
-                if !pictures {
-                    plots.plots.clear();
-                }
-                let now = Instant::now();
-                let options = WriteOptions {
-                    label: self.data.label.clone(),
-                    vtu,
-                    csv: self.data.case.output.writes_csv(),
-                    force,
-                    started: now
-                        .checked_sub(Duration::from_secs_f64(self.data.seconds))
-                        .unwrap_or(now),
-                    plot_options: None,
-                    run_id: None,
-                };
-                write_result(&directory, &outcome, &self.data.case, &options, &plots)
-            })
-            .map_err(py_err)?;
+        let summary = crate::convert::detached(py, || {
+            let outcome = self.outcome()?;
+            let mut plots = plot_options(&self.data.case, &self.data.label);
+            if !pictures {
+                plots.plots.clear();
+            }
+            let now = Instant::now();
+            let options = WriteOptions {
+                label: self.data.label.clone(),
+                vtu,
+                force,
+                started: now
+                    .checked_sub(Duration::from_secs_f64(self.data.seconds))
+                    .unwrap_or(now),
+                plot_options: None,
+                run_id: None,
+                cell_data: Vec::new(),
+                adapt: None,
+            };
+            write_result(&directory, &outcome, &self.data.case, &options, &plots)
+        })
+        .map_err(py_err)?;
         to_py(py, &summary)
     }
 
@@ -594,6 +594,11 @@ pub fn _result_from_state(state: &Bound<'_, PyDict>) -> PyResult<PyResult_> {
         derived: None,
     };
     let mesh = PyMesh::new_from(hierarchy_from_state(&get("mesh")?)?);
+    // A mesh given as data travels as the result's mesh; the case gets it back.
+    let mut case = case;
+    if let memcontact::problem::MeshSource::Given(g) = &mut case.problem.mesh.source {
+        g.hierarchy = Some(mesh.hierarchy.clone());
+    }
     Ok(PyResult_ {
         data: Arc::new(ResultData {
             label: meta.label,

@@ -6,11 +6,13 @@ use crate::case::PyCase;
 use crate::convert::{py_err, to_py};
 use crate::mesh::PyMesh;
 use crate::result::{vtu_format, PyResult_};
-use memcontact::output::step_label;
+use memcontact::case::StepSpec;
+use memcontact::outcome::StepRow;
+use memcontact::run::run_sweep;
 use memcontact::solve::Silent;
-use memcontact::sweep::{run_sweep_on, steps, StepRow, StepSpec};
-use memcontact::{Case, Discretization, Error};
-use memcontact_plot::write::{check_on_mesh, SweepWriter};
+use memcontact::write::step_label;
+use memcontact::{Case, Error};
+use memcontact_plot::write::SweepWriter;
 use pyo3::exceptions::{PyIndexError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
@@ -31,11 +33,11 @@ pub struct PySweep {
 /// What the solve of a sweep produced, before it becomes Python objects.
 struct Solved {
     results: Vec<PyResult_>,
+    steps: Vec<StepSpec>,
     rows: Vec<StepRow>,
     message: Option<String>,
 }
 
-/// Solves the steps of `case` in turn (the GIL is released by the caller).
 fn solve_steps(case: &Case, label: &str, warm: bool) -> memcontact::Result<Solved> {
     if !case.is_sweep() {
         return Err(Error::Data(
@@ -44,13 +46,11 @@ fn solve_steps(case: &Case, label: &str, warm: bool) -> memcontact::Result<Solve
                 .into(),
         ));
     }
-    let base = Discretization::new(&case.problem, &mut Silent)?;
-    check_on_mesh(case, base.mesh())?;
-    let mesh = PyMesh::new_from(base.user_hierarchy());
+    let mut mesh: Option<PyMesh> = None;
     let mut results = Vec::new();
-    let mut rows = Vec::new();
-    let mut unaccepted = false;
-    let outcome = run_sweep_on(case, base, warm, &mut Silent, &mut |step, outcome, row| {
+    let run = run_sweep(case, warm, &mut Silent, &mut |step, outcome, row| {
+        let mesh =
+            mesh.get_or_insert_with(|| PyMesh::new_from(outcome.discretization.user_hierarchy()));
         results.push(PyResult_::of_step(
             step_label(label, step),
             case.clone(),
@@ -59,20 +59,14 @@ fn solve_steps(case: &Case, label: &str, warm: bool) -> memcontact::Result<Solve
             row.seconds,
             step.index,
         ));
-        rows.push(row.clone());
-        unaccepted = !outcome.report.accepted;
         Ok(())
-    });
-    let message = match outcome {
-        Ok(_) => None,
-        // A step the settings do not accept ends the sweep: its result is kept.
-        Err(e) if unaccepted => Some(e.to_string()),
-        Err(e) => return Err(e),
-    };
+    })?;
     Ok(Solved {
         results,
-        rows,
-        message,
+        steps: run.steps,
+        rows: run.rows,
+        // A step the settings do not accept ends the sweep: its result is kept.
+        message: run.stopped.map(|(_, e)| e.to_string()),
     })
 }
 
@@ -83,18 +77,15 @@ fn solve_steps(case: &Case, label: &str, warm: bool) -> memcontact::Result<Solve
 #[pyfunction]
 #[pyo3(signature = (case, warm=true))]
 pub fn sweep(py: Python<'_>, case: PyRef<'_, PyCase>, warm: bool) -> PyResult<PySweep> {
-    let c = case.case.clone();
+    let mut c = case.case.clone();
     let label = case.label.clone();
     drop(case);
-    let (solved, all_steps, c, label) = py
-        .detach(move || {
-            memcontact::on_workers(move || -> memcontact::Result<_> {
-                let solved = solve_steps(&c, &label, warm)?;
-                let all_steps = steps(&c)?;
-                Ok((solved, all_steps, c, label))
-            })
-        })
-        .map_err(py_err)?;
+    let cancel = memcontact::Cancel::new();
+    c.settings.cancel = cancel.clone();
+    let (solved, c, label) = crate::convert::interruptible(py, &cancel, move || {
+        let solved = solve_steps(&c, &label, warm)?;
+        Ok((solved, c, label))
+    })?;
     let results = solved
         .results
         .into_iter()
@@ -103,7 +94,7 @@ pub fn sweep(py: Python<'_>, case: PyRef<'_, PyCase>, warm: bool) -> PyResult<Py
     Ok(PySweep {
         label,
         case: c,
-        steps: all_steps,
+        steps: solved.steps,
         results,
         rows: solved.rows,
         message: solved.message,
@@ -203,20 +194,19 @@ impl PySweep {
         pictures: bool,
     ) -> PyResult<Bound<'py, PyAny>> {
         let vtu = vtu_format(vtu, &self.case)?;
-        let summaries = py
-            .detach(|| -> memcontact::Result<_> {
-                let mut writer =
-                    SweepWriter::begin(&directory, force, &self.case, &self.label, vtu, pictures)?;
-                let mut summaries = Vec::with_capacity(self.results.len());
-                for (result, row) in self.results.iter().zip(&self.rows) {
-                    let outcome = result.get().outcome()?;
-                    let step = &self.steps[row.step];
-                    summaries.push(writer.write_step(&self.case, step, &outcome, row.seconds)?);
-                }
-                writer.finish(&self.rows)?;
-                Ok(summaries)
-            })
-            .map_err(py_err)?;
+        let summaries = crate::convert::detached(py, || -> memcontact::Result<_> {
+            let mut writer =
+                SweepWriter::begin(&directory, force, &self.case, &self.label, vtu, pictures)?;
+            let mut summaries = Vec::with_capacity(self.results.len());
+            for (result, row) in self.results.iter().zip(&self.rows) {
+                let outcome = result.get().outcome()?;
+                let step = &self.steps[row.step];
+                summaries.push(writer.write_step(&self.case, step, &outcome, row.seconds)?);
+            }
+            writer.finish(&self.rows)?;
+            Ok(summaries)
+        })
+        .map_err(py_err)?;
         to_py(py, &summaries)
     }
 

@@ -572,11 +572,19 @@ fn evaluate_with<const EXT: bool>(
     }
 }
 
+impl Model {
+    /// The optimality certificates of a candidate U (Problems 2e and 2f, scaled by the
+    /// forces of U): see [`evaluate`].
+    pub fn certificate(&self, u: &[f64]) -> Certificate {
+        evaluate(self, u).certificate
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::model::{Foundation, ProblemData, Sampling, Stiffness};
-    use crate::solve::tests::square;
+    use crate::mesh::test_square as square;
+    use crate::model::{BodyStiffness, Foundation, ProblemData, Sampling};
 
     fn model(h: Option<f64>, f: f64, phi: f64, foundation: Foundation) -> Model {
         let mesh = square(8);
@@ -586,9 +594,9 @@ mod tests {
             load: &f,
             shape: &phi,
             stiffness: if h > 0.0 {
-                Stiffness::Elastic(&h)
+                BodyStiffness::Elastic(&h)
             } else {
-                Stiffness::Rigid
+                BodyStiffness::Rigid
             },
             foundation,
             sampling: Sampling::Nodal,

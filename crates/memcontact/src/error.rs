@@ -48,6 +48,18 @@ pub enum Error {
         /// What is wrong.
         message: String,
     },
+    /// The run was asked to stop ([`crate::parallel::Cancel`]): Ctrl-C, or its caller.
+    #[error("interrupted")]
+    Cancelled,
+    /// An error with what was being done when it happened (shown as its cause).
+    #[error("{context}")]
+    Context {
+        /// What was being done.
+        context: String,
+        /// The error.
+        #[source]
+        source: Box<Error>,
+    },
     /// An input/output failure while writing results.
     #[error("{path}: {source}")]
     Io {
@@ -99,5 +111,54 @@ pub fn excerpt(text: &str) -> std::borrow::Cow<'_, str> {
     }
 }
 
+impl Error {
+    /// This error as the cause of `context` (what was being done).
+    pub fn context(self, context: impl Into<String>) -> Error {
+        Error::Context {
+            context: context.into(),
+            source: Box::new(self),
+        }
+    }
+
+    /// An error about the case as a whole (no key, no file): its message alone.
+    pub fn case(message: impl Into<String>) -> Error {
+        Error::Case {
+            file: None,
+            line: None,
+            key: String::new(),
+            message: message.into(),
+        }
+    }
+}
+
 /// Shorthand for results of this library.
 pub type Result<T, E = Error> = std::result::Result<T, E>;
+
+/// A value refused by validation: the key (dotted path) and what is wrong.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Invalid {
+    /// The dotted key, e.g. `membrane.tension`.
+    pub key: String,
+    /// What is wrong.
+    pub message: String,
+}
+
+impl Invalid {
+    /// A refusal of `key`.
+    pub fn new(key: impl Into<String>, message: impl Into<String>) -> Invalid {
+        Invalid {
+            key: key.into(),
+            message: message.into(),
+        }
+    }
+
+    /// The library error, without a file.
+    pub fn into_error(self) -> Error {
+        Error::Case {
+            file: None,
+            line: None,
+            key: self.key,
+            message: self.message,
+        }
+    }
+}

@@ -5,42 +5,13 @@
 //! it. Rows are independent, so they are built in parallel and the result does not depend
 //! on the number of threads.
 
+use crate::field::Coefficient;
 pub use crate::mesh::VertexTriangles;
 use crate::mesh::{corner, DofMap, Mesh, Point};
 use crate::quadrature::{map, DEGREE5};
 use crate::sparse::{row_chunks, Csr, Pattern};
 use rayon::prelude::*;
 use std::sync::Arc;
-
-/// A coefficient (f, h, ...) that assembly can evaluate.
-pub trait Coefficient: Sync {
-    /// The value at point `p` inside a triangle of region `region`.
-    fn at(&self, p: Point, region: u32) -> f64;
-    /// The value on a whole region, when constant there (assembly then uses exact
-    /// closed-form element integrals instead of quadrature).
-    fn on_region(&self, region: u32) -> Option<f64>;
-}
-
-impl Coefficient for f64 {
-    fn at(&self, _: Point, _: u32) -> f64 {
-        *self
-    }
-    fn on_region(&self, _: u32) -> Option<f64> {
-        Some(*self)
-    }
-}
-
-/// A coefficient given by a closure of the point (tests, manufactured loads).
-pub struct FnCoefficient<F: Fn(Point) -> f64 + Sync>(pub F);
-
-impl<F: Fn(Point) -> f64 + Sync> Coefficient for FnCoefficient<F> {
-    fn at(&self, p: Point, _: u32) -> f64 {
-        (self.0)(p)
-    }
-    fn on_region(&self, _: u32) -> Option<f64> {
-        None
-    }
-}
 
 /// Geometry of one P1 triangle: area and the (constant) gradients of the barycentric
 /// coordinates λ₀, λ₁, λ₂.
@@ -610,6 +581,7 @@ pub fn assemble_lift(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::field::FnCoefficient;
     use std::collections::BTreeMap;
 
     /// The unit square cut into a 2×2 grid of squares, each split into two triangles:

@@ -4,77 +4,53 @@
 //! discretised exactly as in A. Maceri & F. Maceri, "Analysis of a discrete model for the
 //! contact problem between a membrane and an elastic obstacle", Rend. Lincei 80 (1986).
 //!
-//! Data flows one way: [`field`] data and a [`mesh::Mesh`] build a [`model::Model`]
-//! (S, L, D, φₙ of the paper's §2), a [`solve`] method returns a [`solve::Solution`],
-//! and [`results`] derives the physical fields that the [`io`] writers store.
+//! The library owns the run; data flows one way, each layer importing only those below it:
+//!
+//! ```text
+//! case ──► problem ──► discretization ──► model ──► certificate, solve ──► outcome ──► write
+//! (TOML,    (pure       (meshes, levels,     (S, L, D,   (2e/2f; every       (fields,    (VTU, CSV,
+//!  sweeps,   data,       numbering, data      φₙ, M,      formulation of      totals,     JSON: result
+//!  output)   validate)   bound to the mesh)   checks)     the paper)          summary)    sets)
+//! ```
+//!
+//! - [`mod@run`] holds the only places that run: [`run::run`] (a case of one step),
+//!   [`run::run_sweep`] (its load steps or load cases in turn), and, beside the pipeline,
+//!   [`verify::study::run_study`] (a convergence study with the exact solutions of
+//!   [`verify::exact`] and the norms of [`verify::norms`]). The command-line tool and the
+//!   Python module call these and the writers of [`mod@write`]; they run nothing themselves.
+//! - Below the pipeline: [`mesh`] (meshes, generators, refinement, renumbering), [`field`]
+//!   (the data f, φ, h and their expressions), [`fem`] (P1 elements), [`io`] (Gmsh, VTU,
+//!   CSV, JSON, atomic result sets), [`sparse`], [`quadrature`], [`limits`] (memory),
+//!   [`parallel`] (the worker pool and the cancellation token), [`error`].
 
-pub mod bench;
+pub mod case;
 pub mod certificate;
-pub mod checks;
-pub mod convergence;
+
+pub mod discretization;
 pub mod error;
-pub mod errors;
-pub mod exact;
-pub mod expr;
+pub mod estimate;
+
 pub mod fem;
 pub mod field;
 pub mod io;
+pub mod limits;
 pub mod mesh;
 pub mod model;
-pub mod nodal;
-pub mod output;
+pub mod outcome;
+pub mod parallel;
 pub mod problem;
 pub mod quadrature;
-pub mod resources;
-pub mod results;
 pub mod run;
 pub mod solve;
 pub mod sparse;
-pub mod summary;
-pub mod sweep;
+pub mod verify;
+pub mod write;
 
-pub use error::{Error, Result};
-pub use problem::{Case, Problem};
-pub use run::{run, Discretization, Outcome, Report};
+pub use case::Case;
+pub use discretization::Discretization;
+pub use error::{Error, Invalid, Result};
+pub use outcome::{Outcome, Report, Summary};
+pub use parallel::{on_workers, Cancel};
+pub use problem::Problem;
+pub use run::run;
 pub use solve::{Method, Observer, Settings, Status};
-pub use summary::Summary;
-
-/// Runs `f` on one of the worker threads of rayon's pool (directly when called on one).
-/// The parallel loops inside `f` then split their work among the workers from there,
-/// instead of handing every loop to the pool and waking the calling thread when it is
-/// done: the algebraic multigrid, with its many short loops on coarse levels, solves an
-/// imported mesh of 10⁵ vertices about 15 % faster this way (10⁶ vertices: 5 %). The
-/// command-line tool and the Python module run every solve through it.
-pub fn on_workers<R: Send>(f: impl FnOnce() -> R + Send) -> R {
-    if rayon::current_thread_index().is_some() {
-        f()
-    } else {
-        rayon::scope(|_| f())
-    }
-}
-
-/// Runs `f` on a pool of `threads` worker threads (tests that check a result does not
-/// depend on the number of threads).
-#[cfg(test)]
-pub(crate) fn on_threads<R: Send>(threads: usize, f: impl FnOnce() -> R + Send) -> R {
-    rayon::ThreadPoolBuilder::new()
-        .num_threads(threads)
-        .build()
-        .expect("a thread pool")
-        .install(f)
-}
-
-#[cfg(test)]
-mod tests {
-    #[test]
-    fn on_workers_runs_on_a_worker_of_the_pool_once() {
-        // The test harness's threads are not workers of rayon's pool.
-        assert_eq!(rayon::current_thread_index(), None);
-        let (outer, inner) = super::on_workers(|| {
-            let outer = rayon::current_thread_index();
-            (outer, super::on_workers(rayon::current_thread_index))
-        });
-        assert!(outer.is_some(), "f runs on a worker");
-        assert_eq!(outer, inner, "a nested call runs in place");
-    }
-}

@@ -1,7 +1,7 @@
 //! Sparse symmetric matrices in compressed-row form with a shared pattern, and a sparse
 //! Cholesky factorisation (faer) that keeps its symbolic analysis between refactorisations.
 
-use crate::{Error, Result};
+use crate::error::{Error, Result};
 use rayon::prelude::*;
 use std::sync::Arc;
 
@@ -512,6 +512,29 @@ pub(crate) fn row_chunks<'a>(
     out
 }
 
+/// Below this many rows, loops run serially (threads cost more than they save).
+pub const VECTOR_ROWS: usize = 16_384;
+
+/// Runs `f(i, &mut x[i])` over all rows, in parallel for long vectors.
+#[inline]
+pub fn par_rows<T: Send>(x: &mut [T], f: impl Fn(usize, &mut T) + Sync + Send) {
+    if x.len() >= VECTOR_ROWS {
+        x.par_iter_mut()
+            .enumerate()
+            .with_min_len(4096)
+            .for_each(|(i, xi)| f(i, xi));
+    } else {
+        for (i, xi) in x.iter_mut().enumerate() {
+            f(i, xi);
+        }
+    }
+}
+
+/// `dst = src`, on all threads for long vectors.
+pub fn par_copy_from(dst: &mut [f64], src: &[f64]) {
+    par_rows(dst, |i, d| *d = src[i]);
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -548,7 +571,8 @@ mod tests {
             }
         }
         for threads in [1, 2, 3] {
-            let (ptr, values) = crate::on_threads(threads, || group_by_key(n_keys, m, entries));
+            let (ptr, values) =
+                crate::parallel::on_threads(threads, || group_by_key(n_keys, m, entries));
             assert_eq!(ptr.len(), n_keys + 1);
             for (k, list) in lists.iter().enumerate() {
                 assert_eq!(
@@ -567,7 +591,7 @@ mod tests {
         let a = lap1d(n);
         let x: Vec<f64> = (0..n).map(|i| (i as f64 * 0.37).sin()).collect();
         let run = |threads: usize| {
-            crate::on_threads(threads, || {
+            crate::parallel::on_threads(threads, || {
                 (a.quad_form(&x), a.diag(), a.pattern.diagonal_positions())
             })
         };
@@ -656,7 +680,8 @@ mod tests {
             .map(|i| (i as f64 * 0.37).sin() * 1e3f64.powi(i as i32 % 5))
             .collect();
         let y: Vec<f64> = (0..n).map(|i| (i as f64 * 0.11).cos()).collect();
-        let run = |threads: usize| crate::on_threads(threads, || (dot(&x, &y), norm_inf(&x)));
+        let run =
+            |threads: usize| crate::parallel::on_threads(threads, || (dot(&x, &y), norm_inf(&x)));
         let (d1, m1) = run(1);
         assert_eq!((d1, m1), run(2));
         assert_eq!((d1, m1), run(3));

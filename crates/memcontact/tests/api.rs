@@ -2,12 +2,12 @@
 //! same case built from Rust values give the same run; `run` reports every status with the
 //! iterate and its certificate; result sets are written without the command-line tool.
 
+use memcontact::discretization::Discretization;
 use memcontact::field::{Field, Stiffness};
 use memcontact::model::Foundation;
-use memcontact::output::{write_result_set, WriteOptions};
 use memcontact::problem::{Membrane, MeshSource, MeshSpec, Obstacle, SamplingKind};
-use memcontact::run::Discretization;
 use memcontact::solve::{Method, Silent, Status};
+use memcontact::write::{write_result_set, WriteOptions};
 use memcontact::{run, Case, Problem, Settings, Summary};
 use std::time::Instant;
 
@@ -62,8 +62,9 @@ fn toml_rust_and_json_describe_the_same_problem_and_run_alike() {
     assert_eq!(from_toml.problem, problem_in_rust());
     let json = serde_json::to_string(&from_toml).unwrap();
     assert_eq!(Case::from_json_str(&json).unwrap(), from_toml);
-    let a = run(&from_toml.problem, &from_toml.settings, &mut Silent).unwrap();
-    let b = run(&problem_in_rust(), &Settings::default(), &mut Silent).unwrap();
+    let a = run(&from_toml, &mut Silent).unwrap();
+    let b = memcontact::run::run_problem(&problem_in_rust(), &Settings::default(), &mut Silent)
+        .unwrap();
     assert_eq!(a.status(), Status::Converged);
     assert_eq!(a.report.u, b.report.u);
     assert!(a.report.certificate.kkt() <= 1e-10);
@@ -168,17 +169,13 @@ fn every_status_carries_the_iterate_and_its_certificate() {
 #[test]
 fn auto_records_its_choice() {
     let case = Case::from_toml_str(SQUARE, None).unwrap();
-    let r = run(&case.problem, &case.settings, &mut Silent)
-        .unwrap()
-        .report;
+    let r = run(&case, &mut Silent).unwrap().report;
     assert_eq!(r.requested, Method::Auto);
     assert_eq!(r.method, Method::Multigrid);
     assert_eq!(r.choice, memcontact::solve::Choice::GeometricHierarchy);
     let free =
         Case::from_toml_str(&SQUARE.replace("stiffness = 1000.0", "stiffness = 0"), None).unwrap();
-    let r = run(&free.problem, &free.settings, &mut Silent)
-        .unwrap()
-        .report;
+    let r = run(&free, &mut Silent).unwrap().report;
     assert_eq!(r.method, Method::Linear);
     assert_eq!(r.choice, memcontact::solve::Choice::LinearProblem);
 }
@@ -186,17 +183,18 @@ fn auto_records_its_choice() {
 #[test]
 fn a_result_set_is_written_and_read_back_without_the_cli() {
     let case = Case::from_toml_str(SQUARE, None).unwrap();
-    let outcome = run(&case.problem, &case.settings, &mut Silent).unwrap();
+    let outcome = run(&case, &mut Silent).unwrap();
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("result");
     let options = WriteOptions {
         label: "square".into(),
         vtu: case.output.vtu,
-        csv: case.output.writes_csv(),
         force: false,
         started: Instant::now(),
         plot_options: None,
         run_id: None,
+        cell_data: Vec::new(),
+        adapt: None,
     };
     let written =
         write_result_set(&out, &outcome, &case, &options, &mut |_, _| Ok(vec![])).unwrap();
@@ -210,7 +208,7 @@ fn a_result_set_is_written_and_read_back_without_the_cli() {
         let rec = &summary.files[name];
         assert_eq!(
             rec,
-            &memcontact::output::file_record(&out.join(name)).unwrap()
+            &memcontact::write::file_record(&out.join(name)).unwrap()
         );
     }
     // nodes.csv, read independently, holds U at the interior vertices.

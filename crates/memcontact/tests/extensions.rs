@@ -5,7 +5,7 @@
 //! reproduces exactly, a free edge against the mirrored fixed problem, the both-rigid
 //! admissible set.
 
-use memcontact::run::Discretization;
+use memcontact::discretization::Discretization;
 use memcontact::solve::{HierarchyChoice, Method, Silent};
 use memcontact::{Case, Settings};
 
@@ -273,7 +273,7 @@ refine = 2",
     ))
     .problem
     .mesh;
-    let (h, _) = spec.build().unwrap();
+    let (h, _) = memcontact::discretization::build_mesh(&spec).unwrap();
     for m in &h.levels {
         check(m, &|p| match p {
             [_, 0.0] => "bottom",

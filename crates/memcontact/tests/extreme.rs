@@ -5,7 +5,7 @@
 //! accepted certificate, or refuses with a message that names the condition. No iterate
 //! passes the certificate unless it solves the problem.
 
-use memcontact::run::Discretization;
+use memcontact::discretization::Discretization;
 use memcontact::solve::{Method, Silent, Status};
 use memcontact::{Case, Error, Report};
 

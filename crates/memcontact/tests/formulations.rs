@@ -3,11 +3,11 @@
 //! partial foundation, the solutions of 2f (active set), 2c (QP, Clarabel) and 2b
 //! (coordinate descent) coincide, and every answer satisfies the 2e and 2f certificates.
 
-use memcontact::fem::{Coefficient, FnCoefficient};
+use memcontact::field::{Coefficient, FnCoefficient};
 use memcontact::io::gmsh::read_msh;
 use memcontact::mesh::generate::{disk, rectangle, Diagonal, RectangleSpec};
 use memcontact::mesh::Mesh;
-use memcontact::model::{Foundation, Model, ProblemData, Sampling, Stiffness};
+use memcontact::model::{BodyStiffness, Foundation, Model, ProblemData, Sampling};
 use memcontact::solve::{solve, Method, Settings, Silent, Solution};
 use std::path::Path;
 
@@ -95,7 +95,7 @@ fn model(mesh: &Mesh, phi: &dyn Coefficient, h: Option<&dyn Coefficient>, f: Fou
             tension: 1.5,
             load: &8.0,
             shape: phi,
-            stiffness: h.map_or(Stiffness::Rigid, Stiffness::Elastic),
+            stiffness: h.map_or(BodyStiffness::Rigid, BodyStiffness::Elastic),
             foundation: f,
             sampling: Sampling::Nodal,
         },

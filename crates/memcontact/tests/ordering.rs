@@ -2,9 +2,9 @@
 //! Gmsh writes it) is solved in a renumbered order, and every output comes back in the
 //! user's numbering, equal to the answer computed without renumbering up to rounding.
 
+use memcontact::discretization::BoundData;
 use memcontact::field::Field;
 use memcontact::model::Model;
-use memcontact::run::BoundData;
 use memcontact::solve::{self, Method, Silent};
 use memcontact::{run, Case};
 use std::path::Path;
@@ -50,7 +50,7 @@ fn renumbered_solve_answers_in_the_users_numbering() {
     for method in ["active-set", "multigrid"] {
         for load in [None, Some(Field::Nodal(nodal.clone().into()))] {
             let case = site_case(method, load);
-            let outcome = run(&case.problem, &case.settings, &mut Silent).unwrap();
+            let outcome = run(&case, &mut Silent).unwrap();
             assert!(outcome.report.accepted, "{method}");
             // Solved in another numbering ...
             let internal = outcome.discretization.mesh();

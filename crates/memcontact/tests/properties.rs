@@ -15,13 +15,13 @@
 //! `PROPTEST_RNG_SEED`): `PROPTEST_CASES=2000 PROPTEST_RNG_SEED=$RANDOM cargo test
 //! --release -p memcontact --test properties -- --nocapture`.
 
+use memcontact::discretization::Discretization;
 use memcontact::field::{Field, Stiffness};
 use memcontact::mesh::generate::{self, PolygonSpec};
 use memcontact::mesh::refine::Hierarchy;
 use memcontact::mesh::Mesh;
 use memcontact::model::Foundation;
 use memcontact::problem::{Membrane, MeshSpec, Obstacle, SamplingKind};
-use memcontact::run::Discretization;
 use memcontact::solve::{Method, Settings, Silent};
 use memcontact::{Problem, Report};
 use proptest::prelude::*;

@@ -6,8 +6,8 @@
 use memcontact::field::{Field, DEFAULT_KEY};
 use memcontact::mesh::generate::{self, Diagonal, PolygonSpec, RectangleSpec};
 use memcontact::mesh::refine::Hierarchy;
-use memcontact::model::{Foundation, Model, ProblemData, Sampling, Stiffness};
-use memcontact::results::derive;
+use memcontact::model::{BodyStiffness, Foundation, Model, ProblemData, Sampling};
+use memcontact::outcome::fields::derive;
 use memcontact::solve::{self, Settings, Silent};
 use memcontact_plot::result::ResultData;
 use std::collections::BTreeMap;
@@ -54,8 +54,8 @@ pub fn solve_case(
         load: &load,
         shape: &shape,
         stiffness: match &stiff {
-            Some(s) => Stiffness::Elastic(s),
-            None => Stiffness::Rigid,
+            Some(s) => BodyStiffness::Elastic(s),
+            None => BodyStiffness::Rigid,
         },
         foundation: Foundation::Consistent,
         sampling: Sampling::Nodal,

@@ -45,7 +45,7 @@ from typing import (
 import numpy as np
 
 from . import _memcontact as _native
-from ._memcontact import Case, Mesh, Result, Sweep
+from ._memcontact import Case, Mesh, Result, Study, Sweep
 
 __version__: str = _native.__version__
 
@@ -53,8 +53,10 @@ __all__ = [
     "Case",
     "Mesh",
     "Result",
+    "Study",
     "Sweep",
     "SolverError",
+    "convergence",
     "load_case",
     "rectangle",
     "disk",
@@ -266,6 +268,40 @@ def sweep(case: CaseLike, warm: bool = True, *, check: bool = True) -> Sweep:
     return s
 
 
+def convergence(
+    case: CaseLike,
+    levels: int,
+    *,
+    compare: Optional[str] = None,
+    h_sweep: bool = False,
+    h_values: Optional[Sequence[float]] = None,
+) -> Study:
+    """The convergence study of a case, as ``memcontact convergence`` runs it (the same
+    options as keywords): the case's mesh (level 0) and ``levels`` successive uniform
+    refinements, each solved and measured against the exact solution of the case's
+    ``[exact]`` section (without one, against the finest level's solution), with the GIL
+    released. ``compare="foundation"`` (consistent against lumped L) or ``"sampling"``
+    (nodal against mollified φ) studies both variants; ``h_sweep=True`` runs the rigid
+    limit instead, on the case's mesh refined ``levels`` times, with the stiffnesses
+    ``h_values`` (default 10, 10², …, 10⁶).
+
+    Returns a :class:`Study`: ``rows`` (one dict per level keyed by the columns of
+    ``convergence.csv``, or of ``h_sweep.csv`` for the rigid limit; a missing value is
+    None), ``variants`` (the rows of every variant by file name), ``exact``, and
+    ``write(directory)``, which writes the command-line tool's files. Raises
+    ``ValueError`` for bad data."""
+    s = _native.convergence(
+        _as_case(case),
+        int(levels),
+        compare,
+        bool(h_sweep),
+        None if h_values is None else [float(h) for h in h_values],
+    )
+    for note in s.warnings:
+        warnings.warn(note, stacklevel=2)
+    return s
+
+
 def _solve_any(case: Case) -> Result:
     """Solves without raising on a status other than converged."""
     return _native.solve(case)
@@ -353,11 +389,9 @@ def solve_mesh(
         if triangles is None:
             raise TypeError("solve_mesh needs triangles (or a Mesh)")
         mesh = Mesh(vertices, triangles, regions, region_names)
-    # NumPy arrays (one value per vertex) go to the library as arrays; the case holds a
-    # placeholder for them.
     if (lower_shape is None) != (lower_stiffness is None):
         raise TypeError("a body below needs both lower_shape and lower_stiffness")
-    nodal: Dict[str, np.ndarray] = {}
+    # NumPy arrays (one value per vertex) go to the library as they are.
     given: Dict[str, Any] = {"load": load, "shape": shape, "stiffness": stiffness}
     if boundary_height is not None:
         given["height"] = boundary_height
@@ -372,12 +406,10 @@ def solve_mesh(
                     f"{name}: nodal values must have shape ({mesh.n_vertices},), one per "
                     f"vertex, got shape {value.shape}"
                 )
-            nodal[name] = a
-            given[name] = 0.0
-    load, shape, stiffness = given["load"], given["shape"], given["stiffness"]
+            given[name] = a
     obstacle: Dict[str, Any] = {
-        "shape": shape,
-        "stiffness": stiffness,
+        "shape": given["shape"],
+        "stiffness": given["stiffness"],
         "foundation": foundation,
         "sampling": sampling,
     }
@@ -387,8 +419,7 @@ def solve_mesh(
     if max_iterations is not None:
         solver["max_iterations"] = max_iterations
     data: Dict[str, Any] = {
-        "mesh": {"file": "(mesh given in Python)"},
-        "membrane": {"tension": tension, "load": load},
+        "membrane": {"tension": tension, "load": given["load"]},
         "obstacle": obstacle,
         "solver": solver,
     }
@@ -408,12 +439,9 @@ def solve_mesh(
             "foundation": lower_foundation,
             "sampling": lower_sampling,
         }
+    # Errors name the case's keys; this function's arguments are named after them.
     try:
-        case = Case(data, "mesh")
-    except ValueError as e:
-        raise ValueError(_rename_keys(str(e))) from None
-    try:
-        result = _native.solve_on(mesh, case, nodal)
+        result = _native.solve_on(mesh, data, "mesh")
     except ValueError as e:
         raise ValueError(_rename_keys(str(e))) from None
     return _check(result) if check else result

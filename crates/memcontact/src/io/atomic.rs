@@ -2,8 +2,8 @@
 //! failed run never leaves a half-written output behind. The bytes are counted and hashed
 //! as they are written ([`Written`]), so a result set's manifest never reads its files back.
 
-use super::staged::Staged;
-use crate::{Error, Result};
+use super::direct_writer::Staged;
+use crate::error::{Error, Result};
 use std::io::Write;
 use std::path::Path;
 
@@ -97,7 +97,7 @@ mod tests {
     fn large_file_written_in_staging_buffers_is_whole() {
         let tmp = tempfile::tempdir().unwrap();
         let p = tmp.path().join("big.bin");
-        let data: Vec<u8> = (0..(5 * super::super::staged::STAGE as u64 + 12_345))
+        let data: Vec<u8> = (0..(5 * super::super::direct_writer::STAGE as u64 + 12_345))
             .map(|i| (i % 253) as u8)
             .collect();
         let written = write_atomic(&p, |w| {

@@ -12,8 +12,8 @@
 //!
 //! Files are written atomically ([`crate::io::write_atomic`]).
 
-use super::vtu::DataArray;
-use crate::{Error, Result};
+use super::numbers::{push_int, push_shortest, DataArray};
+use crate::error::{Error, Result};
 use rayon::prelude::*;
 use std::path::Path;
 
@@ -157,46 +157,6 @@ fn push_f64(buf: &mut Vec<u8>, x: f64) {
     } else {
         buf.extend_from_slice(b"-inf");
     }
-}
-
-/// Appends the finite `x` in the shortest form that reads back to the same `f64`, with
-/// exponents written without a plus sign (`1e16`, `2.5e-7`), the form of every text file
-/// memcontact writes.
-pub(crate) fn push_shortest(buf: &mut Vec<u8>, x: f64) {
-    let mut b = zmij::Buffer::new();
-    let text = b.format_finite(x).as_bytes();
-    // Only numbers of magnitude 1e16 and more are written with a positive exponent.
-    if x.abs() < 1e15 {
-        buf.extend_from_slice(text);
-        return;
-    }
-    match text.iter().position(|&c| c == b'+') {
-        Some(k) => {
-            buf.extend_from_slice(&text[..k]);
-            buf.extend_from_slice(&text[k + 1..]);
-        }
-        None => buf.extend_from_slice(text),
-    }
-}
-
-/// Appends the decimal digits of `x`, as `{x}` writes them, without the formatting
-/// machinery (state and region columns are a million integers and more).
-pub(crate) fn push_int(buf: &mut Vec<u8>, x: i64) {
-    if x < 0 {
-        buf.push(b'-');
-    }
-    let mut n = x.unsigned_abs();
-    let mut digits = [0u8; 20];
-    let mut k = digits.len();
-    loop {
-        k -= 1;
-        digits[k] = b'0' + (n % 10) as u8;
-        n /= 10;
-        if n == 0 {
-            break;
-        }
-    }
-    buf.extend_from_slice(&digits[k..]);
 }
 
 #[cfg(test)]
@@ -356,23 +316,6 @@ pub(crate) mod tests {
         std::fs::remove_file(&path).unwrap();
     }
 
-    /// CPU time of this process (user + system, all threads) from /proc, NaN elsewhere: wall
-    /// times are unreliable on a loaded machine.
-    pub(crate) fn cpu_seconds() -> f64 {
-        let Ok(stat) = std::fs::read_to_string("/proc/self/stat") else {
-            return f64::NAN;
-        };
-        // Fields after the command name (which is in parentheses): utime, stime are 14, 15.
-        let after = &stat[stat.rfind(')').unwrap() + 2..];
-        let f: Vec<f64> = after
-            .split(' ')
-            .skip(11)
-            .take(2)
-            .map(|x| x.parse().unwrap())
-            .collect();
-        (f[0] + f[1]) / 100.0
-    }
-
     /// Release-mode timing: `cargo test --release -p memcontact csv_speed -- --ignored --nocapture`.
     #[test]
     #[ignore]
@@ -393,16 +336,16 @@ pub(crate) mod tests {
             .collect();
         let path = tmp("speed.csv");
         let t = std::time::Instant::now();
-        let cpu = cpu_seconds();
+        let cpu = crate::io::numbers::cpu_seconds();
         write_columns_csv(&path, &columns).unwrap();
         eprintln!(
             "CSV 1M rows x 10 f64 columns: {:.3} s wall, {:.2} s CPU (all threads), {:.1} MB",
             t.elapsed().as_secs_f64(),
-            cpu_seconds() - cpu,
+            crate::io::numbers::cpu_seconds() - cpu,
             std::fs::metadata(&path).unwrap().len() as f64 / 1e6
         );
         let t = std::time::Instant::now();
-        let cpu = cpu_seconds();
+        let cpu = crate::io::numbers::cpu_seconds();
         let bytes: usize = (0..n)
             .step_by(ROWS_PER_BLOCK)
             .map(|i| format_rows(&columns, i..(i + ROWS_PER_BLOCK).min(n)).len())
@@ -410,7 +353,7 @@ pub(crate) mod tests {
         eprintln!(
             "  formatting alone on one thread: {:.3} s wall, {:.2} s CPU ({bytes} bytes)",
             t.elapsed().as_secs_f64(),
-            cpu_seconds() - cpu
+            crate::io::numbers::cpu_seconds() - cpu
         );
         std::fs::remove_file(&path).unwrap();
     }

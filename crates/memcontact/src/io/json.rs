@@ -5,7 +5,7 @@
 //! serialised struct that is NaN or infinite is written as `null` by serde_json. Readers
 //! therefore see `null` where a value was not finite.
 
-use crate::Result;
+use crate::error::Result;
 use std::path::Path;
 
 /// Writes `value` pretty-printed (two-space indent) with a trailing newline, atomically.
@@ -13,7 +13,7 @@ use std::path::Path;
 /// `value` is usually a [`serde_json::Value`], but any [`serde::Serialize`] type works (a
 /// results struct, a map, ...). Non-finite floats are written as `null` (see the module
 /// documentation). A serialisation failure (e.g. a map with non-string keys) is reported as
-/// [`crate::Error::Io`] and leaves no file.
+/// [`crate::error::Error::Io`] and leaves no file.
 pub fn write_json<T: serde::Serialize + ?Sized>(path: &Path, value: &T) -> Result<()> {
     crate::io::write_atomic(path, |w| {
         serde_json::to_writer_pretty(&mut *w, value).map_err(std::io::Error::other)?;

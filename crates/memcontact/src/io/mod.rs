@@ -2,10 +2,12 @@
 
 mod atomic;
 pub mod csv;
+mod direct_writer;
 pub mod gmsh;
+pub mod input;
 pub mod json;
+pub mod numbers;
 pub mod result_set;
-mod staged;
 pub mod vtu;
 pub use atomic::{write_atomic, Written};
 

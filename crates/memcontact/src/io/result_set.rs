@@ -7,7 +7,7 @@
 //! `RENAME_EXCHANGE`); the old one is then removed. Staging directories left by killed
 //! runs are removed by the next run into the same place.
 
-use crate::{Error, Result};
+use crate::error::{Error, Result};
 use std::ffi::OsString;
 use std::path::{Path, PathBuf};
 

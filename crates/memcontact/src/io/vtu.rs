@@ -17,39 +17,13 @@
 //!
 //! The file is written atomically ([`crate::io::write_atomic`]).
 
-use crate::io::csv::push_int;
+use crate::error::{Error, Result};
+pub use crate::io::numbers::DataArray;
+use crate::io::numbers::{push_int, push_shortest};
 use crate::io::Written;
 use crate::mesh::Mesh;
-use crate::{Error, Result};
 use std::io::Write;
 use std::path::Path;
-
-/// A borrowed data array for a VTU file (one component per vertex or per triangle).
-#[derive(Debug, Clone, Copy)]
-pub enum DataArray<'a> {
-    /// 64-bit floats (VTK `Float64`).
-    F64(&'a [f64]),
-    /// 32-bit signed integers (VTK `Int32`), e.g. region tags or vertex indices.
-    I32(&'a [i32]),
-    /// 8-bit signed integers (VTK `Int8`), e.g. flags such as "in contact".
-    I8(&'a [i8]),
-}
-
-impl DataArray<'_> {
-    /// Number of values.
-    pub fn len(&self) -> usize {
-        match self {
-            DataArray::F64(v) => v.len(),
-            DataArray::I32(v) => v.len(),
-            DataArray::I8(v) => v.len(),
-        }
-    }
-
-    /// True when the array holds no value.
-    pub fn is_empty(&self) -> bool {
-        self.len() == 0
-    }
-}
 
 /// How the arrays of a VTU file are stored.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -294,7 +268,7 @@ fn write_le<T: Copy, const N: usize>(
 /// Appends `x` in its shortest round-trip form (`nan`, `inf`, `-inf` when not finite).
 fn push_f64(buf: &mut Vec<u8>, x: f64) {
     if x.is_finite() {
-        super::csv::push_shortest(buf, x);
+        push_shortest(buf, x);
     } else if x.is_nan() {
         buf.extend_from_slice(b"nan");
     } else if x > 0.0 {
@@ -907,10 +881,10 @@ mod tests {
             .collect();
         let path = tmp("speed.vtu");
         let t = std::time::Instant::now();
-        let cpu = crate::io::csv::tests::cpu_seconds();
+        let cpu = crate::io::numbers::cpu_seconds();
         write_vtu(&path, &mesh, &point_data, &[], VtuEncoding::Binary).unwrap();
         let dt = t.elapsed();
-        let cpu = crate::io::csv::tests::cpu_seconds() - cpu;
+        let cpu = crate::io::numbers::cpu_seconds() - cpu;
         let size = std::fs::metadata(&path).unwrap().len();
         eprintln!(
             "binary VTU: {} vertices, {} triangles, 6 arrays: {:.3} s wall, {cpu:.2} s CPU, {:.1} MB",

@@ -4,7 +4,7 @@
 //! t ∂u/∂n = 0) that decides which vertices carry unknowns.
 
 use super::{DofMap, Mesh, VertexTriangles};
-use crate::{Error, Result};
+use crate::error::{Error, Result};
 use std::collections::{BTreeMap, HashMap};
 
 /// The tag of the boundary edges no region names (and of the whole boundary of a mesh
@@ -74,7 +74,7 @@ impl BoundaryRegions {
 
 /// The name of the boundary edges that no boundary region covers (tag [`UNTAGGED`]): the
 /// key that `free` and `[boundary]` tables give them by.
-pub const UNTAGGED_NAME: &str = "default";
+pub const UNTAGGED_NAME: &str = super::regions::DEFAULT;
 
 /// Warnings about boundary region names that `free` and `[boundary]` tables cannot address
 /// plainly: a region named [`UNTAGGED_NAME`] (the name of the edges no region covers, and

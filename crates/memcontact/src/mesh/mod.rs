@@ -1,14 +1,18 @@
 //! Triangular meshes: the type, its checks and quality report, the boundary and the map
 //! between vertices and unknowns (SPEC §2: the unknowns are the interior vertices).
 
+pub mod bisect;
 pub mod boundary;
 pub mod generate;
+pub mod mark;
 pub mod refine;
+pub mod regions;
 pub mod reorder;
+pub mod segment;
 
 pub use boundary::BoundaryRegions;
 
-use crate::{Error, Result};
+use crate::error::{Error, Result};
 use std::collections::BTreeMap;
 
 /// A point of the plane.
@@ -661,6 +665,29 @@ pub fn dist(a: Point, b: Point) -> f64 {
     ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2)).sqrt()
 }
 
+/// The unit square cut into `n × n` cells, each into two triangles (tests of every
+/// layer).
+#[cfg(test)]
+/// The unit square cut into `n × n` cells, each into two triangles.
+pub(crate) fn test_square(n: usize) -> Mesh {
+    let mut p = Vec::new();
+    for j in 0..=n {
+        for i in 0..=n {
+            p.push([i as f64 / n as f64, j as f64 / n as f64]);
+        }
+    }
+    let mut t = Vec::new();
+    let w = (n + 1) as u32;
+    for j in 0..n as u32 {
+        for i in 0..n as u32 {
+            let a = j * w + i;
+            t.push([a, a + 1, a + w + 1]);
+            t.push([a, a + w + 1, a + w]);
+        }
+    }
+    Mesh::new(p, t, vec![], BTreeMap::new()).unwrap()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -697,7 +724,7 @@ mod tests {
             }
         }
         for threads in [1, 2, 3] {
-            let adj = crate::on_threads(threads, || VertexTriangles::new(&mesh));
+            let adj = crate::parallel::on_threads(threads, || VertexTriangles::new(&mesh));
             for (v, list) in lists.iter().enumerate() {
                 assert_eq!(adj.of(v), &list[..], "vertex {v}, {threads} threads");
             }

@@ -502,7 +502,7 @@ mod tests {
         assert!((a.area - b.area).abs() < 1e-14 * b.area);
         assert_eq!((a.l_n, a.s_n, a.unknowns), (b.l_n, b.s_n, b.unknowns));
         // A structured order is kept.
-        let grid = crate::solve::tests::square(32);
+        let grid = crate::mesh::test_square(32);
         assert!(renumbering_for_locality(&grid).is_none());
     }
 

@@ -2,7 +2,7 @@
 //! states of the consistent model, globalised so that it converges from any start.
 //!
 //! One iteration:
-//! 1. a nonsmooth Gauss-Seidel sweep (exact one-variable minimisation, [`super::local`]):
+//! 1. a nonsmooth Gauss-Seidel sweep (exact one-variable minimisation, [`super::relax`]):
 //!    it moves every vertex whose state is wrong (a touching vertex whose multiplier has
 //!    the wrong sign leaves the kink) and puts vertices exactly on φ_i where their local
 //!    minimum is the kink;
@@ -19,12 +19,12 @@
 //! step lands on U exactly (finite termination in exact arithmetic).
 
 use super::line_search::{apply_step, exact_step, line_data};
-use super::local::sweep_forward;
 use super::newton::{newton_system, unit_diagonal_on_truncated, NewtonStates};
+use super::relax::sweep_forward;
 use super::{IterationRecord, Method, Observer, PhaseTimer, Settings, Solution};
+use crate::error::{Error, Result};
 use crate::model::Model;
 use crate::sparse::{Cholesky, Csr};
-use crate::{Error, Result};
 
 /// Default iteration limit.
 pub(crate) const MAX_ITERATIONS: usize = 500;
@@ -131,6 +131,7 @@ pub fn solve(
         certificate = ev.certificate;
         let record = IterationRecord::new(iterations, &ev);
         observer.iteration(&record);
+        settings.cancel.check()?;
         history.push(record);
         if v == before {
             stalled += 1;

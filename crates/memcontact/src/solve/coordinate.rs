@@ -3,10 +3,10 @@
 //! Simple and robust, but the number of sweeps grows like the square of the mesh size:
 //! meant for verification on small meshes.
 
-use super::local::sweep_forward;
+use super::relax::sweep_forward;
 use super::{IterationRecord, Method, Observer, PhaseTimer, Settings, Solution};
+use crate::error::Result;
 use crate::model::Model;
-use crate::Result;
 
 /// Default limit on sweeps.
 pub(crate) const MAX_SWEEPS: usize = 1_000_000;
@@ -35,14 +35,19 @@ pub fn solve_from(
         let todo = check_every.min(max - sweeps);
         timer.time("sweeps", || {
             for _ in 0..todo {
+                if settings.cancel.is_cancelled() {
+                    break;
+                }
                 sweep_forward(model, &mut v);
             }
         });
+        settings.cancel.check()?;
         sweeps += todo;
         let ev = timer.time("certificate", || crate::certificate::evaluate(model, &v));
         certificate = ev.certificate;
         let record = IterationRecord::new(sweeps, &ev);
         observer.iteration(&record);
+        settings.cancel.check()?;
         history.push(record);
         if certificate.settled(settings.tolerance) || watch.stuck(&certificate) {
             break;

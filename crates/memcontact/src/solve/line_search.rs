@@ -19,8 +19,8 @@
 //! computes the pieces of either body. Where a body is rigid the step is limited so that
 //! `V + αδ` keeps its constraint.
 
-use super::multigrid::transfer::{par_rows, PAR_ROWS};
 use crate::model::{FoundationMatrix, Model};
+use crate::sparse::{par_rows, VECTOR_ROWS};
 use rayon::prelude::*;
 
 /// Rows per block of the deterministic reductions.
@@ -52,7 +52,7 @@ fn reduce<T: Send + Copy>(
     fold: impl Fn(T, T) -> T,
 ) -> T {
     let nb = n.div_ceil(BLOCK).max(1);
-    let parts: Vec<T> = if n >= PAR_ROWS {
+    let parts: Vec<T> = if n >= VECTOR_ROWS {
         (0..nb).into_par_iter().map(block).collect()
     } else {
         (0..nb).map(block).collect()
@@ -399,7 +399,7 @@ pub fn apply_step(model: &Model, v: &mut [f64], dir: &[f64], alpha: f64) -> bool
         }
         changed
     };
-    if v.len() < PAR_ROWS {
+    if v.len() < VECTOR_ROWS {
         return chunk(0, v);
     }
     v.par_chunks_mut(BLOCK)

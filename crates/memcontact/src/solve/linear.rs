@@ -2,9 +2,9 @@
 //! paper's "classical algorithms" case).
 
 use super::{PhaseTimer, Settings, Solution};
+use crate::error::{Error, Result};
 use crate::model::Model;
 use crate::sparse::Cholesky;
-use crate::{Error, Result};
 
 /// Solves `S U = D` by sparse Cholesky; a bad-input error unless L = 0.
 pub fn solve(model: &Model, _settings: &Settings) -> Result<Solution> {

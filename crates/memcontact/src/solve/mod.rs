@@ -16,14 +16,15 @@ pub mod active_set;
 pub mod coordinate;
 pub mod line_search;
 pub mod linear;
-pub mod local;
 pub mod multigrid;
 pub mod newton;
 pub mod qp;
+pub mod relax;
 
+use crate::certificate::Certificate;
+use crate::error::{Error, Result};
 use crate::mesh::refine::Hierarchy;
-use crate::model::{Certificate, Model};
-use crate::{Error, Result};
+use crate::model::Model;
 use std::time::Instant;
 
 /// The solution methods.
@@ -99,6 +100,10 @@ pub struct Settings {
     pub accept_rounding_floor: bool,
     /// The coarse levels of the multigrid method.
     pub hierarchy: HierarchyChoice,
+    /// Stops the solve when cancelled (checked every iteration and inside the multigrid
+    /// iteration; not part of a case file).
+    #[serde(skip)]
+    pub cancel: crate::parallel::Cancel,
 }
 
 /// Which coarse levels the multigrid method uses.
@@ -119,8 +124,8 @@ pub const LOOSEST_TOLERANCE: f64 = 1e-2;
 
 impl Settings {
     /// Checks the settings: `0 < tolerance <` [`LOOSEST_TOLERANCE`], `max_iterations ≥ 1`.
-    pub fn validate(&self) -> std::result::Result<(), crate::problem::Invalid> {
-        use crate::problem::Invalid;
+    pub fn validate(&self) -> std::result::Result<(), crate::error::Invalid> {
+        use crate::error::Invalid;
         let tol = self.tolerance;
         if !(tol.is_finite() && tol > 0.0) {
             return Err(Invalid::new(
@@ -153,6 +158,7 @@ impl Default for Settings {
             max_iterations: None,
             accept_rounding_floor: true,
             hierarchy: HierarchyChoice::Auto,
+            cancel: crate::parallel::Cancel::default(),
         }
     }
 }
@@ -201,6 +207,37 @@ pub trait Observer {
     fn phase_finished(&mut self, _name: &str, _seconds: f64) {}
     /// Step `index` (0-based) of `total` of a sweep starts.
     fn step_started(&mut self, _index: usize, _total: usize, _name: &str) {}
+    /// Whether the run should stop (asked between the phases of a run).
+    fn cancelled(&self) -> bool {
+        false
+    }
+}
+
+/// An observer that also answers [`Observer::cancelled`] from a token (the runs wrap the
+/// caller's observer with their settings' token).
+pub struct Cancellable<'a> {
+    /// The caller's observer.
+    pub inner: &'a mut dyn Observer,
+    /// The token.
+    pub cancel: &'a crate::parallel::Cancel,
+}
+
+impl Observer for Cancellable<'_> {
+    fn iteration(&mut self, record: &IterationRecord) {
+        self.inner.iteration(record)
+    }
+    fn phase_started(&mut self, name: &str) {
+        self.inner.phase_started(name)
+    }
+    fn phase_finished(&mut self, name: &str, seconds: f64) {
+        self.inner.phase_finished(name, seconds)
+    }
+    fn step_started(&mut self, index: usize, total: usize, name: &str) {
+        self.inner.step_started(index, total, name)
+    }
+    fn cancelled(&self) -> bool {
+        self.cancel.is_cancelled() || self.inner.cancelled()
+    }
 }
 
 /// An observer that ignores everything.
@@ -414,7 +451,7 @@ impl Method {
             Method::ActiveSet => active_set::MAX_ITERATIONS,
             Method::Qp => qp::MAX_ITERATIONS as usize,
             Method::Coordinate => coordinate::MAX_SWEEPS,
-            Method::Multigrid => multigrid::MAX_ITERATIONS,
+            Method::Multigrid => multigrid::tnnmg::MAX_ITERATIONS,
         }
     }
 }
@@ -663,6 +700,42 @@ pub fn status_error(
             "{what}, with scaled KKT residual {kkt:.3e} above the tolerance {tolerance:.1e}{why}"
         ),
     }
+}
+
+/// The memory a solve by `method` adds to the run's ([`crate::limits::run_bytes`]) on `unknowns`
+/// unknowns: a sparse factorisation for the direct methods, nothing that grows faster
+/// than the run's own data for multigrid and coordinate descent.
+pub fn solver_bytes(method: Method, unknowns: usize) -> f64 {
+    let n = unknowns.max(2) as f64;
+    match method {
+        Method::ActiveSet | Method::Linear => {
+            crate::limits::DIRECT_BYTES_PER_UNKNOWN_LOG * n * n.log2()
+        }
+        Method::Qp => crate::limits::QP_BYTES_PER_UNKNOWN_LOG * n * n.log2(),
+        Method::Auto | Method::Multigrid | Method::Coordinate => 0.0,
+    }
+}
+
+/// Refuses a solve by `method` of a model of `unknowns` unknowns when its factorisation
+/// would not fit in the memory available now (the mesh and the model are already
+/// allocated and so are not counted again).
+pub fn check_solver_fits(method: Method, unknowns: usize) -> Result<()> {
+    let need = solver_bytes(method, unknowns);
+    if need == 0.0 {
+        return Ok(());
+    }
+    let (available, source) = crate::limits::available_memory();
+    if need > available as f64 {
+        return Err(Error::Data(format!(
+            "solver {}: its factorisation of {unknowns} unknowns needs about {} of memory, \
+             more than the {} available ({source}): use method = \"multigrid\" (with \
+             mesh.refine ≥ 2) or \"auto\", or a coarser mesh",
+            method.name(),
+            crate::limits::human_bytes(need),
+            crate::limits::human_bytes(available as f64),
+        )));
+    }
+    Ok(())
 }
 
 #[cfg(test)]

@@ -12,10 +12,10 @@
 //! `E_Q L_low E_Q` to the Hessian and `− E_Q L_low q` (`q = (φ_low − V)⁺`) to the gradient;
 //! vertices on either body's surface, or held by a rigid one, are truncated.
 
-use super::multigrid::transfer::{par_rows, PAR_ROWS};
 use crate::model::{FoundationMatrix, Model};
 use crate::sparse::row_chunks;
 use crate::sparse::{filled, zeroed, Csr, Pattern};
+use crate::sparse::{par_rows, VECTOR_ROWS};
 use rayon::prelude::*;
 
 /// The states of the truncated Newton step at V: which vertices are held (touching, or at
@@ -324,7 +324,7 @@ fn newton_system_with<const EXT: bool>(
                     off += len;
                 }
             };
-            if v.len() >= PAR_ROWS {
+            if v.len() >= VECTOR_ROWS {
                 blocks
                     .into_par_iter()
                     .zip(g.par_chunks_mut(CHUNK).zip(r.par_chunks_mut(CHUNK)))
@@ -343,7 +343,7 @@ fn newton_system_with<const EXT: bool>(
                     gradient(block * CHUNK + k, gi, ri);
                 }
             };
-            if v.len() >= PAR_ROWS {
+            if v.len() >= VECTOR_ROWS {
                 g.par_chunks_mut(CHUNK)
                     .zip(r.par_chunks_mut(CHUNK))
                     .enumerate()
@@ -364,7 +364,7 @@ fn newton_system_with<const EXT: bool>(
                     *di = shift(i);
                 }
             };
-            if v.len() >= PAR_ROWS {
+            if v.len() >= VECTOR_ROWS {
                 d.par_chunks_mut(CHUNK)
                     .zip(g.par_chunks_mut(CHUNK).zip(r.par_chunks_mut(CHUNK)))
                     .enumerate()
@@ -519,7 +519,9 @@ mod tests {
                     }
                 }
                 (NewtonMatrix::Implicit, Foundation::Lumped) => {
-                    let FoundationMatrix::Lumped(l) = &model.l else { unreachable!() };
+                    let FoundationMatrix::Lumped(l) = &model.l else {
+                        unreachable!()
+                    };
                     let op = crate::solve::multigrid::operator::LumpedShifted {
                         s: &model.s,
                         l,

@@ -73,9 +73,10 @@
 
 use super::newton::{truncated_hessian, NewtonStates};
 use super::{Method, Multipliers, PhaseTimer, Settings, Solution};
-use crate::model::{Certificate, FoundationMatrix, Model};
+use crate::certificate::Certificate;
+use crate::error::{Error, Result};
+use crate::model::{FoundationMatrix, Model};
 use crate::sparse::{Cholesky, Csr};
-use crate::{Error, Result};
 use clarabel::algebra::CscMatrix;
 use clarabel::solver::{
     DefaultSettingsBuilder, DefaultSolver, IPSolver, SolverStatus, SupportedConeT,
@@ -865,9 +866,10 @@ fn polish(model: &Model, guess: NewtonStates, tolerance: f64) -> Option<Polished
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::fem::{Coefficient, FnCoefficient};
+    use crate::field::{Coefficient, FnCoefficient};
+    use crate::mesh::test_square as square;
+    use crate::model::testing::model;
     use crate::model::Foundation;
-    use crate::solve::tests::{model, square};
     use crate::solve::{active_set, Silent};
     use crate::sparse::norm_inf;
 

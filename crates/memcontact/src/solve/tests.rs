@@ -2,29 +2,10 @@
 //! certificates at the tolerance.
 
 use super::*;
-use crate::fem::FnCoefficient;
-use crate::mesh::Mesh;
-use crate::model::{Foundation, ProblemData, Sampling, Stiffness};
-use std::collections::BTreeMap;
-
-pub(crate) fn square(n: usize) -> Mesh {
-    let mut p = Vec::new();
-    for j in 0..=n {
-        for i in 0..=n {
-            p.push([i as f64 / n as f64, j as f64 / n as f64]);
-        }
-    }
-    let mut t = Vec::new();
-    let w = (n + 1) as u32;
-    for j in 0..n as u32 {
-        for i in 0..n as u32 {
-            let a = j * w + i;
-            t.push([a, a + 1, a + w + 1]);
-            t.push([a, a + w + 1, a + w]);
-        }
-    }
-    Mesh::new(p, t, vec![], BTreeMap::new()).unwrap()
-}
+use crate::field::FnCoefficient;
+use crate::mesh::test_square as square;
+use crate::model::testing::model;
+use crate::model::Foundation;
 
 fn settings(method: Method) -> Settings {
     Settings {
@@ -40,29 +21,6 @@ fn rel_diff(a: &[f64], b: &[f64]) -> f64 {
         .zip(b)
         .fold(0.0f64, |m, (x, y)| m.max((x - y).abs()));
     num / crate::sparse::norm_inf(b).max(1e-300)
-}
-
-pub(crate) fn model(
-    mesh: &Mesh,
-    h: Option<&dyn crate::fem::Coefficient>,
-    foundation: Foundation,
-) -> Model {
-    let phi = FnCoefficient(|p: [f64; 2]| 0.12 + 0.05 * (6.0 * p[0]).sin() * p[1]);
-    Model::assemble(
-        mesh,
-        &ProblemData {
-            tension: 1.0,
-            load: &8.0,
-            shape: &phi,
-            stiffness: match h {
-                Some(h) => Stiffness::Elastic(h),
-                None => Stiffness::Rigid,
-            },
-            foundation,
-            sampling: Sampling::Nodal,
-        },
-    )
-    .unwrap()
 }
 
 #[test]

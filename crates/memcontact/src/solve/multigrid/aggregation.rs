@@ -352,7 +352,7 @@ mod tests {
         let a = lap2d(400);
         assert!(a.n() >= 2 * MATCH_BLOCK);
         let many = pairwise(&a);
-        let one = crate::on_threads(1, || pairwise(&a));
+        let one = crate::parallel::on_threads(1, || pairwise(&a));
         assert_eq!(many, one);
     }
 

@@ -4,12 +4,16 @@
 //! sparse Cholesky), with monotone energy, bounded iteration counts under refinement and
 //! results independent of the number of threads.
 
-use super::*;
-use crate::fem::Coefficient;
+use super::levels::*;
+use super::smoother::*;
+use super::tnnmg::*;
+use crate::field::Coefficient;
 use crate::mesh::generate::{disk, polygon, PolygonSpec};
 use crate::mesh::{Mesh, Point};
-use crate::model::{Foundation, ProblemData, Sampling, Stiffness};
+use crate::model::Model;
+use crate::model::{BodyStiffness, Foundation, ProblemData, Sampling};
 use crate::solve::{active_set, Silent};
+use crate::solve::{Method, Settings};
 use crate::sparse::norm_inf;
 
 /// A coefficient given per region and point.
@@ -43,8 +47,8 @@ fn model(mesh: &Mesh, h: Option<&dyn Coefficient>, foundation: Foundation) -> Mo
             load: &20.0,
             shape: &phi,
             stiffness: match h {
-                Some(h) => Stiffness::Elastic(h),
-                None => Stiffness::Rigid,
+                Some(h) => BodyStiffness::Elastic(h),
+                None => BodyStiffness::Rigid,
             },
             foundation,
             sampling: Sampling::Nodal,
@@ -61,11 +65,11 @@ fn settings() -> Settings {
     }
 }
 
-/// Options that coarsen small test meshes over several levels.
-fn options() -> Options {
-    Options {
+/// TnnmgOptions that coarsen small test meshes over several levels.
+fn options() -> TnnmgOptions {
+    TnnmgOptions {
         coarsest: 40,
-        ..Options::default()
+        ..TnnmgOptions::default()
     }
 }
 
@@ -83,7 +87,7 @@ fn agrees_with_active_set(model: &Model, what: &str) {
     let reference = active_set::solve(model, &settings(), None, &mut Silent).unwrap();
     for nested in [true, false] {
         let what = format!("{what}, nested {nested}");
-        let options = Options {
+        let options = TnnmgOptions {
             nested,
             ..options()
         };
@@ -96,7 +100,12 @@ fn agrees_with_active_set(model: &Model, what: &str) {
 }
 
 /// Algebraic TNNMG with `options` against `reference`, with its energy history monotone.
-fn agrees_with(model: &Model, options: &Options, reference: &[f64], what: &str) -> Report {
+fn agrees_with(
+    model: &Model,
+    options: &TnnmgOptions,
+    reference: &[f64],
+    what: &str,
+) -> TnnmgReport {
     let (sol, rep) = solve_with(
         model,
         Coarsening::Algebraic,
@@ -204,7 +213,7 @@ fn iteration_counts_stay_bounded_under_refinement() {
                     &m,
                     Coarsening::Algebraic,
                     &settings(),
-                    &Options::default().with_coarsest(200),
+                    &TnnmgOptions::default().with_coarsest(200),
                     None,
                     &mut Silent,
                 )
@@ -223,14 +232,14 @@ fn results_do_not_depend_on_the_thread_count() {
     // Large enough for the parallel paths (blocks of the smoother, reductions).
     let mesh = disk([0.0, 0.0], 1.0, 0.008).unwrap();
     let m = model(&mesh, Some(&1000.0), Foundation::Consistent);
-    assert!(m.n() > 2 * super::cycle::GS_BLOCK, "{}", m.n());
+    assert!(m.n() > 2 * GS_BLOCK, "{}", m.n());
     let run = |threads: usize| {
-        crate::on_threads(threads, || {
+        crate::parallel::on_threads(threads, || {
             solve_with(
                 &m,
                 Coarsening::Algebraic,
                 &settings(),
-                &Options::default(),
+                &TnnmgOptions::default(),
                 None,
                 &mut Silent,
             )

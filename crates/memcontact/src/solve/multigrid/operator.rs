@@ -5,7 +5,7 @@
 //! one vector replaces a second copy of S's values (a sixth of the solver's memory on
 //! the benchmark square).
 
-use super::transfer::par_rows;
+use crate::sparse::par_rows;
 use crate::sparse::Csr;
 
 /// A symmetric operator read row by row: the stored matrix's rows, a shift added to the

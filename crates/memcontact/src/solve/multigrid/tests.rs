@@ -1,13 +1,20 @@
 //! Multigrid checks on small structured squares: the linear V-cycle against Cholesky, TNNMG
 //! against the active-set method, monotone energy, iteration counts under refinement.
 
+use super::levels::*;
+use super::smoother::*;
+use super::tnnmg::*;
 use super::*;
-use crate::fem::FnCoefficient;
+use crate::field::FnCoefficient;
+use crate::mesh::refine::Hierarchy;
 use crate::mesh::refine::Refinement;
+use crate::mesh::test_square as square;
 use crate::mesh::{DofMap, Mesh};
-use crate::model::{Foundation, ProblemData, Sampling, Stiffness};
-use crate::solve::tests::square;
+use crate::model::{BodyStiffness, Foundation, ProblemData, Sampling};
+use crate::model::{FoundationMatrix, Model};
 use crate::solve::{active_set, Silent};
+use crate::solve::{Method, Settings};
+use crate::sparse::Csr;
 use crate::sparse::{norm_inf, Cholesky};
 
 /// The unit square on an `n0 2^k` grid for `k = 0..levels`, "right" diagonals, with the
@@ -54,8 +61,8 @@ pub(crate) fn bench_model(mesh: &Mesh, h: Option<f64>, foundation: Foundation) -
             load: &20.0,
             shape: &phi,
             stiffness: match h {
-                Some(_) => Stiffness::Elastic(&hv),
-                None => Stiffness::Rigid,
+                Some(_) => BodyStiffness::Elastic(&hv),
+                None => BodyStiffness::Rigid,
             },
             foundation,
             sampling: Sampling::Nodal,
@@ -210,9 +217,9 @@ fn tnnmg_without_nested_iteration_converges_from_zero() {
         (None, Foundation::Lumped),
     ] {
         let model = bench_model(hier.finest(), h, f);
-        let opts = Options {
+        let opts = TnnmgOptions {
             nested: false,
-            ..Options::default()
+            ..TnnmgOptions::default()
         };
         let (sol, rep) = solve_with(
             &model,
@@ -327,9 +334,9 @@ fn block_gauss_seidel_keeps_the_rate_and_ignores_the_thread_count() {
     // 255² > GS_BLOCK unknowns: the fine level is smoothed block-parallel.
     let h = square_hierarchy(4, 7);
     let model = bench_model(h.finest(), Some(0.0), Foundation::Lumped);
-    assert!(model.n() > cycle::GS_BLOCK);
+    assert!(model.n() > GS_BLOCK);
     let run = |threads: usize| {
-        crate::on_threads(threads, || {
+        crate::parallel::on_threads(threads, || {
             poisson_solve(&model.s, &model.d, &h, &model.dofs, 1e-10, None, 50).unwrap()
         })
     };
@@ -347,9 +354,9 @@ fn sweep_rows_are_the_seams_and_the_diagonal_offsets() {
         let h = square_hierarchy(4, levels);
         let model = bench_model(h.finest(), Some(0.0), Foundation::Lumped);
         let p = &model.s.pattern;
-        let rows = cycle::SweepRows::of(p);
+        let rows = SweepRows::of(p);
         let n = p.n();
-        let block = cycle::gs_block(n);
+        let block = gs_block(n);
         let cols = |i: usize| &p.col[p.row_ptr[i]..p.row_ptr[i + 1]];
         for i in 0..n {
             let before = cols(i).iter().filter(|&&c| (c as usize) < i).count();
@@ -372,7 +379,7 @@ fn sweep_rows_are_the_seams_and_the_diagonal_offsets() {
         row_ptr: vec![0, 1, 1, 2],
         col: vec![0, 2],
     };
-    let rows = cycle::SweepRows::of(&empty);
+    let rows = SweepRows::of(&empty);
     assert_eq!(rows.diag, vec![0, 0, 0]);
     assert!(rows.seams.is_empty());
     // Rows with more columns before the diagonal than a byte counts: the offset is found
@@ -391,8 +398,8 @@ fn sweep_rows_are_the_seams_and_the_diagonal_offsets() {
         row_ptr.push(col.len());
     }
     let star = crate::sparse::Pattern { row_ptr, col };
-    let rows = cycle::SweepRows::of(&star);
-    assert_eq!(rows.diag[m - 1], cycle::SweepRows::MANY);
+    let rows = SweepRows::of(&star);
+    assert_eq!(rows.diag[m - 1], SweepRows::MANY);
     for i in 0..m {
         let cols = &star.col[star.row_ptr[i]..star.row_ptr[i + 1]];
         let expected = match i {
@@ -417,19 +424,19 @@ fn sweep_rows_are_the_seams_and_the_diagonal_offsets() {
         }
     }
     let mut inv = vec![0.0; m];
-    cycle::fill_inv_diag(&a, &mut inv);
+    fill_inv_diag(&a, &mut inv);
     let b: Vec<f64> = (0..m).map(|i| ((i as f64) * 0.71).sin()).collect();
     let (mut x, mut r, mut snap) = (vec![1.0; m], vec![0.0; m], vec![0.0; m]);
-    cycle::gauss_seidel_from_zero(&a, &inv, &mut x, &b, &mut r, &rows);
+    gauss_seidel_from_zero(&a, &inv, &mut x, &b, &mut r, &rows);
     let mut x_ref = vec![0.0; m];
-    cycle::gauss_seidel(&a, &inv, &mut x_ref, &b, &mut snap, false);
+    gauss_seidel(&a, &inv, &mut x_ref, &b, &mut snap, false);
     let mut r_ref = vec![0.0; m];
-    cycle::residual(&a, &x_ref, &b, &mut r_ref);
+    residual(&a, &x_ref, &b, &mut r_ref);
     let close = |p: &[f64], q: &[f64]| p.iter().zip(q).all(|(u, v)| (u - v).abs() <= 1e-12);
     assert!(close(&x, &x_ref) && close(&r, &r_ref));
     let mut y = vec![0.0; m];
-    cycle::gauss_seidel_back_with_product(&a, &inv, &mut x, &b, &mut snap, &mut y, &rows);
-    cycle::gauss_seidel(&a, &inv, &mut x_ref, &b, &mut snap, true);
+    gauss_seidel_back_with_product(&a, &inv, &mut x, &b, &mut snap, &mut y, &rows);
+    gauss_seidel(&a, &inv, &mut x_ref, &b, &mut snap, true);
     let mut y_ref = vec![0.0; m];
     a.mul_into(&x_ref, &mut y_ref);
     assert!(close(&x, &x_ref) && close(&y, &y_ref));
@@ -454,21 +461,21 @@ fn fused_sweep_from_zero_is_the_sweep_and_its_residual() {
             }
         }
         let mut inv = vec![0.0; n];
-        cycle::fill_inv_diag(&a, &mut inv);
+        fill_inv_diag(&a, &mut inv);
         let b: Vec<f64> = (0..n).map(|i| ((i as f64) * 0.71).sin()).collect();
         // The reference: the sweep from zero, then the residual, separately.
         let mut x_ref = vec![0.0; n];
         let mut snap = vec![0.0; n];
-        cycle::gauss_seidel(&a, &inv, &mut x_ref, &b, &mut snap, false);
+        gauss_seidel(&a, &inv, &mut x_ref, &b, &mut snap, false);
         let mut r_ref = vec![0.0; n];
-        cycle::residual(&a, &x_ref, &b, &mut r_ref);
-        let rows = cycle::SweepRows::of(&a.pattern);
-        assert_eq!(rows.seams.is_empty(), n <= cycle::gs_block(n));
+        residual(&a, &x_ref, &b, &mut r_ref);
+        let rows = SweepRows::of(&a.pattern);
+        assert_eq!(rows.seams.is_empty(), n <= gs_block(n));
         let fused = |threads: usize| {
             // Whatever x holds on entry is ignored.
             let (mut x, mut r) = (vec![1.0; n], vec![f64::NAN; n]);
-            crate::on_threads(threads, || {
-                cycle::gauss_seidel_from_zero(&a, &inv, &mut x, &b, &mut r, &rows)
+            crate::parallel::on_threads(threads, || {
+                gauss_seidel_from_zero(&a, &inv, &mut x, &b, &mut r, &rows)
             });
             (x, r)
         };
@@ -521,7 +528,7 @@ fn backward_sweep_with_product_is_the_sweep_and_its_product() {
                 }
             })
             .collect();
-        let rows = cycle::SweepRows::of(&model.s.pattern);
+        let rows = SweepRows::of(&model.s.pattern);
         let check = |name: &str,
                      fused: &dyn Fn(usize) -> (Vec<f64>, Vec<f64>),
                      reference: (Vec<f64>, Vec<f64>)| {
@@ -545,19 +552,17 @@ fn backward_sweep_with_product_is_the_sweep_and_its_product() {
         };
         // The shifted operator: held rows keep x = 0 and get y = 0.
         let mut inv = vec![0.0; n];
-        cycle::fill_inv_diag(&op, &mut inv);
+        fill_inv_diag(&op, &mut inv);
         let reference = {
             let (mut x, mut snap, mut y) = (x0.clone(), vec![0.0; n], vec![0.0; n]);
-            cycle::gauss_seidel(&op, &inv, &mut x, &b, &mut snap, true);
+            gauss_seidel(&op, &inv, &mut x, &b, &mut snap, true);
             apply(&op, &x, &mut y);
             (x, y)
         };
         let fused = |threads: usize| {
             let (mut x, mut snap, mut y) = (x0.clone(), vec![0.0; n], vec![f64::NAN; n]);
-            crate::on_threads(threads, || {
-                cycle::gauss_seidel_back_with_product(
-                    &op, &inv, &mut x, &b, &mut snap, &mut y, &rows,
-                )
+            crate::parallel::on_threads(threads, || {
+                gauss_seidel_back_with_product(&op, &inv, &mut x, &b, &mut snap, &mut y, &rows)
             });
             for i in (0..n).filter(|&i| held[i]) {
                 assert_eq!((x[i], y[i]), (0.0, 0.0), "held row {i}");
@@ -575,19 +580,17 @@ fn backward_sweep_with_product_is_the_sweep_and_its_product() {
             }
         }
         let x1: Vec<f64> = (0..n).map(|i| ((i as f64) * 0.3).cos()).collect();
-        cycle::fill_inv_diag(&a, &mut inv);
+        fill_inv_diag(&a, &mut inv);
         let reference = {
             let (mut x, mut snap) = (x1.clone(), vec![0.0; n]);
-            cycle::gauss_seidel(&a, &inv, &mut x, &b, &mut snap, true);
+            gauss_seidel(&a, &inv, &mut x, &b, &mut snap, true);
             let y = a.mul(&x);
             (x, y)
         };
         let fused = |threads: usize| {
             let (mut x, mut snap, mut y) = (x1.clone(), vec![0.0; n], vec![f64::NAN; n]);
-            crate::on_threads(threads, || {
-                cycle::gauss_seidel_back_with_product(
-                    &a, &inv, &mut x, &b, &mut snap, &mut y, &rows,
-                )
+            crate::parallel::on_threads(threads, || {
+                gauss_seidel_back_with_product(&a, &inv, &mut x, &b, &mut snap, &mut y, &rows)
             });
             (x, y)
         };

@@ -1,4 +1,4 @@
-//! Grid transfer between consecutive levels of a [`Hierarchy`], over the *unknowns* (the
+//! Grid transfer between consecutive levels of a [`crate::mesh::refine::Hierarchy`], over the *unknowns* (the
 //! interior vertices, SPEC §2), and the Galerkin coarse operator `A_c = Pᵀ A P`.
 //!
 //! The mesh refinement says that fine vertex `v` carries `½(c[a] + c[b])` of a coarse P1
@@ -10,15 +10,12 @@
 //! fixed order: results never depend on the number of threads.
 
 use super::operator::{entry, TopOperator};
+use crate::error::{Error, Result};
 use crate::mesh::refine::Refinement;
 use crate::mesh::DofMap;
-use crate::sparse::{row_chunks, Csr, Pattern};
-use crate::{Error, Result};
+use crate::sparse::{par_rows, row_chunks, Csr, Pattern, VECTOR_ROWS};
 use rayon::prelude::*;
 use std::sync::Arc;
-
-/// Below this many rows, loops run serially (threads cost more than they save).
-pub(crate) const PAR_ROWS: usize = 16_384;
 
 /// The weights a fine unknown can have for its two parents.
 const WEIGHTS: [[f32; 2]; 4] = [[0.0, 0.0], [1.0, 0.0], [0.5, 0.5], [0.5, 0.0]];
@@ -98,7 +95,7 @@ impl Transfer {
                 }
             }
         };
-        let (parents, weights): (Vec<[u32; 2]>, Vec<[f32; 2]>) = if n_fine >= PAR_ROWS {
+        let (parents, weights): (Vec<[u32; 2]>, Vec<[f32; 2]>) = if n_fine >= VECTOR_ROWS {
             fine.vertex.par_iter().with_min_len(4096).map(map).unzip()
         } else {
             fine.vertex.iter().map(map).unzip()
@@ -144,7 +141,11 @@ impl Transfer {
             .collect();
         drop(entries);
         let single_parent = weights.par_iter().with_min_len(4096).all(|w| w[1] == 0.0);
-        let weight_code = weights.par_iter().with_min_len(4096).map(|&w| weight_code(w)).collect();
+        let weight_code = weights
+            .par_iter()
+            .with_min_len(4096)
+            .map(|&w| weight_code(w))
+            .collect();
         Transfer {
             n_coarse,
             parents,
@@ -269,7 +270,7 @@ impl Transfer {
             (lens, cols)
         };
         let nb = n_coarse.div_ceil(ROWS);
-        let blocks: Vec<(Vec<u32>, Vec<u32>)> = if n_coarse >= PAR_ROWS {
+        let blocks: Vec<(Vec<u32>, Vec<u32>)> = if n_coarse >= VECTOR_ROWS {
             (0..nb)
                 .into_par_iter()
                 .map_init(|| vec![u32::MAX; n_coarse], block)
@@ -339,7 +340,7 @@ impl Transfer {
                 off += len;
             }
         };
-        if n_coarse >= PAR_ROWS / 4 {
+        if n_coarse >= VECTOR_ROWS / 4 {
             chunks
                 .into_par_iter()
                 .for_each_init(|| vec![0u32; n_coarse], work);
@@ -359,26 +360,6 @@ impl Transfer {
                 .any(|&v| dirty_fine[v as usize]);
         });
     }
-}
-
-/// Runs `f(i, &mut x[i])` over all rows, in parallel for long vectors.
-#[inline]
-pub(crate) fn par_rows<T: Send>(x: &mut [T], f: impl Fn(usize, &mut T) + Sync + Send) {
-    if x.len() >= PAR_ROWS {
-        x.par_iter_mut()
-            .enumerate()
-            .with_min_len(4096)
-            .for_each(|(i, xi)| f(i, xi));
-    } else {
-        for (i, xi) in x.iter_mut().enumerate() {
-            f(i, xi);
-        }
-    }
-}
-
-/// `dst = src`, on all threads for long vectors.
-pub(crate) fn par_copy_from(dst: &mut [f64], src: &[f64]) {
-    par_rows(dst, |i, d| *d = src[i]);
 }
 
 /// The Galerkin patterns of a chain of transfers, coarsest first, ending with `finest`.

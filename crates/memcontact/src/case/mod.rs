@@ -1,0 +1,26 @@
+//! The case: what a case file (TOML), a Rust program or a Python dict says, as owned serde
+//! values. Everything deserialises into the same [`Case`]; unknown keys and bad values are
+//! refused here, before any work, with the key (and, for a file, the file and line).
+//!
+//! A [`Case`] is a [`crate::problem::Problem`], the solver [`crate::solve::Settings`], the
+//! [`OutputOptions`], the [`ExactSpec`] of a closed-form solution for convergence studies,
+//! and the steps of a load sweep or of load combinations.
+
+mod adapt;
+mod exact;
+mod file;
+mod output;
+mod overrides;
+mod sweep;
+#[cfg(test)]
+mod tests;
+
+pub use crate::io::input::CASE_FILE_CAP;
+pub use adapt::AdaptSpec;
+pub use exact::{BenchmarkBody, ExactSpec, ManufacturedDomain, ManufacturedForm};
+pub use file::{steps, Case};
+pub use output::{OutputOptions, PictureKind, Units, VtuFormat};
+pub use overrides::apply_overrides;
+pub use sweep::{
+    step_list, validate_steps, LoadCase, StepSpec, SweepParameter, SweepSpec, MAX_STEPS,
+};

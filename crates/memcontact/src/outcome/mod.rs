@@ -1,0 +1,18 @@
+//! The outcome of a solve: the report (status, method, certificate, iterate), the physical
+//! fields and totals in the user's numbering, `summary.json`'s values, and the checks they
+//! pass before anything is written.
+
+mod adapt;
+pub mod checks;
+pub mod fields;
+mod report;
+mod solved;
+pub mod summary;
+pub mod sweep;
+
+pub use adapt::AdaptRow;
+pub use fields::{LowerFields, LowerTotals, NodalFields, Totals};
+pub use report::Report;
+pub use solved::Outcome;
+pub use summary::{FileRecord, Summary};
+pub use sweep::StepRow;

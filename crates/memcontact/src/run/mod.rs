@@ -1,0 +1,24 @@
+//! The library's front door, and the only places that run: [`run`] (a case of one step),
+//! [`run_sweep`] (its steps in turn), [`crate::verify::study::run_study`] (a convergence
+//! study), each from a [`crate::case::Case`] to owned outcomes that the writers of
+//! [`crate::write`] store. Data flows one way:
+//!
+//! ```text
+//! Problem ─► Discretization (mesh levels, data bound to regions, S, L, D, φₙ, M)
+//!         ─► solve (method, auto policy, fallback) ─► Outcome (U, Status, Report)
+//! ```
+//!
+//! Bad input is an `Err`; a numerical outcome (converged, iteration limit, stalled,
+//! numerical failure) is a [`crate::solve::Status`] inside the [`crate::outcome::Report`], always with the best iterate
+//! and its certificate. The library prints nothing: progress reaches the caller through
+//! the [`crate::solve::Observer`].
+
+mod adapt;
+mod checks;
+mod one;
+mod sweep;
+
+pub use adapt::{run_adapt, AdaptRun, AdaptStop};
+pub use checks::{check_case_on_mesh, check_load_cases_on_mesh, check_profile_on_mesh};
+pub use one::{run, run_problem};
+pub use sweep::{apply, run_sweep, run_sweep_on, step_discretization, step_model, SweepRun};

@@ -1,0 +1,222 @@
+//! The levels of a linear multigrid: the unknowns of every level of a mesh hierarchy (or of
+//! an aggregation hierarchy), the transfers between them and the Galerkin patterns of the
+//! coarse operators, computed once.
+
+use super::smoother::SweepRows;
+use super::transfer::{galerkin_patterns, Transfer};
+use crate::error::{Error, Result};
+use crate::mesh::refine::{Hierarchy, Refinement};
+use crate::mesh::{DofMap, Mesh};
+use crate::sparse::{Csr, Pattern};
+use std::sync::Arc;
+
+/// Where the coarse levels of a multigrid come from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Kind {
+    /// Nested meshes of uniform refinement (the exact P1 prolongation).
+    Geometric,
+    /// Aggregation of the matrix's unknowns ([`super::aggregation`]).
+    Algebraic,
+}
+
+/// The static structure of a multigrid hierarchy over unknowns: per level its size and
+/// operator pattern (and, for a geometric hierarchy, its dof map), and the prolongations.
+/// Built once per hierarchy.
+#[derive(Debug, Clone)]
+pub struct Levels {
+    /// Geometric or algebraic.
+    pub kind: Kind,
+    /// Unknowns of every level, coarsest first.
+    pub sizes: Vec<usize>,
+    /// Geometric hierarchies: the unknowns of every level's mesh but the finest (the
+    /// model's own), coarsest first (levels without unknowns are left out). Empty for an
+    /// algebraic hierarchy.
+    pub dofs: Vec<DofMap>,
+    /// Operator patterns, coarsest first; the finest is the pattern of S.
+    pub patterns: Vec<Arc<Pattern>>,
+    /// `transfers[k]` prolongates level `k` to level `k + 1`.
+    pub transfers: Vec<Transfer>,
+    /// What the smoother reads from every level's pattern, coarsest first.
+    pub(crate) sweep_rows: Vec<SweepRows>,
+}
+
+impl Levels {
+    /// Checks that `hierarchy` ends with the mesh of the unknowns `finest` (whose operator
+    /// pattern is `pattern`) and builds the transfers and Galerkin patterns. A hierarchy
+    /// that does not fit is an error.
+    pub fn new(hierarchy: &Hierarchy, finest: &DofMap, pattern: Arc<Pattern>) -> Result<Levels> {
+        let nl = hierarchy.levels.len();
+        if nl == 0 || hierarchy.refinements.len() + 1 != nl {
+            return Err(Error::Mesh(format!(
+                "a hierarchy of {nl} levels needs {} refinement relations, it has {}",
+                nl.saturating_sub(1),
+                hierarchy.refinements.len()
+            )));
+        }
+        let last = hierarchy.finest();
+        if last.n_vertices() != finest.dof.len() || pattern.n() != finest.len() {
+            return Err(Error::Mesh(format!(
+                "the finest level of the hierarchy has {} vertices, but the model was \
+                 assembled on a mesh of {} vertices: the hierarchy must end with the model's \
+                 mesh",
+                last.n_vertices(),
+                finest.dof.len()
+            )));
+        }
+        check_pattern(last, finest, &pattern)?;
+        // The unknowns of the coarser levels, from the finer ones: a coarse vertex is
+        // interior exactly when the fine vertex sitting on it is (nested meshes). The
+        // finest level's unknowns are the model's own: no copy is kept.
+        let mut dofs: Vec<DofMap> = Vec::with_capacity(nl - 1);
+        for k in (0..nl - 1).rev() {
+            let coarse = coarse_dofs(
+                &hierarchy.refinements[k],
+                hierarchy.levels[k].n_vertices(),
+                dofs.last().unwrap_or(finest),
+            )?;
+            dofs.push(coarse);
+        }
+        dofs.reverse();
+        let level = |k: usize| dofs.get(k).unwrap_or(finest);
+        // Levels without unknowns cannot carry a correction: start above them.
+        let first = (0..nl).position(|k| !level(k).is_empty()).unwrap_or(nl - 1);
+        let mut transfers = Vec::with_capacity(nl - 1 - first);
+        for k in first..nl - 1 {
+            let t = Transfer::new(&hierarchy.refinements[k], level(k), level(k + 1))?;
+            transfers.push(t);
+        }
+        let sizes = (first..nl).map(|k| level(k).len()).collect();
+        let dofs: Vec<DofMap> = dofs.into_iter().skip(first).collect();
+        let patterns = galerkin_patterns(&transfers, pattern);
+        Ok(Levels {
+            kind: Kind::Geometric,
+            sizes,
+            dofs,
+            sweep_rows: patterns.iter().map(|p| SweepRows::of(p)).collect(),
+            patterns,
+            transfers,
+        })
+    }
+
+    /// An algebraic hierarchy for the operator `a` (the finest level; its pattern is the
+    /// finest pattern) by double pairwise aggregation, down to about `coarsest` unknowns.
+    pub fn algebraic(a: &Csr, coarsest: usize) -> Levels {
+        let (transfers, sizes, patterns) = super::aggregation::hierarchy(a, coarsest);
+        Levels {
+            kind: Kind::Algebraic,
+            sizes,
+            dofs: Vec::new(),
+            sweep_rows: patterns.iter().map(|p| SweepRows::of(p)).collect(),
+            patterns,
+            transfers,
+        }
+    }
+
+    /// Number of levels.
+    pub fn len(&self) -> usize {
+        self.sizes.len()
+    }
+
+    /// `true` when there is no level (never, after [`Levels::new`]).
+    pub fn is_empty(&self) -> bool {
+        self.sizes.is_empty()
+    }
+
+    /// Number of unknowns of level `k`.
+    pub fn n(&self, k: usize) -> usize {
+        self.sizes[k]
+    }
+}
+
+/// The unknowns of a coarse level of `n_vertices` vertices, given those of the level
+/// refined from it: coarse vertex `c` is interior iff the fine vertex on it (parents
+/// `[c, c]`) is. A coarse vertex without such a fine vertex is an error.
+fn coarse_dofs(refinement: &Refinement, n_vertices: usize, fine: &DofMap) -> Result<DofMap> {
+    if refinement.parents.len() != fine.dof.len() {
+        return Err(Error::Mesh(format!(
+            "the refinement relation names parents for {} vertices, but the finer level has \
+             {} vertices",
+            refinement.parents.len(),
+            fine.dof.len()
+        )));
+    }
+    use rayon::prelude::*;
+    use std::sync::atomic::{AtomicU8, Ordering::Relaxed};
+    // Per coarse vertex: 0 while no fine vertex sits on it, then FIXED or INTERIOR. A
+    // refinement puts one fine vertex on each coarse one; should a broken one put two, the
+    // larger state is kept, whatever the order the threads write in.
+    const FIXED: u8 = 1;
+    const INTERIOR: u8 = 2;
+    let state: Vec<AtomicU8> = (0..n_vertices)
+        .into_par_iter()
+        .with_min_len(4096)
+        .map(|_| AtomicU8::new(0))
+        .collect();
+    let bad = refinement
+        .parents
+        .par_iter()
+        .enumerate()
+        .with_min_len(4096)
+        .map(|(v, &[a, b])| {
+            if a as usize >= n_vertices || b as usize >= n_vertices {
+                return Some((v, a, b));
+            }
+            if a == b {
+                let on = if fine.dof[v].is_some() {
+                    INTERIOR
+                } else {
+                    FIXED
+                };
+                state[a as usize].fetch_max(on, Relaxed);
+            }
+            None
+        })
+        .find_first(Option::is_some)
+        .flatten();
+    if let Some((v, a, b)) = bad {
+        return Err(Error::Mesh(format!(
+            "vertex {v} of the finer level has parent vertices ({a}, {b}), but the coarser \
+             level has only {n_vertices} vertices"
+        )));
+    }
+    let state: Vec<u8> = state.into_par_iter().map(AtomicU8::into_inner).collect();
+    if let Some(c) = crate::sparse::first_where(&state, |x| x == 0) {
+        return Err(Error::Mesh(format!(
+            "the refinement relation keeps no vertex on vertex {c} of the coarser level"
+        )));
+    }
+    let fixed: Vec<bool> = state.par_iter().map(|&x| x == FIXED).collect();
+    Ok(DofMap::from_fixed(&fixed))
+}
+
+/// Checks that the operator pattern couples the unknowns along the edges of the triangles
+/// of `mesh` (every triangle of small meshes, every 16th of large ones): a cheap test that
+/// the model was assembled on this mesh.
+fn check_pattern(mesh: &Mesh, dofs: &DofMap, pattern: &Pattern) -> Result<()> {
+    use rayon::prelude::*;
+    let step = if mesh.n_triangles() > 100_000 { 16 } else { 1 };
+    let bad = mesh
+        .triangles
+        .par_iter()
+        .enumerate()
+        .with_min_len(4096)
+        .filter(|(k, _)| k % step == 0)
+        .find_any(|(_, t)| {
+            t.iter().any(|&a| {
+                t.iter()
+                    .any(|&b| match (dofs.dof[a as usize], dofs.dof[b as usize]) {
+                        (Some(i), Some(j)) => pattern.find(i as usize, j as usize).is_none(),
+                        _ => false,
+                    })
+            })
+        });
+    match bad {
+        Some((k, _)) => Err(Error::Mesh(format!(
+            "triangle {k} of the finest level of the hierarchy couples unknowns that the \
+             model's matrices do not: the hierarchy must end with the mesh the model was \
+             assembled on"
+        ))),
+        None => Ok(()),
+    }
+}

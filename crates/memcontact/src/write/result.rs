@@ -1,0 +1,305 @@
+//! The result set of one solve: `solution.vtu`, `nodes.csv`, the caller's extra files and
+//! `summary.json`, with the run id and the hashes that bind them.
+
+use crate::case::{Case, VtuFormat};
+use crate::error::{Error, Result};
+use crate::io::csv::write_columns_csv;
+use crate::io::json::write_json;
+use crate::io::result_set::ResultSet;
+use crate::io::vtu::{write_vtu_with_field_data, DataArray, VtuEncoding};
+use crate::outcome::fields::NodalFields;
+use crate::outcome::summary::{FileRecord, Summary};
+use crate::outcome::Outcome;
+use std::path::Path;
+use std::time::Instant;
+
+/// The names of the per-vertex columns of `nodes.csv` (after `x`, `y`) and point fields of
+/// `solution.vtu`, in order.
+pub const NODAL_FIELDS: [&str; 6] = [
+    "u",
+    "phi",
+    "penetration",
+    "pressure",
+    "contact_force",
+    "state",
+];
+
+/// The columns of `nodes.csv` (and point fields of `solution.vtu`) a body below adds, after
+/// [`NODAL_FIELDS`].
+pub const LOWER_FIELDS: [&str; 5] = [
+    "phi_low",
+    "penetration_low",
+    "pressure_low",
+    "contact_force_low",
+    "state_low",
+];
+
+/// How a result set is written.
+#[derive(Debug, Clone)]
+pub struct WriteOptions {
+    /// The case's label in `summary.json` (its file path, or a name).
+    pub label: String,
+    /// The encoding of `solution.vtu`.
+    pub vtu: VtuFormat,
+    /// Replace a directory that holds files other than a memcontact result.
+    pub force: bool,
+    /// When the run started (for `time_total_s`).
+    pub started: Instant,
+    /// The options of the pictures, recorded in `summary.json` so they can be redrawn.
+    pub plot_options: Option<serde_json::Value>,
+    /// The run id the files carry (`None`: a fresh one, [`new_run_id`]); the steps of a
+    /// sweep share their sweep's.
+    pub run_id: Option<String>,
+    /// Further cell data of `solution.vtu`, one value per triangle in the user's order
+    /// (the adaptive loop's `estimator`).
+    pub cell_data: Vec<(String, Vec<f64>)>,
+    /// The adaptive loop's totals for `summary.json` (with `[adapt]`).
+    pub adapt: Option<crate::outcome::summary::AdaptTotals>,
+}
+
+/// A fresh random run identifier (32 hex digits).
+pub fn new_run_id() -> String {
+    use std::hash::{BuildHasher, Hasher};
+    let nanos = std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .map(|d| d.as_nanos())
+        .unwrap_or(0);
+    let mut parts = [0u64; 2];
+    for (k, p) in parts.iter_mut().enumerate() {
+        let mut h = std::collections::hash_map::RandomState::new().build_hasher();
+        h.write_u128(nanos);
+        h.write_u32(std::process::id());
+        h.write_usize(k);
+        *p = h.finish();
+    }
+    format!("{:016x}{:016x}", parts[0], parts[1])
+}
+
+/// The hash of a case: XXH3-64 of its canonical JSON and, for a mesh file, of the file's
+/// bytes (16 hex digits), so that a changed mesh file under the same name is another input.
+pub fn input_hash(case: &Case) -> String {
+    let json = serde_json::to_string(case).unwrap_or_default();
+    let mut h = xxhash_rust::xxh3::Xxh3::new();
+    h.update(json.as_bytes());
+    if let crate::problem::MeshSource::File(path) = &case.problem.mesh.source {
+        // Streamed through the hash (the digest of the whole file's bytes), never held in
+        // memory whole.
+        use std::io::Read;
+        let kind = crate::io::input::MESH_FILE;
+        let streamed = crate::io::input::open_input(path, kind).and_then(|(file, _)| {
+            let mut reader = file.take(kind.cap + 1);
+            let mut buf = vec![0u8; 1 << 20];
+            loop {
+                match reader.read(&mut buf) {
+                    Ok(0) => return Ok(()),
+                    Ok(n) => h.update(&buf[..n]),
+                    Err(e) if e.kind() == std::io::ErrorKind::Interrupted => {}
+                    Err(e) => {
+                        return Err(Error::Io {
+                            path: path.clone(),
+                            source: e,
+                        })
+                    }
+                }
+            }
+        });
+        if streamed.is_err() {
+            h.update(b"(the mesh file could not be read)");
+        }
+    }
+    format!("{:016x}", h.digest())
+}
+
+/// The size and hash of a written file (read in blocks: a result file of hundreds of MB
+/// is never held in memory twice).
+pub fn file_record(path: &Path) -> Result<FileRecord> {
+    use std::io::Read;
+    let io = |source| Error::Io {
+        path: path.to_path_buf(),
+        source,
+    };
+    let mut file = std::fs::File::open(path).map_err(io)?;
+    let mut hasher = xxhash_rust::xxh3::Xxh3::new();
+    let mut buf = vec![0u8; 1 << 20];
+    let mut bytes = 0u64;
+    loop {
+        let n = match file.read(&mut buf) {
+            Ok(0) => break,
+            Ok(n) => n,
+            Err(e) if e.kind() == std::io::ErrorKind::Interrupted => continue,
+            Err(e) => return Err(io(e)),
+        };
+        hasher.update(&buf[..n]);
+        bytes += n as u64;
+    }
+    Ok(crate::io::Written {
+        bytes,
+        xxh3: hasher.digest(),
+    }
+    .into())
+}
+
+/// Writes `solution.vtu` (with `run_id` in its field data) and, when `csv`, `nodes.csv` of
+/// `fields` on the outcome's mesh into `dir`; returns their names and records, hashed as
+/// written.
+pub fn write_fields(
+    dir: &Path,
+    outcome: &Outcome,
+    fields: &NodalFields,
+    vtu: VtuFormat,
+    csv: bool,
+    run_id: &str,
+    cell_data: &[(String, Vec<f64>)],
+) -> Result<Vec<(String, FileRecord)>> {
+    let mesh = outcome.mesh();
+    let region: Vec<i32> = mesh.regions.iter().map(|&r| r as i32).collect();
+    let state: Vec<i32> = fields.state.iter().map(|&s| s as i32).collect();
+    let covered: Vec<i32> = fields.covered.iter().map(|&c| c as i32).collect();
+    let point_data = [
+        ("u", DataArray::F64(&fields.u)),
+        ("phi", DataArray::F64(&fields.phi)),
+        ("penetration", DataArray::F64(&fields.penetration)),
+        ("pressure", DataArray::F64(&fields.pressure)),
+        ("contact_force", DataArray::F64(&fields.contact_force)),
+        ("state", DataArray::I32(&state)),
+    ];
+    // The body below's fields follow the paper's (SPEC §5), when there is one.
+    let lower = fields.lower.as_ref();
+    let state_low: Vec<i32> =
+        lower.map_or(Vec::new(), |l| l.state.iter().map(|&s| s as i32).collect());
+    let covered_low: Vec<i32> = lower.map_or(Vec::new(), |l| {
+        l.covered.iter().map(|&c| c as i32).collect()
+    });
+    let lower_data: Vec<(&str, DataArray)> = match lower {
+        Some(l) => vec![
+            ("phi_low", DataArray::F64(&l.phi)),
+            ("penetration_low", DataArray::F64(&l.penetration)),
+            ("pressure_low", DataArray::F64(&l.pressure)),
+            ("contact_force_low", DataArray::F64(&l.contact_force)),
+            ("state_low", DataArray::I32(&state_low)),
+        ],
+        None => Vec::new(),
+    };
+    let mut vtu_points = point_data.to_vec();
+    vtu_points.push(("covered", DataArray::I32(&covered)));
+    vtu_points.extend(lower_data.iter().cloned());
+    if lower.is_some() {
+        vtu_points.push(("covered_low", DataArray::I32(&covered_low)));
+    }
+    let x: Vec<f64> = mesh.points.iter().map(|p| p[0]).collect();
+    let y: Vec<f64> = mesh.points.iter().map(|p| p[1]).collect();
+    let mut columns = vec![("x", DataArray::F64(&x)), ("y", DataArray::F64(&y))];
+    columns.extend(point_data);
+    columns.extend(lower_data);
+    // The two files are written side by side: one thread's formatting overlaps the other's
+    // writes.
+    let (vtu_written, csv_written) = rayon::join(
+        || {
+            write_vtu_with_field_data(
+                &dir.join("solution.vtu"),
+                &mesh,
+                &vtu_points,
+                &std::iter::once(("region", DataArray::I32(&region)))
+                    .chain(
+                        cell_data
+                            .iter()
+                            .map(|(n, v)| (n.as_str(), DataArray::F64(v))),
+                    )
+                    .collect::<Vec<_>>(),
+                match vtu {
+                    VtuFormat::Binary => VtuEncoding::Binary,
+                    VtuFormat::Ascii => VtuEncoding::Ascii,
+                },
+                &[("run_id", run_id)],
+            )
+        },
+        || csv.then(|| write_columns_csv(&dir.join("nodes.csv"), &columns)),
+    );
+    let mut files = vec![("solution.vtu".to_string(), vtu_written?.into())];
+    if let Some(written) = csv_written {
+        files.push(("nodes.csv".to_string(), written?.into()));
+    }
+    Ok(files)
+}
+
+/// Writes the files of `outcome` into the directory `dir` (which must exist and is not
+/// replaced: use [`write_result_set`] for an atomic set): `solution.vtu`, `nodes.csv`,
+/// what `extra` writes (it returns the names of its files), and `summary.json` last.
+/// Returns the summary written.
+pub fn write_files(
+    dir: &Path,
+    outcome: &Outcome,
+    case: &Case,
+    options: &WriteOptions,
+    extra: &mut dyn FnMut(&Path, &NodalFields) -> Result<Vec<String>>,
+) -> Result<Summary> {
+    let t0 = Instant::now();
+    let (fields, totals) = outcome.checked_fields()?;
+    let r = &outcome.report;
+    crate::outcome::checks::check_solution(
+        r.energy,
+        r.certificate.kkt(),
+        outcome.discretization.model.is_rigid(),
+    )?;
+    let run_id = options.run_id.clone().unwrap_or_else(new_run_id);
+    // The input's hash reads the mesh file again: alongside the writing, not after it.
+    let (written, hash) = rayon::join(
+        || {
+            write_fields(
+                dir,
+                outcome,
+                &fields,
+                options.vtu,
+                case.output.writes_csv(),
+                &run_id,
+                &options.cell_data,
+            )
+        },
+        || input_hash(case),
+    );
+    let written = written?;
+    case.settings.cancel.check()?;
+    let names = extra(dir, &fields)?;
+    let mut summary = Summary::new(
+        &options.label,
+        outcome,
+        &outcome.discretization.quality,
+        &totals,
+    );
+    summary.run_id = run_id;
+    summary.input_hash = hash;
+    summary.plot_options = options.plot_options.clone();
+    summary.adapt = options.adapt.clone();
+    // The fields' files were hashed as they were written; the extra files (pictures) are
+    // read back, side by side.
+    let records: Vec<FileRecord> = {
+        use rayon::prelude::*;
+        names
+            .par_iter()
+            .map(|name| file_record(&dir.join(name)))
+            .collect::<Result<_>>()?
+    };
+    summary.files.extend(written);
+    summary.files.extend(names.into_iter().zip(records));
+    summary.time_write_s = t0.elapsed().as_secs_f64();
+    summary.time_total_s = options.started.elapsed().as_secs_f64();
+    write_json(&dir.join("summary.json"), &summary)?;
+    Ok(summary)
+}
+
+/// Writes the result set of `outcome` into `target` atomically ([`ResultSet`]): the files
+/// of [`write_files`], moved into place together. Returns the summary written.
+pub fn write_result_set(
+    target: &Path,
+    outcome: &Outcome,
+    case: &Case,
+    options: &WriteOptions,
+    extra: &mut dyn FnMut(&Path, &NodalFields) -> Result<Vec<String>>,
+) -> Result<Summary> {
+    let set = ResultSet::begin(target, options.force)?;
+    let summary = write_files(set.dir(), outcome, case, options, extra)?;
+    // Stopped while writing: the staging directory goes, the previous result stays.
+    case.settings.cancel.check()?;
+    set.commit()?;
+    Ok(summary)
+}
