@@ -70,7 +70,11 @@ pub fn solve(case_path: &Path, flags: &SolveFlags) -> Result<()> {
         cell_data: Vec::new(),
         adapt: None,
     };
+    #[cfg(feature = "alloc-trace")]
+    crate::alloc_trace::report("write started");
     let summary = write::write_result(flags.out, &outcome, &case, &options, &plots)?;
+    #[cfg(feature = "alloc-trace")]
+    crate::alloc_trace::report("end of the write");
     print!(
         "{}",
         report::human(&options.label, &outcome, Some((&summary, flags.out)))
