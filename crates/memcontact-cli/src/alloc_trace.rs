@@ -151,11 +151,18 @@ pub fn report(label: &str) {
         seg as f64 / 1048576.0,
         peak as f64 / 1048576.0
     );
-    if !ON.load(Ordering::Relaxed) || !label.starts_with("end") {
+    // MEMCONTACT_ALLOC_TRACE=phases: the list at every phase's peak, not only at the end.
+    let phases = std::env::var("MEMCONTACT_ALLOC_TRACE").is_ok_and(|v| v == "phases");
+    let at_end = label.starts_with("end");
+    if !ON.load(Ordering::Relaxed) || !(at_end || phases && label.ends_with("finished")) {
         return;
     }
     guarded(|| {
-        let p = AT_PEAK.lock().unwrap().clone();
+        let p = if phases {
+            AT_PEAK.lock().unwrap().take()
+        } else {
+            AT_PEAK.lock().unwrap().clone()
+        };
         let Some((at, list)) = p else { return };
         let mut by: HashMap<String, (usize, usize)> = HashMap::new();
         for (size, bt) in &list {

@@ -44,7 +44,7 @@ pub fn solve(case_path: &Path, flags: &SolveFlags) -> Result<()> {
         return crate::adapt_cmd::adapt(&label, &case, flags, progress, started);
     }
     // Everything that needs the mesh is checked before anything is solved.
-    let outcome = memcontact::run(&case, &mut progress)?;
+    let outcome = memcontact::run::run_for_writing(&case, &mut progress)?;
     progress.finish();
     print_warnings(&outcome.discretization);
     let accepted = outcome.report.accepted;

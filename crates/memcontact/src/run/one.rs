@@ -54,10 +54,25 @@ impl Discretization {
         start: Option<&[f64]>,
         observer: &mut dyn Observer,
     ) -> Result<Report> {
+        if self.is_released() {
+            return Err(Error::Solver {
+                solver: self.method_for(settings).name().into(),
+                message: "this discretisation was solved once and its matrices released: \
+                          build it again to solve it again"
+                    .into(),
+            });
+        }
         self.check_memory(settings)?;
         observer.phase_started("solve");
         let t0 = Instant::now();
-        let a = solve::attempt_from(&self.model, self.levels(), settings, start, observer)?;
+        let a = solve::attempt_with_levels(
+            &self.model,
+            self.levels(),
+            self.built_levels(),
+            settings,
+            start,
+            observer,
+        )?;
         crate::outcome::checks::check_solution(
             a.solution.energy,
             a.solution.certificate.kkt(),
@@ -110,27 +125,9 @@ impl Discretization {
 /// A case with steps (`[sweep]`, `[[load_case]]`) is refused: [`super::run_sweep`] runs
 /// those.
 pub fn run(case: &Case, observer: &mut dyn Observer) -> Result<Outcome> {
-    if case.is_sweep() {
-        return Err(Error::Case {
-            file: None,
-            line: None,
-            key: if case.sweep.is_some() {
-                "sweep".into()
-            } else {
-                "load_case".into()
-            },
-            message: "the case has steps to solve in turn: run them as a sweep".into(),
-        });
-    }
+    refuse_steps(case)?;
     case.validate().map_err(Invalid::into_error)?;
-    if case.adapt.is_some() {
-        return Err(Error::Case {
-            file: None,
-            line: None,
-            key: "adapt".into(),
-            message: "the case refines its mesh adaptively: run its adaptive loop".into(),
-        });
-    }
+    refuse_adapt(case)?;
     let observer = &mut solve::Cancellable {
         inner: observer,
         cancel: &case.settings.cancel,
@@ -139,6 +136,31 @@ pub fn run(case: &Case, observer: &mut dyn Observer) -> Result<Outcome> {
     case.settings.cancel.check()?;
     check_case_on_mesh(case, discretization.mesh(), false)?;
     let report = discretization.solve(&case.settings, observer)?;
+    Ok(Outcome {
+        discretization,
+        report,
+    })
+}
+
+/// [`run`] for a run whose outcome is only written afterwards (`memcontact solve`): the
+/// discretisation keeps only what the solve and then the writers read
+/// ([`Discretization::for_one_solve`], [`Discretization::release_solver_data`]), so that
+/// the peak memory of a large run is lower. The outcome's discretisation cannot be solved
+/// again.
+pub fn run_for_writing(case: &Case, observer: &mut dyn Observer) -> Result<Outcome> {
+    refuse_steps(case)?;
+    case.validate().map_err(Invalid::into_error)?;
+    refuse_adapt(case)?;
+    let observer = &mut solve::Cancellable {
+        inner: observer,
+        cancel: &case.settings.cancel,
+    };
+    let mut discretization =
+        Discretization::for_one_solve(&case.problem, &case.settings, observer)?;
+    case.settings.cancel.check()?;
+    check_case_on_mesh(case, discretization.mesh(), false)?;
+    let report = discretization.solve(&case.settings, observer)?;
+    discretization.release_solver_data();
     Ok(Outcome {
         discretization,
         report,
@@ -164,4 +186,34 @@ pub fn run_problem(
         discretization,
         report,
     })
+}
+
+/// A case with steps is refused by the one-step runs.
+fn refuse_steps(case: &Case) -> Result<()> {
+    if case.is_sweep() {
+        return Err(Error::Case {
+            file: None,
+            line: None,
+            key: if case.sweep.is_some() {
+                "sweep".into()
+            } else {
+                "load_case".into()
+            },
+            message: "the case has steps to solve in turn: run them as a sweep".into(),
+        });
+    }
+    Ok(())
+}
+
+/// A case with `[adapt]` is refused by the one-step runs.
+fn refuse_adapt(case: &Case) -> Result<()> {
+    if case.adapt.is_some() {
+        return Err(Error::Case {
+            file: None,
+            line: None,
+            key: "adapt".into(),
+            message: "the case refines its mesh adaptively: run its adaptive loop".into(),
+        });
+    }
+    Ok(())
 }

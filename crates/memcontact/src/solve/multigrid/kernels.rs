@@ -40,6 +40,7 @@ pub fn kernel_timings(
     time("levels setup", &mut || {
         levels = match coarsening {
             Coarsening::Geometric(h) => Levels::new(h, &model.dofs, model.s.pattern.clone()).ok(),
+            Coarsening::Built(l) => Some(l.clone()),
             Coarsening::Algebraic => Some(Levels::algebraic(
                 &setup_matrix(model),
                 aggregation::COARSEST,

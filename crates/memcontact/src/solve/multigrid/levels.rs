@@ -46,15 +46,37 @@ impl Levels {
     /// pattern is `pattern`) and builds the transfers and Galerkin patterns. A hierarchy
     /// that does not fit is an error.
     pub fn new(hierarchy: &Hierarchy, finest: &DofMap, pattern: Arc<Pattern>) -> Result<Levels> {
-        let nl = hierarchy.levels.len();
-        if nl == 0 || hierarchy.refinements.len() + 1 != nl {
-            return Err(Error::Mesh(format!(
-                "a hierarchy of {nl} levels needs {} refinement relations, it has {}",
-                nl.saturating_sub(1),
-                hierarchy.refinements.len()
-            )));
-        }
-        let last = hierarchy.finest();
+        let counts: Vec<usize> = hierarchy.levels.iter().map(Mesh::n_vertices).collect();
+        Levels::from_relations(
+            &hierarchy.refinements,
+            &counts,
+            hierarchy.levels.last(),
+            finest,
+            pattern,
+        )
+    }
+
+    /// [`Levels::new`] from what it reads of a hierarchy: the refinement relations, the
+    /// vertex count of every level (coarsest first) and the finest mesh (`None` for a
+    /// hierarchy without levels, an error). The coarser meshes themselves are not needed.
+    pub fn from_relations(
+        refinements: &[Refinement],
+        vertex_counts: &[usize],
+        last: Option<&Mesh>,
+        finest: &DofMap,
+        pattern: Arc<Pattern>,
+    ) -> Result<Levels> {
+        let nl = vertex_counts.len();
+        let last = match last {
+            Some(m) if nl > 0 && refinements.len() + 1 == nl => m,
+            _ => {
+                return Err(Error::Mesh(format!(
+                    "a hierarchy of {nl} levels needs {} refinement relations, it has {}",
+                    nl.saturating_sub(1),
+                    refinements.len()
+                )))
+            }
+        };
         if last.n_vertices() != finest.dof.len() || pattern.n() != finest.len() {
             return Err(Error::Mesh(format!(
                 "the finest level of the hierarchy has {} vertices, but the model was \
@@ -71,8 +93,8 @@ impl Levels {
         let mut dofs: Vec<DofMap> = Vec::with_capacity(nl - 1);
         for k in (0..nl - 1).rev() {
             let coarse = coarse_dofs(
-                &hierarchy.refinements[k],
-                hierarchy.levels[k].n_vertices(),
+                &refinements[k],
+                vertex_counts[k],
                 dofs.last().unwrap_or(finest),
             )?;
             dofs.push(coarse);
@@ -83,7 +105,7 @@ impl Levels {
         let first = (0..nl).position(|k| !level(k).is_empty()).unwrap_or(nl - 1);
         let mut transfers = Vec::with_capacity(nl - 1 - first);
         for k in first..nl - 1 {
-            let t = Transfer::new(&hierarchy.refinements[k], level(k), level(k + 1))?;
+            let t = Transfer::new(&refinements[k], level(k), level(k + 1))?;
             transfers.push(t);
         }
         let sizes = (first..nl).map(|k| level(k).len()).collect();

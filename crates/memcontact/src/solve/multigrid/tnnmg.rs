@@ -15,6 +15,7 @@ use crate::solve::newton::{mark_dirty, NewtonMatrix, NewtonStates};
 use crate::solve::relax::sweep_forward;
 use crate::solve::{IterationRecord, Method, Observer, PhaseTimer, Settings, Solution};
 use crate::sparse::{filled, par_rows, zeroed, Csr};
+use std::sync::Arc;
 use std::time::Instant;
 
 pub(crate) const MAX_ITERATIONS: usize = 300;
@@ -110,6 +111,9 @@ pub enum Coarsening<'a> {
     /// Nested meshes of uniform refinement; the last must be the mesh the model was
     /// assembled on (anything else is an error).
     Geometric(&'a Hierarchy),
+    /// Geometric levels built beforehand ([`Levels::new`]) for the model's unknowns and
+    /// matrix pattern.
+    Built(&'a Levels),
     /// An aggregation hierarchy built from the model's matrices ([`aggregation`]).
     Algebraic,
 }
@@ -119,6 +123,7 @@ impl Coarsening<'_> {
     pub fn kind(&self) -> Kind {
         match self {
             Coarsening::Geometric(_) => Kind::Geometric,
+            Coarsening::Built(l) => l.kind,
             Coarsening::Algebraic => Kind::Algebraic,
         }
     }
@@ -188,10 +193,29 @@ pub fn solve_with(
     observer: &mut dyn Observer,
 ) -> Result<(Solution, TnnmgReport)> {
     let mut timer = PhaseTimer::default();
-    let levels = timer.time("setup", || match coarsening {
-        Coarsening::Geometric(h) => Levels::new(h, &model.dofs, model.s.pattern.clone()),
-        Coarsening::Algebraic => Ok(Levels::algebraic(&setup_matrix(model), options.coarsest)),
-    })?;
+    let built;
+    let levels: &Levels = match coarsening {
+        Coarsening::Built(l) => {
+            if !Arc::ptr_eq(&l.patterns[l.len() - 1], &model.s.pattern) {
+                return Err(crate::error::Error::Mesh(
+                    "the multigrid levels were built for another matrix than the model's".into(),
+                ));
+            }
+            l
+        }
+        Coarsening::Geometric(h) => {
+            built = timer.time("setup", || {
+                Levels::new(h, &model.dofs, model.s.pattern.clone())
+            })?;
+            &built
+        }
+        Coarsening::Algebraic => {
+            built = timer.time("setup", || {
+                Levels::algebraic(&setup_matrix(model), options.coarsest)
+            });
+            &built
+        }
+    };
     let top = levels.len() - 1;
     let max = settings.max_iterations.unwrap_or(MAX_ITERATIONS);
     let mut report = TnnmgReport::default();
@@ -206,9 +230,9 @@ pub fn solve_with(
     let mut models: Vec<Model> = Vec::new();
     if first < top {
         timer.time("setup", || {
-            let mut m = coarse_model(model, &levels.transfers[top - 1], &levels, top - 1);
+            let mut m = coarse_model(model, &levels.transfers[top - 1], levels, top - 1);
             for k in (first..top - 1).rev() {
-                let next = coarse_model(&m, &levels.transfers[k], &levels, k);
+                let next = coarse_model(&m, &levels.transfers[k], levels, k);
                 models.push(m);
                 m = next;
             }
@@ -254,7 +278,7 @@ pub fn solve_with(
         };
         let out = level_solve(LevelSolve {
             model: m,
-            levels: &levels,
+            levels,
             top: k,
             v: &mut v,
             tolerance: tol,
