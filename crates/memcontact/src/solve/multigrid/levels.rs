@@ -104,9 +104,8 @@ impl Levels {
         // Levels without unknowns cannot carry a correction: start above them.
         let first = (0..nl).position(|k| !level(k).is_empty()).unwrap_or(nl - 1);
         let mut transfers = Vec::with_capacity(nl - 1 - first);
-        for k in first..nl - 1 {
-            let t = Transfer::new(&refinements[k], level(k), level(k + 1))?;
-            transfers.push(t);
+        for (k, refinement) in refinements.iter().enumerate().skip(first) {
+            transfers.push(Transfer::new(refinement, level(k), level(k + 1))?);
         }
         let sizes = (first..nl).map(|k| level(k).len()).collect();
         let dofs: Vec<DofMap> = dofs.into_iter().skip(first).collect();
