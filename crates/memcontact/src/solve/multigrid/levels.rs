@@ -3,7 +3,7 @@
 //! coarse operators, computed once.
 
 use super::smoother::SweepRows;
-use super::transfer::{galerkin_patterns, Transfer};
+use super::transfer::Transfer;
 use crate::error::{Error, Result};
 use crate::mesh::refine::{Hierarchy, Refinement};
 use crate::mesh::{DofMap, Mesh};
@@ -109,7 +109,16 @@ impl Levels {
         }
         let sizes = (first..nl).map(|k| level(k).len()).collect();
         let dofs: Vec<DofMap> = dofs.into_iter().skip(first).collect();
-        let patterns = galerkin_patterns(&transfers, pattern);
+        // Coarsest last: each transfer reads its columns from the pattern of its fine
+        // level, known once the finer levels' Galerkin patterns are.
+        let mut patterns = vec![pattern];
+        for t in transfers.iter_mut().rev() {
+            let fine = patterns.last().expect("the finest pattern");
+            *t = std::mem::replace(t, Transfer::aggregation(&[], 0)).with_columns_from(fine);
+            let coarse = t.galerkin_pattern(fine);
+            patterns.push(Arc::new(coarse));
+        }
+        patterns.reverse();
         Ok(Levels {
             kind: Kind::Geometric,
             sizes,

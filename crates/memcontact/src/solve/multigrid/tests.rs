@@ -621,3 +621,68 @@ fn forcing_is_quadratic_until_the_tolerance_is_near() {
     // A floor below the tolerance changes nothing.
     assert_eq!(forcing(1e-3, tol, 1e-12), 1e-6);
 }
+
+#[test]
+fn transfer_columns_read_from_the_fine_pattern_give_the_same_sums() {
+    use crate::solve::newton::NewtonStates;
+    let disk = crate::mesh::generate::disk([0.0, 0.0], 1.0, 0.3).unwrap();
+    for (name, h) in [
+        ("square", square_hierarchy(4, 4)),
+        ("disc", Hierarchy::refined(disk, 3)),
+    ] {
+        let model = bench_model(h.finest(), Some(1000.0), Foundation::Lumped);
+        let levels = Levels::new(&h, &model.dofs, model.s.pattern.clone()).unwrap();
+        // Every geometric transfer reads its columns from its fine level's pattern.
+        for t in &levels.transfers {
+            assert!(
+                t.columns_from_fine_rows() && t.columns_are_whole_rows(),
+                "{name}"
+            );
+        }
+        // Against the stored columns of the same prolongation: bitwise the same.
+        let top = levels.len() - 1;
+        let fine_rows = &levels.transfers[top - 1];
+        let stored = {
+            let coarse = &levels.dofs[top - 1];
+            Transfer::new(&h.refinements[h.depth() - 2], coarse, &model.dofs).unwrap()
+        };
+        assert!(!stored.columns_from_fine_rows());
+        let n = model.n();
+        let x: Vec<f64> = (0..n)
+            .map(|i| ((i * 7919) % 1013) as f64 / 1013.0 - 0.3)
+            .collect();
+        let (mut a, mut b) = (vec![0.0; stored.n_coarse], vec![0.0; stored.n_coarse]);
+        stored.restrict(&x, &mut a);
+        fine_rows.restrict(&x, &mut b);
+        assert_eq!(a, b, "{name}: restriction");
+        assert_eq!(stored.injection(), fine_rows.injection(), "{name}");
+        let pattern = stored.galerkin_pattern(&model.s.pattern);
+        assert_eq!(
+            pattern,
+            *levels.patterns[top - 1],
+            "{name}: Galerkin pattern"
+        );
+        // The truncated Newton matrix at a state with some unknowns held.
+        let v: Vec<f64> = model.phi.iter().map(|p| p + 0.01).collect();
+        let st = NewtonStates::of(&model, &v);
+        let op = super::operator::LumpedShifted {
+            s: &model.s,
+            l: match &model.l {
+                FoundationMatrix::Lumped(l) => l,
+                _ => unreachable!(),
+            },
+            penetrating: &st.penetrating,
+            held: &st.truncated,
+        };
+        let pat = std::sync::Arc::new(pattern);
+        let (mut ca, mut cb) = (Csr::zeros(pat.clone()), Csr::zeros(pat.clone()));
+        stored.galerkin_values(&op, &mut ca, None);
+        fine_rows.galerkin_values(&op, &mut cb, None);
+        assert_eq!(ca.val, cb.val, "{name}: Galerkin values");
+        let dirty: Vec<bool> = (0..n).map(|i| i % 5 == 0).collect();
+        let (mut da, mut db) = (vec![false; stored.n_coarse], vec![true; stored.n_coarse]);
+        stored.coarse_dirty(&dirty, &mut da);
+        fine_rows.coarse_dirty(&dirty, &mut db);
+        assert_eq!(da, db, "{name}: dirty rows");
+    }
+}
