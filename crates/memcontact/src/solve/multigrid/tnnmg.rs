@@ -370,8 +370,8 @@ pub(super) fn coarse_model(fine: &Model, t: &Transfer, levels: &Levels, k: usize
             can_touch,
             rigid,
             foundation: low.foundation,
-            phi_vertices: Vec::new(),
-            h_vertices: Vec::new(),
+            phi_fixed: Vec::new(),
+            h_vertices: crate::model::VertexValues::Each(Vec::new()),
             epsilon: low.epsilon,
         }
     });
@@ -379,7 +379,6 @@ pub(super) fn coarse_model(fine: &Model, t: &Transfer, levels: &Levels, k: usize
         Kind::Geometric => levels.dofs[k].clone(),
         Kind::Algebraic => crate::mesh::DofMap::all(t.n_coarse),
     };
-    let phi_vertices = dofs.to_vertices(&phi, 0.0);
     Model {
         d: restrict(&fine.d),
         tension: fine.tension,
@@ -389,8 +388,8 @@ pub(super) fn coarse_model(fine: &Model, t: &Transfer, levels: &Levels, k: usize
         can_touch,
         foundation: fine.foundation,
         // Only the solver uses this model: vertex fields are not needed beyond φ.
-        h_vertices: Vec::new(),
-        phi_vertices,
+        h_vertices: crate::model::VertexValues::Each(Vec::new()),
+        phi_fixed: Vec::new(),
         total_load: fine.total_load,
         epsilon: fine.epsilon,
         dofs,
