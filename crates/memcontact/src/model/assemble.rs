@@ -76,7 +76,7 @@ impl Model {
             foundation: data.foundation,
             sampling: data.sampling,
         };
-        let pattern = Arc::new(unknowns_pattern(mesh, &dofs, adj, boundary));
+        let pattern = Arc::new(unknowns_pattern(mesh, &dofs, adj, boundary)?);
         // S and the upper body's consistent L share one pass over the rows.
         let masked = Masked::new(upper);
         let consistent_h = match (masked.elastic(), data.foundation) {

@@ -62,8 +62,7 @@ pub(crate) fn with_fixed(mut at_vertices: Vec<f64>, fixed: &[(u32, f64)]) -> Vec
 
 /// The values of the vertices that carry no unknown (`dof[v]` is `None`), in vertex order.
 pub(crate) fn fixed_values(dofs: &DofMap, at_vertices: &[f64]) -> Vec<(u32, f64)> {
-    dofs.dof
-        .iter()
+    dofs.per_vertex()
         .zip(at_vertices)
         .enumerate()
         .filter(|(_, (d, _))| d.is_none())

@@ -93,7 +93,7 @@ impl Model {
     /// U over all vertices: the unknowns' values, and the heights g (0 by default) on the
     /// fixed boundary.
     pub fn to_vertices(&self, u: &[f64]) -> Vec<f64> {
-        if self.boundary_values.len() != self.dofs.dof.len() {
+        if self.boundary_values.len() != self.dofs.n_vertices() {
             return self.dofs.to_vertices(u, 0.0);
         }
         let mut out = self.boundary_values.clone();

@@ -154,11 +154,7 @@ fn gather<T: Copy + Send + Sync>(
     value: impl Fn(usize) -> T + Sync,
     boundary: T,
 ) -> Vec<T> {
-    dofs.dof
-        .par_iter()
-        .with_min_len(4096)
-        .map(|d| d.map_or(boundary, |i| value(i as usize)))
-        .collect()
+    dofs.gather(value, boundary)
 }
 
 /// The vertices where the stiffness `h` is positive (a body lies there).
@@ -290,5 +286,5 @@ pub fn derive_from(mesh: &Mesh, model: &Model, u_dofs: &[f64]) -> (NodalFields, 
 
 /// `true` for a vertex that carries no unknown (on the fixed boundary).
 fn mesh_boundary(dofs: &crate::mesh::DofMap, v: usize) -> bool {
-    dofs.dof[v].is_none()
+    dofs.is_fixed(v)
 }

@@ -217,7 +217,7 @@ fn newton_system_with<const EXT: bool>(
         }
     };
     let gradient = |i: usize, gi: &mut f64, ri: &mut f64| {
-        let (s, e) = (pat.row_ptr[i], pat.row_ptr[i + 1]);
+        let (s, e) = (pat.ptr(i), pat.ptr(i + 1));
         let cols = &pat.col[s..e];
         let mut sv = 0.0;
         for (&j, &sij) in cols.iter().zip(&sval[s..e]) {
@@ -282,7 +282,7 @@ fn newton_system_with<const EXT: bool>(
         d
     };
     let matrix_row = |i: usize, arow: &mut [f64]| {
-        let (s, e) = (pat.row_ptr[i], pat.row_ptr[i + 1]);
+        let (s, e) = (pat.ptr(i), pat.ptr(i + 1));
         let cols = &pat.col[s..e];
         for (k, &j) in cols.iter().enumerate() {
             let j = j as usize;
@@ -316,7 +316,7 @@ fn newton_system_with<const EXT: bool>(
                 let mut off = 0;
                 for (k, (gi, ri)) in gc.iter_mut().zip(rc.iter_mut()).enumerate() {
                     let i = start + k;
-                    let len = pat.row_ptr[i + 1] - pat.row_ptr[i];
+                    let len = pat.ptr(i + 1) - pat.ptr(i);
                     gradient(i, gi, ri);
                     if rows.is_none_or(|d| d[i]) {
                         matrix_row(i, &mut vals[off..off + len]);
@@ -416,7 +416,7 @@ pub fn mark_dirty(
     });
     let changed: &[bool] = changed;
     par_rows(dirty, |i, d| {
-        *d = pattern.col[pattern.row_ptr[i]..pattern.row_ptr[i + 1]]
+        *d = pattern.col[pattern.ptr(i)..pattern.ptr(i + 1)]
             .iter()
             .any(|&j| changed[j as usize]);
     });
@@ -542,7 +542,7 @@ mod tests {
             let rows: Vec<bool> = (0..n).map(|i| i % 3 == 0).collect();
             newton_system(&model, &v, &st, &mut b, Some(&rows), &mut g, &mut r);
             for i in 0..n {
-                let (s, e) = (b.pattern.row_ptr[i], b.pattern.row_ptr[i + 1]);
+                let (s, e) = (b.pattern.ptr(i), b.pattern.ptr(i + 1));
                 if rows[i] {
                     assert_eq!(&b.val[s..e], &a.val[s..e]);
                 } else {

@@ -478,7 +478,7 @@ impl<'a> Multigrid<'a> {
             let pat = self.coarsest.pattern.clone();
             for i in 0..pat.n() {
                 if self.inv_diag[0][i] == 0.0 {
-                    for k in pat.row_ptr[i]..pat.row_ptr[i + 1] {
+                    for k in pat.ptr(i)..pat.ptr(i + 1) {
                         self.coarsest.val[k] = if pat.col[k] as usize == i { 1.0 } else { 0.0 };
                     }
                 }

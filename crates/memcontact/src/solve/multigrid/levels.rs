@@ -77,13 +77,13 @@ impl Levels {
                 )))
             }
         };
-        if last.n_vertices() != finest.dof.len() || pattern.n() != finest.len() {
+        if last.n_vertices() != finest.n_vertices() || pattern.n() != finest.len() {
             return Err(Error::Mesh(format!(
                 "the finest level of the hierarchy has {} vertices, but the model was \
                  assembled on a mesh of {} vertices: the hierarchy must end with the model's \
                  mesh",
                 last.n_vertices(),
-                finest.dof.len()
+                finest.n_vertices()
             )));
         }
         check_pattern(last, finest, &pattern)?;
@@ -163,12 +163,12 @@ impl Levels {
 /// refined from it: coarse vertex `c` is interior iff the fine vertex on it (parents
 /// `[c, c]`) is. A coarse vertex without such a fine vertex is an error.
 fn coarse_dofs(refinement: &Refinement, n_vertices: usize, fine: &DofMap) -> Result<DofMap> {
-    if refinement.parents.len() != fine.dof.len() {
+    if refinement.parents.len() != fine.n_vertices() {
         return Err(Error::Mesh(format!(
             "the refinement relation names parents for {} vertices, but the finer level has \
              {} vertices",
             refinement.parents.len(),
-            fine.dof.len()
+            fine.n_vertices()
         )));
     }
     use rayon::prelude::*;
@@ -193,11 +193,7 @@ fn coarse_dofs(refinement: &Refinement, n_vertices: usize, fine: &DofMap) -> Res
                 return Some((v, a, b));
             }
             if a == b {
-                let on = if fine.dof[v].is_some() {
-                    INTERIOR
-                } else {
-                    FIXED
-                };
+                let on = if !fine.is_fixed(v) { INTERIOR } else { FIXED };
                 state[a as usize].fetch_max(on, Relaxed);
             }
             None
@@ -235,7 +231,7 @@ fn check_pattern(mesh: &Mesh, dofs: &DofMap, pattern: &Pattern) -> Result<()> {
         .find_any(|(_, t)| {
             t.iter().any(|&a| {
                 t.iter()
-                    .any(|&b| match (dofs.dof[a as usize], dofs.dof[b as usize]) {
+                    .any(|&b| match (dofs.of(a as usize), dofs.of(b as usize)) {
                         (Some(i), Some(j)) => pattern.find(i as usize, j as usize).is_none(),
                         _ => false,
                     })

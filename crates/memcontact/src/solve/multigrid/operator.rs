@@ -154,7 +154,7 @@ pub fn values_into<A: TopOperator>(a: &A, out: &mut [f64]) {
     let m = a.matrix();
     let pat = &m.pattern;
     for i in 0..pat.n() {
-        let (s, e) = (pat.row_ptr[i], pat.row_ptr[i + 1]);
+        let (s, e) = (pat.ptr(i), pat.ptr(i + 1));
         for ((o, &j), &v) in out[s..e].iter_mut().zip(&pat.col[s..e]).zip(&m.val[s..e]) {
             *o = entry(a, i, j as usize, v);
         }
@@ -177,7 +177,7 @@ mod tests {
                 col.push(j as u32);
                 val.push(if i == j { 2.0 } else { -1.0 });
             }
-            row_ptr.push(col.len());
+            row_ptr.push(col.len() as u32);
         }
         Csr {
             pattern: Arc::new(Pattern { row_ptr, col }),

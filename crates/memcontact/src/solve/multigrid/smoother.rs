@@ -10,7 +10,7 @@ pub(crate) fn fill_inv_diag<A: TopOperator>(op: &A, inv: &mut [f64]) {
     let a = op.matrix();
     let pat = &a.pattern;
     par_rows(inv, |i, d| {
-        let (s, e) = (pat.row_ptr[i], pat.row_ptr[i + 1]);
+        let (s, e) = (pat.ptr(i), pat.ptr(i + 1));
         let k = pat.col[s..e].partition_point(|&j| (j as usize) < i);
         let aii = if s + k < e && pat.col[s + k] as usize == i {
             super::operator::entry(op, i, i, a.val[s + k])
@@ -30,7 +30,7 @@ pub(crate) fn residual<A: TopOperator>(op: &A, x: &[f64], b: &[f64], r: &mut [f6
             *ri = b[i];
             return;
         }
-        let (s, e) = (pat.row_ptr[i], pat.row_ptr[i + 1]);
+        let (s, e) = (pat.ptr(i), pat.ptr(i + 1));
         *ri = b[i] - (row_sum(&pat.col[s..e], &a.val[s..e], |j| x[j]) + shift_term(op, i, x[i]));
     });
 }
@@ -138,7 +138,7 @@ pub(crate) fn gauss_seidel<A: TopOperator>(
             if d == 0.0 {
                 return;
             }
-            let (s, e) = (pat.row_ptr[i], pat.row_ptr[i + 1]);
+            let (s, e) = (pat.ptr(i), pat.ptr(i + 1));
             let (cols, vals) = (&pat.col[s..e], &a.val[s..e]);
             let inside = within(cols, lo, hi);
             let ax =
@@ -186,7 +186,7 @@ impl SweepRows {
         use rayon::prelude::*;
         let n = pattern.n();
         let block = gs_block(n);
-        let row = |i: usize| &pattern.col[pattern.row_ptr[i]..pattern.row_ptr[i + 1]];
+        let row = |i: usize| &pattern.col[pattern.ptr(i)..pattern.ptr(i + 1)];
         let seams = if n <= block {
             Vec::new()
         } else {
@@ -249,7 +249,7 @@ pub(crate) fn gauss_seidel_from_zero<A: TopOperator>(
     let sweep = |lo: usize, xs: &mut [f64], rs: &mut [f64]| {
         let hi = lo + xs.len();
         for (k, i) in (lo..hi).enumerate() {
-            let (s, e) = (pat.row_ptr[i], pat.row_ptr[i + 1]);
+            let (s, e) = (pat.ptr(i), pat.ptr(i + 1));
             let (cols, vals) = (&pat.col[s..e], &a.val[s..e]);
             // Columns are sorted: those of the block before i are `first..diag` (the ones
             // before the block, and i's later neighbours, are still 0 in this sweep).
@@ -323,7 +323,7 @@ fn add_outside_blocks(
         let to = seams.partition_point(|&i| (i as usize) < hi);
         for &i in &seams[from..to] {
             let i = i as usize;
-            let (s, e) = (pat.row_ptr[i], pat.row_ptr[i + 1]);
+            let (s, e) = (pat.ptr(i), pat.ptr(i + 1));
             let outside: f64 = pat.col[s..e]
                 .iter()
                 .zip(&a.val[s..e])
@@ -360,7 +360,7 @@ pub(crate) fn gauss_seidel_back_with_product<A: TopOperator>(
         let hi = lo + xs.len();
         for k in (0..xs.len()).rev() {
             let i = lo + k;
-            let (s, e) = (pat.row_ptr[i], pat.row_ptr[i + 1]);
+            let (s, e) = (pat.ptr(i), pat.ptr(i + 1));
             let (cols, vals) = (&pat.col[s..e], &a.val[s..e]);
             let inside = within(cols, lo, hi);
             let ax = block_row_sum(cols, vals, lo, xs, outside, inside) + shift_term(op, i, xs[k]);

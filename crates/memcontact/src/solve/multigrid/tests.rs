@@ -357,7 +357,7 @@ fn sweep_rows_are_the_seams_and_the_diagonal_offsets() {
         let rows = SweepRows::of(p);
         let n = p.n();
         let block = gs_block(n);
-        let cols = |i: usize| &p.col[p.row_ptr[i]..p.row_ptr[i + 1]];
+        let cols = |i: usize| &p.col[p.ptr(i)..p.ptr(i + 1)];
         for i in 0..n {
             let before = cols(i).iter().filter(|&&c| (c as usize) < i).count();
             assert_eq!(rows.diag[i] as usize, before, "row {i}");
@@ -395,13 +395,13 @@ fn sweep_rows_are_the_seams_and_the_diagonal_offsets() {
             vec![0, i as u32, m as u32 - 1]
         };
         col.extend(&cols);
-        row_ptr.push(col.len());
+        row_ptr.push(col.len() as u32);
     }
     let star = crate::sparse::Pattern { row_ptr, col };
     let rows = SweepRows::of(&star);
     assert_eq!(rows.diag[m - 1], SweepRows::MANY);
     for i in 0..m {
-        let cols = &star.col[star.row_ptr[i]..star.row_ptr[i + 1]];
+        let cols = &star.col[star.ptr(i)..star.ptr(i + 1)];
         let expected = match i {
             0 => 0,
             i if i == m - 1 => i,
@@ -414,10 +414,10 @@ fn sweep_rows_are_the_seams_and_the_diagonal_offsets() {
     let star = std::sync::Arc::new(star);
     let mut a = Csr::zeros(star.clone());
     for i in 0..m {
-        for k in star.row_ptr[i]..star.row_ptr[i + 1] {
+        for k in star.ptr(i)..star.ptr(i + 1) {
             let j = star.col[k] as usize;
             a.val[k] = if i == j {
-                (star.row_ptr[i + 1] - star.row_ptr[i]) as f64
+                (star.ptr(i + 1) - star.ptr(i)) as f64
             } else {
                 -1.0
             };
@@ -453,7 +453,7 @@ fn fused_sweep_from_zero_is_the_sweep_and_its_residual() {
         let held = |i: usize| i % 7 == 3 || (i / 50) % 9 == 4;
         let mut a = model.s.clone();
         for i in 0..n {
-            for k in a.pattern.row_ptr[i]..a.pattern.row_ptr[i + 1] {
+            for k in a.pattern.ptr(i)..a.pattern.ptr(i + 1) {
                 let j = a.pattern.col[k] as usize;
                 if held(i) || held(j) {
                     a.val[k] = 0.0;
@@ -573,7 +573,7 @@ fn backward_sweep_with_product_is_the_sweep_and_its_product() {
         // An assembled matrix whose held rows and columns are zero (x is not zero there).
         let mut a = model.s.clone();
         for i in 0..n {
-            for k in a.pattern.row_ptr[i]..a.pattern.row_ptr[i + 1] {
+            for k in a.pattern.ptr(i)..a.pattern.ptr(i + 1) {
                 if held[i] || held[a.pattern.col[k] as usize] {
                     a.val[k] = 0.0;
                 }

@@ -164,7 +164,7 @@ pub(super) fn setup_matrix(model: &Model) -> Csr {
     crate::sparse::row_chunks(pat, &mut val, ROWS)
         .into_par_iter()
         .for_each(|(first, block)| {
-            let base = pat.row_ptr[first];
+            let base = pat.ptr(first);
             for i in first..(first + ROWS).min(pat.n()) {
                 let Some(k) = pat.find(i, i) else { continue };
                 let v = &mut block[k - base];

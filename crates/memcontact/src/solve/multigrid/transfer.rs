@@ -76,13 +76,13 @@ impl Transfer {
     /// P between the unknowns of two consecutive levels. `refinement.parents` must have one
     /// entry per fine vertex, each naming coarse vertices; anything else is an error.
     pub fn new(refinement: &Refinement, coarse: &DofMap, fine: &DofMap) -> Result<Transfer> {
-        let n_cv = coarse.dof.len();
-        if refinement.parents.len() != fine.dof.len() {
+        let n_cv = coarse.n_vertices();
+        if refinement.parents.len() != fine.n_vertices() {
             return Err(Error::Mesh(format!(
                 "the refinement relation names parents for {} vertices, but the finer level \
                  has {} vertices",
                 refinement.parents.len(),
-                fine.dof.len()
+                fine.n_vertices()
             )));
         }
         if let Some((v, p)) = refinement
@@ -100,7 +100,7 @@ impl Transfer {
         let n_fine = fine.len();
         let map = |&v: &u32| -> ([u32; 2], [f32; 2]) {
             let [a, b] = refinement.parents[v as usize];
-            let (da, db) = (coarse.dof[a as usize], coarse.dof[b as usize]);
+            let (da, db) = (coarse.of(a as usize), coarse.of(b as usize));
             if a == b {
                 match da {
                     Some(i) => ([i, i], [1.0, 0.0]),
@@ -209,7 +209,7 @@ impl Transfer {
                 let (lo, hi) = (child_ptr[i], child_ptr[i + 1]);
                 let k = (lo..hi).find(|&k| child_code[k] == 0)?;
                 let v = children[k] as usize;
-                let row = &fine.col[fine.row_ptr[v]..fine.row_ptr[v + 1]];
+                let row = &fine.col[fine.ptr(v)..fine.ptr(v + 1)];
                 let mut next = lo;
                 for &w in row {
                     if self.weight_of(w as usize, i) != 0.0 {
@@ -274,7 +274,7 @@ impl Transfer {
             }
             Columns::FineRows { on, fine, whole } => {
                 let v = on[i] as usize;
-                let row = &fine.col[fine.row_ptr[v]..fine.row_ptr[v + 1]];
+                let row = &fine.col[fine.ptr(v)..fine.ptr(v + 1)];
                 if *whole {
                     for &w in row {
                         f(w as usize, if w as usize == v { 1.0 } else { 0.5 });
@@ -387,7 +387,7 @@ impl Transfer {
                 r.push(i as u32);
                 seen[i] = i as u32;
                 self.for_children(i, |v, _| {
-                    for &w in &fine.col[fine.row_ptr[v]..fine.row_ptr[v + 1]] {
+                    for &w in &fine.col[fine.ptr(v)..fine.ptr(v + 1)] {
                         let (p, wt) = (self.parents[w as usize], self.weights(w as usize));
                         for s in 0..2 {
                             if wt[s] != 0.0 && seen[p[s] as usize] != i as u32 {
@@ -442,7 +442,7 @@ impl Transfer {
         let fine = op.matrix();
         let fpat = &fine.pattern;
         let row = |i: usize, vals: &mut [f64], marker: &mut [u32]| {
-            let cols = &cpat.col[cpat.row_ptr[i]..cpat.row_ptr[i + 1]];
+            let cols = &cpat.col[cpat.ptr(i)..cpat.ptr(i + 1)];
             for (k, &j) in cols.iter().enumerate() {
                 marker[j as usize] = k as u32;
                 vals[k] = 0.0;
@@ -451,7 +451,7 @@ impl Transfer {
                 if !A::PLAIN && op.held(v) {
                     return; // a zero row
                 }
-                let (s, e) = (fpat.row_ptr[v], fpat.row_ptr[v + 1]);
+                let (s, e) = (fpat.ptr(v), fpat.ptr(v + 1));
                 for (&w, &a) in fpat.col[s..e].iter().zip(&fine.val[s..e]) {
                     let a = entry(op, v, w as usize, a);
                     if a == 0.0 {
@@ -476,7 +476,7 @@ impl Transfer {
             let mut off = 0;
             let end = (start + 512).min(n_coarse);
             for i in start..end {
-                let len = cpat.row_ptr[i + 1] - cpat.row_ptr[i];
+                let len = cpat.ptr(i + 1) - cpat.ptr(i);
                 if dirty.is_none_or(|d| d[i]) {
                     row(i, &mut vals[off..off + len], marker);
                 }
