@@ -117,7 +117,7 @@ pub fn newton_system(
     g: &mut [f64],
     r: &mut [f64],
 ) {
-    newton_system_into(model, v, st, Hessian::Rows(a, rows), g, r)
+    newton_system_into(model, v, st, Hessian::Rows(a, rows), g, Some(r))
 }
 
 /// The truncated Newton matrix as TNNMG keeps it between iterations.
@@ -151,6 +151,9 @@ impl NewtonMatrix {
 
     /// [`newton_system`] into this matrix (a [`NewtonMatrix::Diagonal`] is always refilled
     /// whole: it is one vector).
+    ///
+    /// Without `r`, `SV − D` is not kept: the caller recomputes it where it needs it
+    /// ([`crate::solve::line_search::line_data_at`]), one vector less.
     pub fn fill(
         &mut self,
         model: &Model,
@@ -158,7 +161,7 @@ impl NewtonMatrix {
         st: &NewtonStates,
         rows: Option<&[bool]>,
         g: &mut [f64],
-        r: &mut [f64],
+        r: Option<&mut [f64]>,
     ) {
         let target = match self {
             NewtonMatrix::Assembled(a) => Hessian::Rows(a, rows),
@@ -186,7 +189,7 @@ fn newton_system_into(
     st: &NewtonStates,
     hessian: Hessian,
     g: &mut [f64],
-    r: &mut [f64],
+    r: Option<&mut [f64]>,
 ) {
     if model.is_extended() {
         newton_system_with::<true>(model, v, st, hessian, g, r)
@@ -204,7 +207,7 @@ fn newton_system_with<const EXT: bool>(
     st: &NewtonStates,
     hessian: Hessian,
     g: &mut [f64],
-    r: &mut [f64],
+    r: Option<&mut [f64]>,
 ) {
     let pat = model.s.pattern.clone();
     let sval = &model.s.val;
@@ -308,74 +311,113 @@ fn newton_system_with<const EXT: bool>(
             }
         }
     };
+    // The chunks of `r`, or none of them when it is not kept.
+    let n_chunks = v.len().div_ceil(CHUNK);
+    let r_chunks = |r| chunks_or_none(r, n_chunks);
+    let r_chunks_serial = |r| chunks_or_none_serial(r, n_chunks);
+    // Row i's gradient into gi, and SV − D into the chunk's slot k when kept.
+    let row_gradient = |i: usize, k: usize, gi: &mut f64, rc: &mut Option<&mut [f64]>| {
+        let mut scratch = 0.0;
+        let ri = match rc {
+            Some(rc) => &mut rc[k],
+            None => &mut scratch,
+        };
+        gradient(i, gi, ri);
+    };
+    let parallel = v.len() >= VECTOR_ROWS;
     match hessian {
         Hessian::Rows(a, rows) => {
             let blocks = row_chunks(&pat, &mut a.val, CHUNK);
-            type Block<'a> = ((usize, &'a mut [f64]), (&'a mut [f64], &'a mut [f64]));
-            let work = |((start, vals), (gc, rc)): Block| {
+            type Block<'a> = (
+                (usize, &'a mut [f64]),
+                (&'a mut [f64], Option<&'a mut [f64]>),
+            );
+            let work = |((start, vals), (gc, mut rc)): Block| {
                 let mut off = 0;
-                for (k, (gi, ri)) in gc.iter_mut().zip(rc.iter_mut()).enumerate() {
+                for (k, gi) in gc.iter_mut().enumerate() {
                     let i = start + k;
                     let len = pat.ptr(i + 1) - pat.ptr(i);
-                    gradient(i, gi, ri);
+                    row_gradient(i, k, gi, &mut rc);
                     if rows.is_none_or(|d| d[i]) {
                         matrix_row(i, &mut vals[off..off + len]);
                     }
                     off += len;
                 }
             };
-            if v.len() >= VECTOR_ROWS {
+            if parallel {
                 blocks
                     .into_par_iter()
-                    .zip(g.par_chunks_mut(CHUNK).zip(r.par_chunks_mut(CHUNK)))
+                    .zip(g.par_chunks_mut(CHUNK).zip(r_chunks(r)))
                     .for_each(work);
             } else {
                 blocks
                     .into_iter()
-                    .zip(g.chunks_mut(CHUNK).zip(r.chunks_mut(CHUNK)))
+                    .zip(g.chunks_mut(CHUNK).zip(r_chunks_serial(r)))
                     .for_each(work);
             }
         }
         Hessian::None => {
-            type Block<'a> = (&'a mut [f64], &'a mut [f64]);
-            let work = |(block, (gc, rc)): (usize, Block)| {
-                for (k, (gi, ri)) in gc.iter_mut().zip(rc).enumerate() {
-                    gradient(block * CHUNK + k, gi, ri);
+            type Block<'a> = (&'a mut [f64], Option<&'a mut [f64]>);
+            let work = |(block, (gc, mut rc)): (usize, Block)| {
+                for (k, gi) in gc.iter_mut().enumerate() {
+                    row_gradient(block * CHUNK + k, k, gi, &mut rc);
                 }
             };
-            if v.len() >= VECTOR_ROWS {
+            if parallel {
                 g.par_chunks_mut(CHUNK)
-                    .zip(r.par_chunks_mut(CHUNK))
+                    .zip(r_chunks(r))
                     .enumerate()
                     .for_each(work);
             } else {
                 g.chunks_mut(CHUNK)
-                    .zip(r.chunks_mut(CHUNK))
+                    .zip(r_chunks_serial(r))
                     .enumerate()
                     .for_each(work);
             }
         }
         Hessian::Diagonal(d) => {
-            type Block<'a> = (&'a mut [f64], (&'a mut [f64], &'a mut [f64]));
-            let work = |(block, (dc, (gc, rc))): (usize, Block)| {
-                for (k, (di, (gi, ri))) in dc.iter_mut().zip(gc.iter_mut().zip(rc)).enumerate() {
+            type Block<'a> = (&'a mut [f64], (&'a mut [f64], Option<&'a mut [f64]>));
+            let work = |(block, (dc, (gc, mut rc))): (usize, Block)| {
+                for (k, (di, gi)) in dc.iter_mut().zip(gc.iter_mut()).enumerate() {
                     let i = block * CHUNK + k;
-                    gradient(i, gi, ri);
+                    row_gradient(i, k, gi, &mut rc);
                     *di = shift(i);
                 }
             };
-            if v.len() >= VECTOR_ROWS {
+            if parallel {
                 d.par_chunks_mut(CHUNK)
-                    .zip(g.par_chunks_mut(CHUNK).zip(r.par_chunks_mut(CHUNK)))
+                    .zip(g.par_chunks_mut(CHUNK).zip(r_chunks(r)))
                     .enumerate()
                     .for_each(work);
             } else {
                 d.chunks_mut(CHUNK)
-                    .zip(g.chunks_mut(CHUNK).zip(r.chunks_mut(CHUNK)))
+                    .zip(g.chunks_mut(CHUNK).zip(r_chunks_serial(r)))
                     .enumerate()
                     .for_each(work);
             }
         }
+    }
+}
+
+/// The `CHUNK`-row chunks of `r`, or `n_chunks` times `None` without it.
+fn chunks_or_none(
+    r: Option<&mut [f64]>,
+    n_chunks: usize,
+) -> impl IndexedParallelIterator<Item = Option<&mut [f64]>> {
+    match r {
+        Some(r) => rayon::iter::Either::Left(r.par_chunks_mut(CHUNK).map(Some)),
+        None => rayon::iter::Either::Right((0..n_chunks).into_par_iter().map(|_| None)),
+    }
+}
+
+/// [`chunks_or_none`], serially.
+fn chunks_or_none_serial(
+    r: Option<&mut [f64]>,
+    n_chunks: usize,
+) -> impl Iterator<Item = Option<&mut [f64]>> {
+    match r {
+        Some(r) => rayon::iter::Either::Left(r.chunks_mut(CHUNK).map(Some)),
+        None => rayon::iter::Either::Right((0..n_chunks).map(|_| None)),
     }
 }
 
@@ -502,8 +544,12 @@ mod tests {
             // operator, it is the assembled matrix entry by entry, with the same gradient.
             let mut m = NewtonMatrix::for_model(&model);
             let (mut g2, mut r2) = (vec![0.0; n], vec![0.0; n]);
-            m.fill(&model, &v, &st, None, &mut g2, &mut r2);
+            m.fill(&model, &v, &st, None, &mut g2, Some(&mut r2));
             assert_eq!((&g2, &r2), (&g, &r));
+            // Without r: the same gradient.
+            let mut g3 = vec![0.0; n];
+            m.fill(&model, &v, &st, None, &mut g3, None);
+            assert_eq!(g3, g);
             match (&m, f) {
                 (NewtonMatrix::Assembled(b), Foundation::Consistent) => assert_eq!(b.val, a.val),
                 (NewtonMatrix::Diagonal(d), Foundation::Lumped) => {

@@ -427,16 +427,24 @@ fn sweep_rows_are_the_seams_and_the_diagonal_offsets() {
     fill_inv_diag(&a, &mut inv);
     let b: Vec<f64> = (0..m).map(|i| ((i as f64) * 0.71).sin()).collect();
     let (mut x, mut r, mut snap) = (vec![1.0; m], vec![0.0; m], vec![0.0; m]);
-    gauss_seidel_from_zero(&a, &inv, &mut x, &b, &mut r, &rows);
+    gauss_seidel_from_zero(&a, InvDiag::Stored(&inv), &mut x, &b, &mut r, &rows);
     let mut x_ref = vec![0.0; m];
-    gauss_seidel(&a, &inv, &mut x_ref, &b, &mut snap, false);
+    gauss_seidel(&a, InvDiag::Stored(&inv), &mut x_ref, &b, &mut snap, false);
     let mut r_ref = vec![0.0; m];
     residual(&a, &x_ref, &b, &mut r_ref);
     let close = |p: &[f64], q: &[f64]| p.iter().zip(q).all(|(u, v)| (u - v).abs() <= 1e-12);
     assert!(close(&x, &x_ref) && close(&r, &r_ref));
     let mut y = vec![0.0; m];
-    gauss_seidel_back_with_product(&a, &inv, &mut x, &b, &mut snap, &mut y, &rows);
-    gauss_seidel(&a, &inv, &mut x_ref, &b, &mut snap, true);
+    gauss_seidel_back_with_product(
+        &a,
+        InvDiag::Stored(&inv),
+        &mut x,
+        &b,
+        &mut snap,
+        &mut y,
+        &rows,
+    );
+    gauss_seidel(&a, InvDiag::Stored(&inv), &mut x_ref, &b, &mut snap, true);
     let mut y_ref = vec![0.0; m];
     a.mul_into(&x_ref, &mut y_ref);
     assert!(close(&x, &x_ref) && close(&y, &y_ref));
@@ -466,7 +474,7 @@ fn fused_sweep_from_zero_is_the_sweep_and_its_residual() {
         // The reference: the sweep from zero, then the residual, separately.
         let mut x_ref = vec![0.0; n];
         let mut snap = vec![0.0; n];
-        gauss_seidel(&a, &inv, &mut x_ref, &b, &mut snap, false);
+        gauss_seidel(&a, InvDiag::Stored(&inv), &mut x_ref, &b, &mut snap, false);
         let mut r_ref = vec![0.0; n];
         residual(&a, &x_ref, &b, &mut r_ref);
         let rows = SweepRows::of(&a.pattern);
@@ -475,7 +483,7 @@ fn fused_sweep_from_zero_is_the_sweep_and_its_residual() {
             // Whatever x holds on entry is ignored.
             let (mut x, mut r) = (vec![1.0; n], vec![f64::NAN; n]);
             crate::parallel::on_threads(threads, || {
-                gauss_seidel_from_zero(&a, &inv, &mut x, &b, &mut r, &rows)
+                gauss_seidel_from_zero(&a, InvDiag::Stored(&inv), &mut x, &b, &mut r, &rows)
             });
             (x, r)
         };
@@ -555,14 +563,22 @@ fn backward_sweep_with_product_is_the_sweep_and_its_product() {
         fill_inv_diag(&op, &mut inv);
         let reference = {
             let (mut x, mut snap, mut y) = (x0.clone(), vec![0.0; n], vec![0.0; n]);
-            gauss_seidel(&op, &inv, &mut x, &b, &mut snap, true);
+            gauss_seidel(&op, InvDiag::Stored(&inv), &mut x, &b, &mut snap, true);
             apply(&op, &x, &mut y);
             (x, y)
         };
         let fused = |threads: usize| {
             let (mut x, mut snap, mut y) = (x0.clone(), vec![0.0; n], vec![f64::NAN; n]);
             crate::parallel::on_threads(threads, || {
-                gauss_seidel_back_with_product(&op, &inv, &mut x, &b, &mut snap, &mut y, &rows)
+                gauss_seidel_back_with_product(
+                    &op,
+                    InvDiag::Stored(&inv),
+                    &mut x,
+                    &b,
+                    &mut snap,
+                    &mut y,
+                    &rows,
+                )
             });
             for i in (0..n).filter(|&i| held[i]) {
                 assert_eq!((x[i], y[i]), (0.0, 0.0), "held row {i}");
@@ -583,14 +599,22 @@ fn backward_sweep_with_product_is_the_sweep_and_its_product() {
         fill_inv_diag(&a, &mut inv);
         let reference = {
             let (mut x, mut snap) = (x1.clone(), vec![0.0; n]);
-            gauss_seidel(&a, &inv, &mut x, &b, &mut snap, true);
+            gauss_seidel(&a, InvDiag::Stored(&inv), &mut x, &b, &mut snap, true);
             let y = a.mul(&x);
             (x, y)
         };
         let fused = |threads: usize| {
             let (mut x, mut snap, mut y) = (x1.clone(), vec![0.0; n], vec![f64::NAN; n]);
             crate::parallel::on_threads(threads, || {
-                gauss_seidel_back_with_product(&a, &inv, &mut x, &b, &mut snap, &mut y, &rows)
+                gauss_seidel_back_with_product(
+                    &a,
+                    InvDiag::Stored(&inv),
+                    &mut x,
+                    &b,
+                    &mut snap,
+                    &mut y,
+                    &rows,
+                )
             });
             (x, y)
         };
@@ -684,5 +708,63 @@ fn transfer_columns_read_from_the_fine_pattern_give_the_same_sums() {
         stored.coarse_dirty(&dirty, &mut da);
         fine_rows.coarse_dirty(&dirty, &mut db);
         assert_eq!(da, db, "{name}: dirty rows");
+    }
+}
+
+#[test]
+fn sweeps_divide_by_the_diagonal_they_read_as_by_the_stored_inverse() {
+    use super::operator::Shifted;
+    // Below and above one smoothing block, on the shifted operator with held unknowns (and
+    // a shift that makes some diagonals zero or negative: their rows are left alone).
+    for levels in [5, 7] {
+        let h = square_hierarchy(4, levels);
+        let model = bench_model(h.finest(), Some(0.0), Foundation::Lumped);
+        let n = model.n();
+        let held: Vec<bool> = (0..n).map(|i| i % 7 == 3).collect();
+        let shift: Vec<f64> = (0..n)
+            .map(|i| {
+                if i % 11 == 5 {
+                    -1e9
+                } else {
+                    ((i as f64) * 0.13).cos()
+                }
+            })
+            .collect();
+        let op = Shifted {
+            s: &model.s,
+            shift: &shift,
+            held: &held,
+        };
+        let rows = SweepRows::of(&model.s.pattern);
+        let mut inv = vec![0.0; n];
+        fill_inv_diag(&op, &mut inv);
+        assert!(inv.iter().filter(|&&d| d == 0.0).count() > n / 7);
+        let b: Vec<f64> = (0..n).map(|i| ((i as f64) * 0.71).sin()).collect();
+        let start: Vec<f64> = (0..n)
+            .map(|i| {
+                if held[i] {
+                    0.0
+                } else {
+                    ((i as f64) * 0.3).cos()
+                }
+            })
+            .collect();
+        let ways = [InvDiag::Stored(&inv), InvDiag::Rows(&rows), InvDiag::Search];
+        let runs: Vec<[Vec<f64>; 5]> = ways
+            .iter()
+            .map(|&d| {
+                let (mut x0, mut r0) = (vec![0.0; n], vec![0.0; n]);
+                gauss_seidel_from_zero(&op, d, &mut x0, &b, &mut r0, &rows);
+                let (mut x1, mut snap) = (start.clone(), vec![0.0; n]);
+                gauss_seidel(&op, d, &mut x1, &b, &mut snap, false);
+                let mut x2 = start.clone();
+                gauss_seidel(&op, d, &mut x2, &b, &mut snap, true);
+                let (mut x3, mut y3) = (start.clone(), vec![0.0; n]);
+                gauss_seidel_back_with_product(&op, d, &mut x3, &b, &mut snap, &mut y3, &rows);
+                [x0, r0, x1, x2, x3]
+            })
+            .collect();
+        assert_eq!(runs[0], runs[1], "{levels} levels: offsets");
+        assert_eq!(runs[0], runs[2], "{levels} levels: searched");
     }
 }

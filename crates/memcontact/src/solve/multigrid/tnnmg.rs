@@ -10,7 +10,7 @@ use crate::error::Result;
 use crate::mesh::refine::Hierarchy;
 use crate::model::{FoundationMatrix, Model};
 use crate::solve::active_set::start_from;
-use crate::solve::line_search::{apply_step, exact_step, line_data};
+use crate::solve::line_search::{apply_step, exact_step, line_data_at};
 use crate::solve::newton::{mark_dirty, NewtonMatrix, NewtonStates};
 use crate::solve::relax::sweep_forward;
 use crate::solve::{IterationRecord, Method, Observer, PhaseTimer, Settings, Solution};
@@ -507,7 +507,6 @@ pub(super) fn level_solve(ls: LevelSolve) -> Result<(usize, f64, Option<Certific
     mg.smoothing = options.smoothing;
     let mut delta = zeroed(n);
     let mut g = zeroed(n);
-    let mut r = zeroed(n);
     let mut prev: Option<NewtonStates> = None;
     let mut changed = filled(n, false);
     let mut dirty = filled(n, false);
@@ -563,7 +562,7 @@ pub(super) fn level_solve(ls: LevelSolve) -> Result<(usize, f64, Option<Certific
         let settled = dirty_rows.is_some_and(|d| d <= n / 1000);
         let rows = dirty_rows.map(|_| dirty.as_slice());
         timer.time("newton system", || {
-            a.fill(model, v, &st, rows, &mut g, &mut r)
+            a.fill(model, v, &st, rows, &mut g, None)
         });
         timer.time("coarse operators", || {
             with_operator!(a, model, st, |op| mg.update(op, rows))
@@ -619,7 +618,7 @@ pub(super) fn level_solve(ls: LevelSolve) -> Result<(usize, f64, Option<Certific
             });
         });
         timer.time("line search", || {
-            let (g0, s2) = line_data(model, &delta, &r);
+            let (g0, s2) = line_data_at(model, &delta, v);
             if let Some(alpha) = exact_step(model, v, &delta, g0, s2) {
                 moved |= apply_step(model, v, &delta, alpha);
             }
