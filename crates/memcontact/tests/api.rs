@@ -259,6 +259,12 @@ fn a_run_for_writing_solves_alike_and_then_refuses_to_solve_again() {
             b.discretization.hierarchy.depth(),
             "{name}"
         );
+        // The finest mesh, released during the solve, is back as it was.
+        let (ma, mb) = (a.discretization.mesh(), b.discretization.mesh());
+        assert!(!b.discretization.is_mesh_released());
+        assert_eq!(ma.points, mb.points, "{name}");
+        assert_eq!(ma.triangles, mb.triangles, "{name}");
+        assert_eq!(ma.regions, mb.regions, "{name}");
         // Its matrices are gone: a second solve is an error, not a crash.
         assert!(b.discretization.is_released());
         let e = b

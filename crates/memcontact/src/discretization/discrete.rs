@@ -7,7 +7,7 @@ use crate::error::{Invalid, Result};
 use crate::mesh::refine::Hierarchy;
 use crate::mesh::{Mesh, MeshQuality};
 use crate::model::Model;
-use crate::problem::Problem;
+use crate::problem::{MeshSource, MeshSpec, Problem};
 use crate::solve::multigrid::Levels;
 use crate::solve::Observer;
 use crate::solve::Settings;
@@ -43,6 +43,10 @@ pub struct Discretization {
     built: Option<Arc<Levels>>,
     /// Set by [`Discretization::release_solver_data`]: S is gone, nothing can be solved.
     released: bool,
+    /// Set by [`Discretization::release_mesh`]: the finest mesh's vertices, triangles and
+    /// regions are released until [`Discretization::restore_mesh`] builds them again from
+    /// this spec; the hash checks that they come back the same.
+    mesh_released: Option<(MeshSpec, u64)>,
 }
 
 impl Discretization {
@@ -164,6 +168,74 @@ impl Discretization {
         self.released = true;
     }
 
+    /// Releases the finest mesh's vertices, triangles and regions until
+    /// [`Discretization::restore_mesh`] (a one-step run whose solve does not read them:
+    /// `memcontact solve`), when the mesh comes from a generator of `spec` (the rectangle,
+    /// disc and polygon generators are deterministic, so the mesh is built again, the
+    /// same, for the fields and the writers; a mesh read from a file or given as data is
+    /// kept). Returns whether it released them. Assembly, the checks on the mesh and the
+    /// multigrid levels must be done: nothing reads the mesh until it is restored.
+    pub fn release_mesh(&mut self, spec: &MeshSpec) -> bool {
+        let generated = matches!(
+            spec.source,
+            MeshSource::Rectangle { .. } | MeshSource::Disk { .. } | MeshSource::Polygon { .. }
+        );
+        if !generated || self.mesh_released.is_some() {
+            return false;
+        }
+        let finest = self.hierarchy.levels.last_mut().expect("a level");
+        let hash = geometry_hash(finest);
+        finest.points = Vec::new();
+        finest.triangles = Vec::new();
+        finest.regions = Vec::new();
+        self.mesh_released = Some((spec.clone(), hash));
+        true
+    }
+
+    /// Builds the finest mesh again after [`Discretization::release_mesh`] (as
+    /// [`Discretization::for_one_solve`] built it: generated, refined, renumbered) and puts
+    /// its vertices, triangles and regions back; its seconds are added to the `mesh`
+    /// phase. A mesh that does not come back the same is an error. Nothing to do when
+    /// nothing was released.
+    pub fn restore_mesh(&mut self, observer: &mut dyn Observer) -> Result<()> {
+        let Some((spec, hash)) = self.mesh_released.take() else {
+            return Ok(());
+        };
+        observer.phase_started("mesh");
+        let t0 = Instant::now();
+        let (hierarchy, _) = super::meshing::build_mesh_checked(&spec, false)?;
+        let mesh = hierarchy.levels.into_iter().last().expect("a level");
+        let mesh = match crate::mesh::reorder::renumbering_for_locality(&mesh) {
+            Some(r) => Arc::new(r).apply_shared(&mesh),
+            None => mesh,
+        };
+        if geometry_hash(&mesh) != hash {
+            return Err(crate::error::Error::Mesh(
+                "the mesh built again for the outputs differs from the one solved on".into(),
+            ));
+        }
+        let finest = self.hierarchy.levels.last_mut().expect("a level");
+        finest.points = mesh.points;
+        finest.triangles = mesh.triangles;
+        finest.regions = mesh.regions;
+        let seconds = t0.elapsed().as_secs_f64();
+        observer.phase_finished("mesh", seconds);
+        if let Some(p) = self.phases.iter_mut().find(|p| p.name == "mesh") {
+            p.seconds += seconds;
+        }
+        Ok(())
+    }
+
+    /// Whether the finest mesh is released ([`Discretization::release_mesh`]).
+    pub fn is_mesh_released(&self) -> bool {
+        self.mesh_released.is_some()
+    }
+
+    /// Releases the multigrid levels built beforehand (a solve builds its own again).
+    pub fn release_levels(&mut self) {
+        self.built = None;
+    }
+
     /// Whether [`Discretization::release_solver_data`] was called.
     pub fn is_released(&self) -> bool {
         self.released
@@ -209,6 +281,7 @@ impl Discretization {
             warnings: Vec::new(),
             built: None,
             released: false,
+            mesh_released: None,
             phases: vec![
                 Phase {
                     name: "reorder".into(),
@@ -285,4 +358,40 @@ fn reorder(hierarchy: Hierarchy, observer: &mut dyn Observer) -> Result<(Hierarc
         return Err(crate::error::Error::Cancelled);
     }
     Ok((hierarchy, t_reorder))
+}
+
+/// A hash of a mesh's vertices, triangles and regions: xxh3 of their little-endian bytes
+/// in fixed blocks (on all threads), then of the blocks' hashes in order.
+fn geometry_hash(mesh: &Mesh) -> u64 {
+    use rayon::prelude::*;
+    const BLOCK: usize = 1 << 16;
+    fn blocks<T: Sync>(items: &[T], bytes: impl Fn(&T, &mut Vec<u8>) + Sync) -> Vec<u64> {
+        items
+            .par_chunks(BLOCK)
+            .map(|block| {
+                let mut buf = Vec::with_capacity(block.len() * 16);
+                for x in block {
+                    bytes(x, &mut buf);
+                }
+                xxhash_rust::xxh3::xxh3_64(&buf)
+            })
+            .collect()
+    }
+    let mut all = blocks(&mesh.points, |p, b| {
+        b.extend_from_slice(&p[0].to_le_bytes());
+        b.extend_from_slice(&p[1].to_le_bytes());
+    });
+    all.extend(blocks(&mesh.triangles, |t, b| {
+        for v in t {
+            b.extend_from_slice(&v.to_le_bytes());
+        }
+    }));
+    all.extend(blocks(&mesh.regions, |r, b| {
+        b.extend_from_slice(&r.to_le_bytes())
+    }));
+    let mut h = xxhash_rust::xxh3::Xxh3::new();
+    for d in all {
+        h.update(&d.to_le_bytes());
+    }
+    h.digest()
 }

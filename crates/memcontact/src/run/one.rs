@@ -54,6 +54,33 @@ impl Discretization {
         start: Option<&[f64]>,
         observer: &mut dyn Observer,
     ) -> Result<Report> {
+        let t0 = self.begin_solve(settings, observer)?;
+        let a = self.attempt(settings, start, observer)?;
+        self.finish_solve(a, settings, t0, 0.0, observer)
+    }
+
+    /// [`Discretization::solve`] for a discretisation made by
+    /// [`Discretization::for_one_solve`] whose finest mesh may be released
+    /// ([`Discretization::release_mesh`]): the mesh is built again after the solver is done
+    /// and before the fields are derived on it (its seconds count in the `mesh` phase, not
+    /// in `solve`).
+    pub fn solve_once(
+        &mut self,
+        settings: &Settings,
+        observer: &mut dyn Observer,
+    ) -> Result<Report> {
+        let t0 = self.begin_solve(settings, observer)?;
+        let a = self.attempt(settings, None, observer)?;
+        // Only the solver reads the multigrid levels: they go before the mesh comes back.
+        self.release_levels();
+        let t_mesh = Instant::now();
+        self.restore_mesh(&mut crate::solve::Silent)?;
+        let rebuilt = t_mesh.elapsed().as_secs_f64();
+        self.finish_solve(a, settings, t0, rebuilt, observer)
+    }
+
+    /// The checks before a solve (not released, fits in memory); starts its phase.
+    fn begin_solve(&self, settings: &Settings, observer: &mut dyn Observer) -> Result<Instant> {
         if self.is_released() {
             return Err(Error::Solver {
                 solver: self.method_for(settings).name().into(),
@@ -64,15 +91,37 @@ impl Discretization {
         }
         self.check_memory(settings)?;
         observer.phase_started("solve");
-        let t0 = Instant::now();
-        let a = solve::attempt_with_levels(
+        Ok(Instant::now())
+    }
+
+    /// The solver's attempt on the model (with the levels built beforehand, if any).
+    fn attempt(
+        &self,
+        settings: &Settings,
+        start: Option<&[f64]>,
+        observer: &mut dyn Observer,
+    ) -> Result<solve::Attempt> {
+        solve::attempt_with_levels(
             &self.model,
             self.levels(),
             self.built_levels(),
             settings,
             start,
             observer,
-        )?;
+        )
+    }
+
+    /// The report of an attempt: its answer checked, its fields and totals derived on the
+    /// mesh and checked, the phase ended after `t0` (less `excluded` seconds spent on
+    /// something else).
+    fn finish_solve(
+        &self,
+        a: solve::Attempt,
+        settings: &Settings,
+        t0: Instant,
+        excluded: f64,
+        observer: &mut dyn Observer,
+    ) -> Result<Report> {
         crate::outcome::checks::check_solution(
             a.solution.energy,
             a.solution.certificate.kkt(),
@@ -83,7 +132,7 @@ impl Discretization {
         let (fields, totals) = derive_from(self.mesh(), &self.model, &a.solution.u);
         crate::outcome::checks::check_results(self.mesh(), &fields, &totals)?;
         let derived = Some(std::sync::Arc::new((fields, totals)));
-        let seconds = t0.elapsed().as_secs_f64();
+        let seconds = (t0.elapsed().as_secs_f64() - excluded).max(0.0);
         observer.phase_finished("solve", seconds);
         let mut phases = self.phases.clone();
         phases.push(Phase {
@@ -159,7 +208,8 @@ pub fn run_for_writing(case: &Case, observer: &mut dyn Observer) -> Result<Outco
         Discretization::for_one_solve(&case.problem, &case.settings, observer)?;
     case.settings.cancel.check()?;
     check_case_on_mesh(case, discretization.mesh(), false)?;
-    let report = discretization.solve(&case.settings, observer)?;
+    discretization.release_mesh(&case.problem.mesh);
+    let report = discretization.solve_once(&case.settings, observer)?;
     discretization.release_solver_data();
     Ok(Outcome {
         discretization,
