@@ -96,9 +96,10 @@ fn assembly(args: &[String]) {
     time("dof map (boundary)", &mut || {
         std::hint::black_box(DofMap::with_adjacency(&mesh, &adj));
     });
-    let pattern = std::sync::Arc::new(unknowns_pattern(&mesh, &dofs, &adj, &boundary));
+    let pattern =
+        std::sync::Arc::new(unknowns_pattern(&mesh, &dofs, &adj, &boundary).expect("a pattern"));
     time("pattern", &mut || {
-        std::hint::black_box(unknowns_pattern(&mesh, &dofs, &adj, &boundary));
+        std::hint::black_box(unknowns_pattern(&mesh, &dofs, &adj, &boundary).ok());
     });
     time("S and consistent L", &mut || {
         std::hint::black_box(assemble_stiffness_and_mass(

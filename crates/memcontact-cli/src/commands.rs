@@ -24,7 +24,7 @@ pub fn solve(case_path: &Path, flags: &SolveFlags) -> Result<()> {
         return crate::adapt_cmd::adapt(&label, &case, flags, progress, started);
     }
     // Everything that needs the mesh is checked before anything is solved.
-    let outcome = memcontact::run(&case, &mut progress)?;
+    let outcome = memcontact::run::run_for_writing(&case, &mut progress)?;
     progress.finish();
     print_warnings(&outcome.discretization);
     let accepted = outcome.report.accepted;
@@ -50,7 +50,11 @@ pub fn solve(case_path: &Path, flags: &SolveFlags) -> Result<()> {
         cell_data: Vec::new(),
         adapt: None,
     };
+    #[cfg(feature = "alloc-trace")]
+    crate::alloc_trace::report("write started");
     let summary = write::write_result(flags.out, &outcome, &case, &options, &plots)?;
+    #[cfg(feature = "alloc-trace")]
+    crate::alloc_trace::report("end of the write");
     print!(
         "{}",
         report::human(&options.label, &outcome, Some((&summary, flags.out)))

@@ -23,6 +23,7 @@ CASE FILE (TOML; paths relative to the case file; unknown keys are errors)
               accept_rounding_floor = true   accept an answer at the rounding floor of
                                          double precision above the tolerance (reported)
 [output]      vtu = binary               or ascii
+              csv = true                 false: no nodes.csv (solution.vtu has the fields)
               plots = [\"deflection\", \"pressure\", \"liftoff\", \"profile\"]  (default all; [] none)
               allowable_pressure = p     force/area: pressure.png maps pressure / p
               profile = [[x0, y0], [x1, y1]]  the line of profile.png (default: mid-height)

@@ -2,6 +2,8 @@
 //! prints a summary and writes the outputs. All the numerics live in the library.
 
 mod adapt_cmd;
+#[cfg(feature = "alloc-trace")]
+mod alloc_trace;
 mod bench_cmd;
 mod commands;
 mod convergence;
@@ -19,8 +21,16 @@ use std::process::ExitCode;
 
 /// mimalloc keeps freed memory for reuse: the solver's large work vectors are not handed
 /// back to the kernel and faulted in again page by page on every allocation.
+#[cfg(not(feature = "alloc-trace"))]
 #[global_allocator]
 static ALLOCATOR: mimalloc::MiMalloc = mimalloc::MiMalloc;
+
+/// With the `alloc-trace` feature (a profiling aid, off by default): mimalloc with a count
+/// of live bytes and a table of the large allocations alive at the peak.
+#[cfg(feature = "alloc-trace")]
+#[global_allocator]
+static ALLOCATOR: alloc_trace::Tracing<mimalloc::MiMalloc> =
+    alloc_trace::Tracing(mimalloc::MiMalloc);
 
 /// Contact between a stretched membrane and an elastic (Winkler) obstacle: the discrete
 /// model of Maceri & Maceri (1986), solved exactly and certified.
@@ -156,6 +166,8 @@ fn small_pages_only() {
 
 fn main() -> ExitCode {
     small_pages_only();
+    #[cfg(feature = "alloc-trace")]
+    alloc_trace::enable();
     let cli = Cli::parse();
     if let Some(n) = cli.threads {
         if memcontact::parallel::set_threads(n).is_err() {

@@ -151,6 +151,8 @@ impl Observer for Progress {
         }
         if self.verbosity == Verbosity::Verbose {
             eprintln!("  {}{name} …", self.prefix);
+            #[cfg(feature = "alloc-trace")]
+            crate::alloc_trace::report(&format!("{name} started"));
         }
     }
 
@@ -165,6 +167,8 @@ impl Observer for Progress {
     fn phase_finished(&mut self, name: &str, seconds: f64) {
         if self.verbosity == Verbosity::Verbose {
             eprintln!("  {}{name} done in {seconds:.3} s", self.prefix);
+            #[cfg(feature = "alloc-trace")]
+            crate::alloc_trace::report(&format!("{name} finished"));
         }
     }
 }

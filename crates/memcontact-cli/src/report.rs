@@ -158,7 +158,7 @@ pub fn human(label: &str, outcome: &Outcome, written: Option<(&Summary, &Path)>)
             low.can_touch.iter().filter(|&&c| c).count()
         );
     }
-    let fixed = m.dofs.dof.iter().filter(|d| d.is_none()).count();
+    let fixed = m.dofs.per_vertex().filter(|d| d.is_none()).count();
     // The unknowns beyond the interior vertices: those on free edges.
     let free = m.n().saturating_sub(q.unknowns);
     if free > 0 || !m.boundary_values.is_empty() {
@@ -166,7 +166,7 @@ pub fn human(label: &str, outcome: &Outcome, written: Option<(&Summary, &Path)>)
             .boundary_values
             .iter()
             .enumerate()
-            .filter(|(v, _)| m.dofs.dof[*v].is_none())
+            .filter(|(v, _)| m.dofs.is_fixed(*v))
             .map(|(_, &g)| g);
         let (lo, hi) = heights.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), g| {
             (a.min(g), b.max(g))

@@ -126,6 +126,42 @@ fn set_overrides_keys_and_lumped_differs_from_consistent() {
 }
 
 #[test]
+fn csv_false_writes_no_node_table_and_the_same_solution() {
+    let case = examples().join("bench-square.toml");
+    let solve = |out: &Path, extra: &[&str]| {
+        let mut args = vec![
+            "solve",
+            case.to_str().unwrap(),
+            "-o",
+            out.to_str().unwrap(),
+            "-q",
+            "--set",
+            "mesh.nx=24",
+            "--set",
+            "mesh.ny=24",
+            "--set",
+            "output.plot=false",
+        ];
+        args.extend_from_slice(extra);
+        let o = run(&args);
+        assert!(o.status.success(), "{}", text(&o));
+    };
+    let (with, without) = (tmp("csv-true"), tmp("csv-false"));
+    solve(&with, &[]);
+    solve(&without, &["--set", "output.csv=false"]);
+    assert!(with.join("nodes.csv").exists());
+    assert!(!without.join("nodes.csv").exists());
+    let (a, b) = (summary(&with), summary(&without));
+    assert!(a["files"].get("nodes.csv").is_some());
+    assert!(b["files"].get("nodes.csv").is_none(), "{}", b["files"]);
+    assert!(b["files"].get("solution.vtu").is_some());
+    // The solve is the same: the same energy, certificate and contact set.
+    for key in ["energy", "kkt_residual", "iterations", "contact_area"] {
+        assert_eq!(a[key], b[key], "{key}");
+    }
+}
+
+#[test]
 fn check_reports_the_mesh() {
     let case = examples().join("roof.toml");
     let o = run(&["check", case.to_str().unwrap()]);

@@ -63,6 +63,7 @@ fn samples(section: &str) -> BTreeMap<&'static str, &'static str> {
         ],
         "output" => vec![
             ("vtu", "\"ascii\""),
+            ("csv", "false"),
             ("plots", "[\"deflection\"]"),
             ("plot", "true"),
             ("allowable_pressure", "5.0"),

@@ -460,7 +460,7 @@ fn evaluate_with<const EXT: bool>(
         let mut acc = Acc::default();
         let (lo, hi) = (b * BLOCK, ((b + 1) * BLOCK).min(n));
         for i in lo..hi {
-            let (s, e) = (pat.row_ptr[i], pat.row_ptr[i + 1]);
+            let (s, e) = (pat.ptr(i), pat.ptr(i + 1));
             let (mut su, mut size, mut sii) = (0.0, model.d[i].abs(), 0.0);
             for (&j, &a) in pat.col[s..e].iter().zip(&sval[s..e]) {
                 let j = j as usize;

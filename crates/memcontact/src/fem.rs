@@ -5,6 +5,7 @@
 //! it. Rows are independent, so they are built in parallel and the result does not depend
 //! on the number of threads.
 
+use crate::error::{Error, Result};
 use crate::field::Coefficient;
 pub use crate::mesh::VertexTriangles;
 use crate::mesh::{corner, DofMap, Mesh, Point};
@@ -161,7 +162,7 @@ fn row_columns(
             buf.extend(
                 mesh.triangles[k as usize]
                     .iter()
-                    .filter_map(|&w| dofs.dof[w as usize]),
+                    .filter_map(|&w| dofs.of(w as usize)),
             );
         }
         buf.sort_unstable();
@@ -171,7 +172,7 @@ fn row_columns(
     // The vertex and the vertices after it in its triangles are distinct (every directed
     // edge is used once); on the boundary, the vertices before it add those not among
     // them. Unknowns, or u32::MAX for a boundary vertex (ranked last, dropped).
-    let unknown = |w: u32| dofs.dof[w as usize].unwrap_or(u32::MAX);
+    let unknown = |w: u32| dofs.of(w as usize).unwrap_or(u32::MAX);
     let (mut next, mut prev) = ([u32::MAX; SMALL_ROW], [u32::MAX; SMALL_ROW]);
     for (q, &k) in fan.iter().enumerate() {
         let t = mesh.triangles[k as usize];
@@ -223,7 +224,7 @@ pub fn unknowns_pattern(
     dofs: &DofMap,
     adj: &VertexTriangles,
     boundary: &[bool],
-) -> Pattern {
+) -> Result<Pattern> {
     let n = dofs.len();
     let blocks: Vec<(Vec<u32>, Vec<u32>)> = (0..n.div_ceil(ROW_BLOCK))
         .into_par_iter()
@@ -240,7 +241,14 @@ pub fn unknowns_pattern(
             (lengths, cols)
         })
         .collect();
-    Pattern::from_blocks(&blocks)
+    let nnz: usize = blocks.iter().map(|(_, c)| c.len()).sum();
+    if nnz > crate::sparse::MAX_ENTRIES {
+        return Err(Error::Mesh(format!(
+            "the mesh's matrices would hold {nnz} entries, more than the {} a run supports",
+            crate::sparse::MAX_ENTRIES
+        )));
+    }
+    Ok(Pattern::from_blocks(&blocks))
 }
 
 /// The position of column `j` in the sorted, distinct columns `cols` of a row that holds
@@ -299,10 +307,10 @@ pub fn assemble_stiffness_and_mass(
         .zip(l_blocks)
         .for_each(|((first, s_block), mut l_block)| {
             let rows = first..(first + ROW_BLOCK).min(n);
-            let base = pattern.row_ptr[rows.start];
+            let base = pattern.ptr(rows.start);
             for i in rows {
-                let range = pattern.row_ptr[i] - base..pattern.row_ptr[i + 1] - base;
-                let cols = &pattern.col[pattern.row_ptr[i]..pattern.row_ptr[i + 1]];
+                let range = pattern.ptr(i) - base..pattern.ptr(i + 1) - base;
+                let cols = &pattern.col[pattern.ptr(i)..pattern.ptr(i + 1)];
                 let v = dofs.vertex[i];
                 for &k in adj.of(v as usize) {
                     let tri = mesh.triangles[k as usize];
@@ -322,7 +330,7 @@ pub fn assemble_stiffness_and_mass(
                     let region = mesh.regions[k as usize];
                     let h_const = h.and_then(|h| h.on_region(region));
                     for (b, &w) in tri.iter().enumerate() {
-                        let Some(j) = dofs.dof[w as usize] else {
+                        let Some(j) = dofs.of(w as usize) else {
                             continue;
                         };
                         let pos = position(cols, j);
@@ -562,13 +570,13 @@ pub fn assemble_lift(
             let mut sum = 0.0;
             for &k in adj.of(v) {
                 let tri = mesh.triangles[k as usize];
-                if tri.iter().all(|&w| dofs.dof[w as usize].is_some()) {
+                if tri.iter().all(|&w| !dofs.is_fixed(w as usize)) {
                     continue;
                 }
                 let e = Element::of(mesh, k as usize);
                 let a = corner(tri, v as u32);
                 for (b, &w) in tri.iter().enumerate() {
-                    if dofs.dof[w as usize].is_none() {
+                    if dofs.is_fixed(w as usize) {
                         sum += t * e.stiffness(a, b) * g[w as usize];
                     }
                 }
@@ -643,17 +651,17 @@ mod tests {
                 .map(|v| boundary[v] && !(free_edges && m.points[v][0] < 0.3))
                 .collect();
             let dofs = DofMap::from_fixed(&fixed);
-            let pattern = unknowns_pattern(m, &dofs, &adj, &boundary);
+            let pattern = unknowns_pattern(m, &dofs, &adj, &boundary).unwrap();
             for (i, &v) in dofs.vertex.iter().enumerate() {
                 let mut expected: Vec<u32> = adj
                     .of(v as usize)
                     .iter()
                     .flat_map(|&k| m.triangles[k as usize])
-                    .filter_map(|w| dofs.dof[w as usize])
+                    .filter_map(|w| dofs.of(w as usize))
                     .collect();
                 expected.sort_unstable();
                 expected.dedup();
-                let row = &pattern.col[pattern.row_ptr[i]..pattern.row_ptr[i + 1]];
+                let row = &pattern.col[pattern.ptr(i)..pattern.ptr(i + 1)];
                 assert_eq!(row, expected.as_slice(), "row {i}");
             }
         }
@@ -804,7 +812,7 @@ mod tests {
         let m = grid();
         let dofs = DofMap::new(&m);
         let adj = VertexTriangles::new(&m);
-        let pat = Arc::new(unknowns_pattern(&m, &dofs, &adj, &m.boundary_vertices()));
+        let pat = Arc::new(unknowns_pattern(&m, &dofs, &adj, &m.boundary_vertices()).unwrap());
         let (s, l) = assemble_stiffness_and_mass(&m, &dofs, &adj, &pat, 1.0, Some(&2.0));
         // ∫ h g² over the patch = h × 6 × (area/6) with area 1/8 per triangle.
         assert!((l.unwrap().get(0, 0) - 2.0 * 6.0 * (1.0 / 8.0) / 6.0).abs() < 1e-15);

@@ -14,13 +14,31 @@ const PAR_ENTRIES: usize = 1 << 16;
 /// matrices, so that it is built once (assemble once, keep the pattern).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Pattern {
-    /// Row `i` occupies `col[row_ptr[i]..row_ptr[i + 1]]`.
-    pub row_ptr: Vec<usize>,
+    /// Row `i` occupies `col[row_ptr[i]..row_ptr[i + 1]]` ([`Pattern::ptr`]). Four bytes
+    /// per row: a pattern holds fewer than 2³² entries ([`MAX_ENTRIES`]).
+    pub row_ptr: Vec<u32>,
     /// Column indices, sorted within each row.
     pub col: Vec<u32>,
 }
 
+/// The most entries a [`Pattern`] holds (its row pointers are `u32`): about 600 million
+/// unknowns of a triangle mesh, far beyond what a run agrees to allocate
+/// ([`crate::limits`]).
+pub const MAX_ENTRIES: usize = u32::MAX as usize;
+
 impl Pattern {
+    /// Where row `i` starts in `col` (and where row `i − 1` ends).
+    #[inline(always)]
+    pub fn ptr(&self, i: usize) -> usize {
+        self.row_ptr[i] as usize
+    }
+
+    /// The columns of row `i`.
+    #[inline(always)]
+    pub fn cols(&self, i: usize) -> &[u32] {
+        &self.col[self.ptr(i)..self.ptr(i + 1)]
+    }
+
     /// Number of rows (= columns: the patterns here are square).
     pub fn n(&self) -> usize {
         self.row_ptr.len() - 1
@@ -33,19 +51,26 @@ impl Pattern {
 
     /// The position of entry `(i, j)` in the value array, if stored.
     pub fn find(&self, i: usize, j: usize) -> Option<usize> {
-        let row = &self.col[self.row_ptr[i]..self.row_ptr[i + 1]];
-        row.binary_search(&(j as u32))
-            .ok()
-            .map(|k| self.row_ptr[i] + k)
+        let row = &self.col[self.ptr(i)..self.ptr(i + 1)];
+        row.binary_search(&(j as u32)).ok().map(|k| self.ptr(i) + k)
     }
 
     /// The pattern of consecutive blocks of rows, each given as its rows' lengths and their
     /// columns concatenated. The blocks are put into place on all threads: the arrays are
     /// large and fresh, and their first touch is shared by the threads.
+    ///
+    /// # Panics
+    /// With more than [`MAX_ENTRIES`] entries (callers check the counts of large patterns
+    /// first and report an error).
     pub fn from_blocks(blocks: &[(Vec<u32>, Vec<u32>)]) -> Pattern {
         let n: usize = blocks.iter().map(|(lengths, _)| lengths.len()).sum();
-        let mut row_ptr = filled(n + 1, 0usize);
-        let mut col = filled(blocks.iter().map(|(_, c)| c.len()).sum(), 0u32);
+        let nnz: usize = blocks.iter().map(|(_, c)| c.len()).sum();
+        assert!(
+            nnz <= MAX_ENTRIES,
+            "a sparsity pattern of {nnz} entries, more than {MAX_ENTRIES}"
+        );
+        let mut row_ptr = filled(n + 1, 0u32);
+        let mut col = filled(nnz, 0u32);
         let mut pieces = Vec::with_capacity(blocks.len());
         let (mut ptr_rest, mut col_rest) = (&mut row_ptr[1..], &mut col[..]);
         let mut start = 0;
@@ -59,9 +84,9 @@ impl Pattern {
         pieces
             .into_par_iter()
             .for_each(|(start, lengths, cols, p, c)| {
-                let mut end = start;
+                let mut end = start as u32;
                 for (slot, &l) in p.iter_mut().zip(lengths) {
-                    end += l as usize;
+                    end += l;
                     *slot = end;
                 }
                 c.copy_from_slice(cols);
@@ -100,7 +125,7 @@ impl Csr {
     pub fn diagonal(d: &[f64]) -> Csr {
         Csr {
             pattern: Arc::new(Pattern {
-                row_ptr: (0..=d.len()).collect(),
+                row_ptr: (0..=d.len() as u32).collect(),
                 col: (0..d.len() as u32).collect(),
             }),
             val: d.to_vec(),
@@ -114,7 +139,7 @@ impl Csr {
         for &(i, j, v) in triplets {
             rows[i].push((j as u32, v));
         }
-        let mut row_ptr = vec![0usize];
+        let mut row_ptr = vec![0u32];
         let mut col = Vec::new();
         let mut val = Vec::new();
         for mut r in rows {
@@ -130,7 +155,7 @@ impl Csr {
                 col.push(j);
                 val.push(v);
             }
-            row_ptr.push(col.len());
+            row_ptr.push(u32::try_from(col.len()).expect("a small matrix"));
         }
         Csr {
             pattern: Arc::new(Pattern { row_ptr, col }),
@@ -156,7 +181,7 @@ impl Csr {
     /// Row `i` as (columns, values).
     #[inline]
     pub fn row(&self, i: usize) -> (&[u32], &[f64]) {
-        let r = self.pattern.row_ptr[i]..self.pattern.row_ptr[i + 1];
+        let r = self.pattern.ptr(i)..self.pattern.ptr(i + 1);
         (&self.pattern.col[r.clone()], &self.val[r])
     }
 
@@ -222,7 +247,7 @@ impl Cholesky {
         use faer::sparse::SymbolicSparseColMatRef;
         let n = a.n();
         // A symmetric matrix in CSR is its own CSC: row pointers become column pointers.
-        let col_ptr = a.pattern.row_ptr.clone();
+        let col_ptr: Vec<usize> = a.pattern.row_ptr.iter().map(|&p| p as usize).collect();
         let row_idx: Vec<usize> = a.pattern.col.iter().map(|&j| j as usize).collect();
         let sym = SymbolicSparseColMatRef::new_checked(n, n, &col_ptr, None, &row_idx);
         let symbolic = faer::sparse::linalg::solvers::SymbolicLlt::try_new(sym, faer::Side::Lower)
@@ -503,7 +528,7 @@ pub(crate) fn row_chunks<'a>(
     let mut start = 0;
     while start < n {
         let end = (start + rows).min(n);
-        let len = pattern.row_ptr[end] - pattern.row_ptr[start];
+        let len = pattern.ptr(end) - pattern.ptr(start);
         let (head, tail) = rest.split_at_mut(len);
         out.push((start, head));
         rest = tail;
@@ -654,13 +679,9 @@ mod tests {
             .collect();
         let p = Pattern::from_blocks(&blocks);
         assert_eq!(p.n(), n);
-        assert_eq!(p.row_ptr[0], 0);
+        assert_eq!(p.ptr(0), 0);
         for i in 0..n {
-            assert_eq!(
-                &p.col[p.row_ptr[i]..p.row_ptr[i + 1]],
-                &row(i)[..],
-                "row {i}"
-            );
+            assert_eq!(&p.col[p.ptr(i)..p.ptr(i + 1)], &row(i)[..], "row {i}");
         }
         assert_eq!(p.nnz(), 3 * n - 2);
         assert_eq!(

@@ -225,3 +225,52 @@ fn a_result_set_is_written_and_read_back_without_the_cli() {
         .to_vertices(&outcome.report.u, 0.0);
     assert_eq!(u, expect);
 }
+
+#[test]
+fn a_run_for_writing_solves_alike_and_then_refuses_to_solve_again() {
+    let disk = std::fs::read_to_string(
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/disk.toml"),
+    )
+    .unwrap()
+    .replace("refine = 0", "refine = 2");
+    let lumped = SQUARE.replace(
+        "stiffness = 1000.0",
+        "stiffness = 1000.0\nfoundation = \"lumped\"",
+    );
+    for (name, text) in [
+        ("square", SQUARE),
+        ("square, lumped", &lumped),
+        ("disk", &disk),
+    ] {
+        let case = Case::from_toml_str(text, None).unwrap();
+        let a = run(&case, &mut Silent).unwrap();
+        let b = memcontact::run::run_for_writing(&case, &mut Silent).unwrap();
+        assert_eq!(a.report.method, Method::Multigrid, "{name}");
+        assert_eq!(a.report.u, b.report.u, "{name}");
+        assert_eq!(a.report.iterations, b.report.iterations, "{name}");
+        assert_eq!(a.report.certificate, b.report.certificate, "{name}");
+        let (fa, ta) = a.checked_fields().unwrap();
+        let (fb, tb) = b.checked_fields().unwrap();
+        assert_eq!(fa.u, fb.u, "{name}");
+        assert_eq!(fa.contact_force, fb.contact_force, "{name}");
+        assert_eq!(ta.total_contact_force, tb.total_contact_force, "{name}");
+        assert_eq!(
+            a.discretization.hierarchy.depth(),
+            b.discretization.hierarchy.depth(),
+            "{name}"
+        );
+        // The finest mesh, released during the solve, is back as it was.
+        let (ma, mb) = (a.discretization.mesh(), b.discretization.mesh());
+        assert!(!b.discretization.is_mesh_released());
+        assert_eq!(ma.points, mb.points, "{name}");
+        assert_eq!(ma.triangles, mb.triangles, "{name}");
+        assert_eq!(ma.regions, mb.regions, "{name}");
+        // Its matrices are gone: a second solve is an error, not a crash.
+        assert!(b.discretization.is_released());
+        let e = b
+            .discretization
+            .solve(&case.settings, &mut Silent)
+            .unwrap_err();
+        assert!(e.to_string().contains("solve it again"), "{e}");
+    }
+}

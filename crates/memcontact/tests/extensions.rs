@@ -105,7 +105,7 @@ fn a_table_gives_each_side_its_height() {
     let d = disc(&text);
     let (u, _) = solve(&d, Method::ActiveSet, 1e-11);
     for (v, p) in d.mesh().points.iter().enumerate() {
-        let fixed = d.model.dofs.dof[v].is_none();
+        let fixed = d.model.dofs.is_fixed(v);
         let expect = match (p[0], p[1]) {
             (0.0, 0.0) => Some(0.05), // left 0.1 and bottom 0
             (0.0, _) => Some(0.1),

@@ -77,7 +77,7 @@ fn renumbered_solve_answers_in_the_users_numbering() {
                     "{method}: vertex {v}: {a} vs {b}"
                 );
             }
-            let phi_ref = &model.phi_vertices;
+            let phi_ref = &model.phi_vertices();
             for (a, b) in fields.phi.iter().zip(phi_ref) {
                 assert_eq!(a, b);
             }

@@ -65,7 +65,7 @@ pub fn solve_case(
     let solution = solve::solve(&model, h, &Settings::default(), &mut Silent).unwrap();
     let (fields, _) = derive(mesh, &model, &solution);
     // The body covers the vertices where h > 0 (h = ∞ when rigid), boundary included.
-    let covered = model.h_vertices.iter().map(|&h| h > 0.0).collect();
+    let covered = model.h_vertices.to_vec().iter().map(|&h| h > 0.0).collect();
     Solved {
         name,
         data: ResultData {

@@ -24,6 +24,10 @@ pub struct OutputOptions {
     /// The encoding of `solution.vtu`.
     #[serde(default)]
     pub vtu: VtuFormat,
+    /// `false`: no `nodes.csv` (the node table of a large mesh takes gigabytes); default
+    /// `true`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub csv: Option<bool>,
     /// The pictures to draw (default: all four; `[]`: none).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub plots: Option<Vec<PictureKind>>,
@@ -78,6 +82,11 @@ impl PictureKind {
 }
 
 impl OutputOptions {
+    /// Whether `nodes.csv` is written (`[output] csv`, default true).
+    pub fn writes_csv(&self) -> bool {
+        self.csv.unwrap_or(true)
+    }
+
     /// The pictures to draw.
     pub fn pictures(&self) -> Vec<PictureKind> {
         match (&self.plots, self.plot) {

@@ -7,8 +7,12 @@ use crate::error::{Invalid, Result};
 use crate::mesh::refine::Hierarchy;
 use crate::mesh::{Mesh, MeshQuality};
 use crate::model::Model;
-use crate::problem::Problem;
+use crate::problem::{MeshSource, MeshSpec, Problem};
+use crate::solve::multigrid::Levels;
 use crate::solve::Observer;
+use crate::solve::Settings;
+use crate::sparse::Csr;
+use std::sync::Arc;
 use std::time::Instant;
 
 /// A named phase of a run and its wall-clock seconds.
@@ -34,6 +38,15 @@ pub struct Discretization {
     pub warnings: Vec<String>,
     /// Wall-clock seconds of `mesh` and `assembly`.
     pub phases: Vec<Phase>,
+    /// The geometric multigrid levels, built beforehand by
+    /// [`Discretization::for_one_solve`] (a solve builds its own otherwise).
+    built: Option<Arc<Levels>>,
+    /// Set by [`Discretization::release_solver_data`]: S is gone, nothing can be solved.
+    released: bool,
+    /// Set by [`Discretization::release_mesh`]: the finest mesh's vertices, triangles and
+    /// regions are released until [`Discretization::restore_mesh`] builds them again from
+    /// this spec; the hash checks that they come back the same.
+    mesh_released: Option<(MeshSpec, u64)>,
 }
 
 impl Discretization {
@@ -69,14 +82,178 @@ impl Discretization {
         hierarchy: Hierarchy,
         observer: &mut dyn Observer,
     ) -> Result<Discretization> {
-        observer.phase_started("reorder");
+        let (hierarchy, t_reorder) = reorder(hierarchy, observer)?;
+        Discretization::assemble_reordered(problem, hierarchy, t_reorder, observer)
+    }
+
+    /// The discretisation for one solve with `settings` and, after it, only the writing of
+    /// its outcome (`memcontact solve` of a case without steps): the mesh is built and
+    /// renumbered as by [`Discretization::new`], then the coarser levels' meshes are
+    /// released before assembly (their vertex counts and the refinement relations are all
+    /// multigrid reads of them), and after assembly the geometric multigrid levels the
+    /// solve will use are built and the refinement relations released too. The coarser
+    /// levels stay in [`Discretization::hierarchy`] as empty meshes, so that its depth is
+    /// still reported. Call [`Discretization::release_solver_data`] after the solve.
+    pub fn for_one_solve(
+        problem: &Problem,
+        settings: &Settings,
+        observer: &mut dyn Observer,
+    ) -> Result<Discretization> {
+        problem.validate().map_err(Invalid::into_error)?;
+        observer.phase_started("mesh");
         let t0 = Instant::now();
-        let (hierarchy, _) = hierarchy.reordered();
-        let t_reorder = t0.elapsed().as_secs_f64();
-        observer.phase_finished("reorder", t_reorder);
+        let (hierarchy, warnings) = build_mesh(&problem.mesh)?;
+        let t_mesh = t0.elapsed().as_secs_f64();
+        observer.phase_finished("mesh", t_mesh);
         if observer.cancelled() {
             return Err(crate::error::Error::Cancelled);
         }
+        let (mut hierarchy, t_reorder) = reorder(hierarchy, observer)?;
+        let counts: Vec<usize> = hierarchy.levels.iter().map(Mesh::n_vertices).collect();
+        let depth = hierarchy.depth();
+        for m in &mut hierarchy.levels[..depth - 1] {
+            m.points = Vec::new();
+            m.triangles = Vec::new();
+            m.regions = Vec::new();
+            m.numbering = None;
+        }
+        let mut d = Discretization::assemble_reordered(problem, hierarchy, t_reorder, observer)?;
+        d.warnings = warnings;
+        d.phases.insert(
+            0,
+            Phase {
+                name: "mesh".into(),
+                seconds: t_mesh,
+            },
+        );
+        // The levels multigrid will build from the mesh's hierarchy, built now (part of
+        // the symbolic phase), so that the refinement relations can go.
+        let geometric = d.method_for(settings) == crate::solve::Method::Multigrid
+            && settings.hierarchy != crate::solve::HierarchyChoice::Algebraic
+            && depth > 1;
+        if geometric {
+            let t0 = Instant::now();
+            observer.phase_started("levels");
+            let levels = Levels::from_relations(
+                &d.hierarchy.refinements,
+                &counts,
+                d.hierarchy.levels.last(),
+                &d.model.dofs,
+                d.model.s.pattern.clone(),
+            )?;
+            d.built = Some(Arc::new(levels));
+            let seconds = t0.elapsed().as_secs_f64();
+            observer.phase_finished("levels", seconds);
+            if let Some(p) = d.phases.iter_mut().find(|p| p.name == "assembly") {
+                p.seconds += seconds;
+            }
+        }
+        d.hierarchy.refinements = Vec::new();
+        Ok(d)
+    }
+
+    /// Releases what only a solve reads (S and the multigrid levels), once a discretisation
+    /// made by [`Discretization::for_one_solve`] has been solved and its outcome is about
+    /// to be written. The outcome's fields, totals and report are kept; a later solve is
+    /// refused with an error.
+    pub fn release_solver_data(&mut self) {
+        self.built = None;
+        self.model.s = Csr {
+            pattern: Arc::new(crate::sparse::Pattern {
+                row_ptr: vec![0],
+                col: Vec::new(),
+            }),
+            val: Vec::new(),
+        };
+        self.released = true;
+    }
+
+    /// Releases the finest mesh's vertices, triangles and regions until
+    /// [`Discretization::restore_mesh`] (a one-step run whose solve does not read them:
+    /// `memcontact solve`), when the mesh comes from a generator of `spec` (the rectangle,
+    /// disc and polygon generators are deterministic, so the mesh is built again, the
+    /// same, for the fields and the writers; a mesh read from a file or given as data is
+    /// kept). Returns whether it released them. Assembly, the checks on the mesh and the
+    /// multigrid levels must be done: nothing reads the mesh until it is restored.
+    pub fn release_mesh(&mut self, spec: &MeshSpec) -> bool {
+        let generated = matches!(
+            spec.source,
+            MeshSource::Rectangle { .. } | MeshSource::Disk { .. } | MeshSource::Polygon { .. }
+        );
+        if !generated || self.mesh_released.is_some() {
+            return false;
+        }
+        let finest = self.hierarchy.levels.last_mut().expect("a level");
+        let hash = geometry_hash(finest);
+        finest.points = Vec::new();
+        finest.triangles = Vec::new();
+        finest.regions = Vec::new();
+        self.mesh_released = Some((spec.clone(), hash));
+        true
+    }
+
+    /// Builds the finest mesh again after [`Discretization::release_mesh`] (as
+    /// [`Discretization::for_one_solve`] built it: generated, refined, renumbered) and puts
+    /// its vertices, triangles and regions back; its seconds are added to the `mesh`
+    /// phase. A mesh that does not come back the same is an error. Nothing to do when
+    /// nothing was released.
+    pub fn restore_mesh(&mut self, observer: &mut dyn Observer) -> Result<()> {
+        let Some((spec, hash)) = self.mesh_released.take() else {
+            return Ok(());
+        };
+        observer.phase_started("mesh");
+        let t0 = Instant::now();
+        let (hierarchy, _) = super::meshing::build_mesh_checked(&spec, false)?;
+        let mesh = hierarchy.levels.into_iter().last().expect("a level");
+        let mesh = match crate::mesh::reorder::renumbering_for_locality(&mesh) {
+            Some(r) => Arc::new(r).apply_shared(&mesh),
+            None => mesh,
+        };
+        if geometry_hash(&mesh) != hash {
+            return Err(crate::error::Error::Mesh(
+                "the mesh built again for the outputs differs from the one solved on".into(),
+            ));
+        }
+        let finest = self.hierarchy.levels.last_mut().expect("a level");
+        finest.points = mesh.points;
+        finest.triangles = mesh.triangles;
+        finest.regions = mesh.regions;
+        let seconds = t0.elapsed().as_secs_f64();
+        observer.phase_finished("mesh", seconds);
+        if let Some(p) = self.phases.iter_mut().find(|p| p.name == "mesh") {
+            p.seconds += seconds;
+        }
+        Ok(())
+    }
+
+    /// Whether the finest mesh is released ([`Discretization::release_mesh`]).
+    pub fn is_mesh_released(&self) -> bool {
+        self.mesh_released.is_some()
+    }
+
+    /// Releases the multigrid levels built beforehand (a solve builds its own again).
+    pub fn release_levels(&mut self) {
+        self.built = None;
+    }
+
+    /// Whether [`Discretization::release_solver_data`] was called.
+    pub fn is_released(&self) -> bool {
+        self.released
+    }
+
+    /// The geometric multigrid levels built beforehand, if any.
+    pub fn built_levels(&self) -> Option<&Levels> {
+        self.built.as_deref()
+    }
+
+    /// [`Discretization::assemble`] on a hierarchy already renumbered (in `t_reorder`
+    /// seconds).
+    fn assemble_reordered(
+        problem: &Problem,
+        hierarchy: Hierarchy,
+        t_reorder: f64,
+        observer: &mut dyn Observer,
+    ) -> Result<Discretization> {
         observer.phase_started("assembly");
         let t0 = Instant::now();
         let mesh = hierarchy.finest();
@@ -102,6 +279,9 @@ impl Discretization {
             model,
             quality,
             warnings: Vec::new(),
+            built: None,
+            released: false,
+            mesh_released: None,
             phases: vec![
                 Phase {
                     name: "reorder".into(),
@@ -164,4 +344,54 @@ impl Discretization {
     pub fn levels(&self) -> Option<&Hierarchy> {
         (self.hierarchy.depth() > 1).then_some(&self.hierarchy)
     }
+}
+
+/// Renumbers the levels of `hierarchy` for locality (the `reorder` phase); returns it with
+/// the seconds taken.
+fn reorder(hierarchy: Hierarchy, observer: &mut dyn Observer) -> Result<(Hierarchy, f64)> {
+    observer.phase_started("reorder");
+    let t0 = Instant::now();
+    let (hierarchy, _) = hierarchy.reordered();
+    let t_reorder = t0.elapsed().as_secs_f64();
+    observer.phase_finished("reorder", t_reorder);
+    if observer.cancelled() {
+        return Err(crate::error::Error::Cancelled);
+    }
+    Ok((hierarchy, t_reorder))
+}
+
+/// A hash of a mesh's vertices, triangles and regions: xxh3 of their little-endian bytes
+/// in fixed blocks (on all threads), then of the blocks' hashes in order.
+fn geometry_hash(mesh: &Mesh) -> u64 {
+    use rayon::prelude::*;
+    const BLOCK: usize = 1 << 16;
+    fn blocks<T: Sync>(items: &[T], bytes: impl Fn(&T, &mut Vec<u8>) + Sync) -> Vec<u64> {
+        items
+            .par_chunks(BLOCK)
+            .map(|block| {
+                let mut buf = Vec::with_capacity(block.len() * 16);
+                for x in block {
+                    bytes(x, &mut buf);
+                }
+                xxhash_rust::xxh3::xxh3_64(&buf)
+            })
+            .collect()
+    }
+    let mut all = blocks(&mesh.points, |p, b| {
+        b.extend_from_slice(&p[0].to_le_bytes());
+        b.extend_from_slice(&p[1].to_le_bytes());
+    });
+    all.extend(blocks(&mesh.triangles, |t, b| {
+        for v in t {
+            b.extend_from_slice(&v.to_le_bytes());
+        }
+    }));
+    all.extend(blocks(&mesh.regions, |r, b| {
+        b.extend_from_slice(&r.to_le_bytes())
+    }));
+    let mut h = xxhash_rust::xxh3::Xxh3::new();
+    for d in all {
+        h.update(&d.to_le_bytes());
+    }
+    h.digest()
 }

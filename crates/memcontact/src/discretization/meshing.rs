@@ -12,7 +12,13 @@ use crate::problem::{MeshSource, MeshSpec};
 /// checked before the base mesh is generated (when its size is known beforehand) and
 /// again, exactly, before it is refined.
 pub fn build_mesh(spec: &MeshSpec) -> Result<(Hierarchy, Vec<String>)> {
-    if let Some(base) = expected_size(spec) {
+    build_mesh_checked(spec, true)
+}
+
+/// [`build_mesh`], the memory check made only when `check` (a mesh built again for the
+/// writers of a run that already holds its data is not checked against what is left).
+pub(crate) fn build_mesh_checked(spec: &MeshSpec, check: bool) -> Result<(Hierarchy, Vec<String>)> {
+    if let Some(base) = expected_size(spec).filter(|_| check) {
         check_mesh_fits(base, spec.refine, &describe_refinement(spec, &base))?;
     }
     let mut warnings = Vec::new();
@@ -79,7 +85,9 @@ pub fn build_mesh(spec: &MeshSpec) -> Result<(Hierarchy, Vec<String>)> {
     };
     if spec.refine > 0 {
         let base = MeshSize::of(hierarchy.finest());
-        check_mesh_fits(base, spec.refine, &describe_refinement(spec, &base))?;
+        if check {
+            check_mesh_fits(base, spec.refine, &describe_refinement(spec, &base))?;
+        }
         hierarchy.refine(spec.refine);
     }
     Ok((hierarchy, warnings))

@@ -391,7 +391,7 @@ impl DofMap {
             .map(|c| c.iter().filter(|&&f| !f).count())
             .collect();
         let mut vertex = crate::sparse::filled(counts.iter().sum(), 0u32);
-        let mut dof = crate::sparse::filled(fixed.len(), None);
+        let mut dof = crate::sparse::filled(fixed.len(), DofMap::NONE);
         // Each block's unknowns: the next `count` entries of `vertex`, numbered from there.
         let mut parts = Vec::with_capacity(counts.len());
         let (mut rest, mut first) = (vertex.as_mut_slice(), 0u32);
@@ -408,13 +408,13 @@ impl DofMap {
                 let mut next = 0;
                 for (k, (d, &f)) in dof.iter_mut().zip(fixed).enumerate() {
                     if !f {
-                        *d = Some(first + next as u32);
+                        *d = first + next as u32;
                         part[next] = (b * BLOCK + k) as u32;
                         next += 1;
                     }
                 }
             });
-        DofMap { vertex, dof }
+        DofMap::from_parts(vertex, dof)
     }
 }
 
@@ -480,16 +480,16 @@ mod tests {
             .map(|v| v % 7 == 3 || v % 11 == 0 || (16_000..33_000).contains(&v))
             .collect();
         let d = DofMap::from_fixed(&fixed);
-        assert_eq!(d.dof.len(), n);
+        assert_eq!(d.n_vertices(), n);
         assert_eq!(d.vertex.len(), fixed.iter().filter(|&&f| !f).count());
         // Unknown i is the i-th free vertex: increasing vertices, each the inverse of dof.
         assert!(d.vertex.windows(2).all(|w| w[0] < w[1]));
         for (i, &v) in d.vertex.iter().enumerate() {
             assert!(!fixed[v as usize]);
-            assert_eq!(d.dof[v as usize], Some(i as u32));
+            assert_eq!(d.of(v as usize), Some(i as u32));
         }
         for (v, &f) in fixed.iter().enumerate() {
-            assert_eq!(d.dof[v].is_none(), f, "vertex {v}");
+            assert_eq!(d.is_fixed(v), f, "vertex {v}");
         }
     }
 

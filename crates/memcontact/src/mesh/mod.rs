@@ -543,7 +543,9 @@ const SMALL_FAN: usize = 16;
 /// The triangles around every vertex (the patch `Q_i` of the paper).
 #[derive(Debug, Clone)]
 pub struct VertexTriangles {
-    ptr: Vec<usize>,
+    /// The triangles of vertex `v` are `tri[ptr[v]..ptr[v + 1]]` (fewer than 2³² entries:
+    /// three per triangle, and triangles are numbered by `u32`).
+    ptr: Vec<u32>,
     tri: Vec<u32>,
 }
 
@@ -554,13 +556,19 @@ impl VertexTriangles {
         let (ptr, tri) = crate::sparse::group_by_key(mesh.n_vertices(), mesh.n_triangles(), |k| {
             mesh.triangles[k].map(|v| Some((v, k as u32)))
         });
+        use rayon::prelude::*;
+        let ptr = ptr
+            .par_iter()
+            .with_min_len(8192)
+            .map(|&p| p as u32)
+            .collect();
         VertexTriangles { ptr, tri }
     }
 
     /// The triangles having vertex `v`.
     #[inline]
     pub fn of(&self, v: usize) -> &[u32] {
-        &self.tri[self.ptr[v]..self.ptr[v + 1]]
+        &self.tri[self.ptr[v] as usize..self.ptr[v + 1] as usize]
     }
 }
 
@@ -571,8 +579,9 @@ impl VertexTriangles {
 pub struct DofMap {
     /// `vertex[i]`: the mesh vertex of unknown `i`.
     pub vertex: Vec<u32>,
-    /// `dof[v]`: the unknown of vertex `v`, or `None` on the boundary.
-    pub dof: Vec<Option<u32>>,
+    /// `dof[v]`: the unknown of vertex `v`, or [`DofMap::NONE`] on the boundary (four
+    /// bytes per vertex; read through [`DofMap::of`]).
+    dof: Vec<u32>,
 }
 
 impl DofMap {
@@ -586,7 +595,61 @@ impl DofMap {
     pub fn all(n: usize) -> DofMap {
         DofMap {
             vertex: (0..n as u32).collect(),
-            dof: (0..n as u32).map(Some).collect(),
+            dof: (0..n as u32).collect(),
+        }
+    }
+
+    /// The mark of a vertex without an unknown in `dof` (no mesh has 2³² − 1 vertices:
+    /// they are numbered by `u32`).
+    pub const NONE: u32 = u32::MAX;
+
+    /// The unknowns `vertex` and, per vertex, its unknown or [`DofMap::NONE`].
+    pub(crate) fn from_parts(vertex: Vec<u32>, dof: Vec<u32>) -> DofMap {
+        DofMap { vertex, dof }
+    }
+
+    /// The unknown of vertex `v`, or `None` on the boundary.
+    #[inline(always)]
+    pub fn of(&self, v: usize) -> Option<u32> {
+        let d = self.dof[v];
+        (d != Self::NONE).then_some(d)
+    }
+
+    /// `true` when vertex `v` carries no unknown.
+    #[inline(always)]
+    pub fn is_fixed(&self, v: usize) -> bool {
+        self.dof[v] == Self::NONE
+    }
+
+    /// Number of mesh vertices.
+    pub fn n_vertices(&self) -> usize {
+        self.dof.len()
+    }
+
+    /// Every vertex's unknown, or `None`, in vertex order.
+    pub fn per_vertex(&self) -> impl ExactSizeIterator<Item = Option<u32>> + '_ {
+        self.dof.iter().map(|&d| (d != Self::NONE).then_some(d))
+    }
+
+    /// `value(i)` at the vertex of every unknown i, `boundary` elsewhere (in parallel for
+    /// large meshes).
+    pub fn gather<T: Copy + Send + Sync>(
+        &self,
+        value: impl Fn(usize) -> T + Sync,
+        boundary: T,
+    ) -> Vec<T> {
+        use rayon::prelude::*;
+        let at = |&d: &u32| {
+            if d == Self::NONE {
+                boundary
+            } else {
+                value(d as usize)
+            }
+        };
+        if self.dof.len() >= 1 << 16 {
+            self.dof.par_iter().with_min_len(4096).map(at).collect()
+        } else {
+            self.dof.iter().map(at).collect()
         }
     }
 
@@ -594,10 +657,10 @@ impl DofMap {
     pub fn with_adjacency(mesh: &Mesh, adj: &VertexTriangles) -> DofMap {
         let boundary = mesh.boundary_vertices_with(adj);
         let mut vertex = Vec::with_capacity(boundary.len());
-        let mut dof = vec![None; boundary.len()];
+        let mut dof = vec![Self::NONE; boundary.len()];
         for (v, &b) in boundary.iter().enumerate() {
             if !b {
-                dof[v] = Some(vertex.len() as u32);
+                dof[v] = vertex.len() as u32;
                 vertex.push(v as u32);
             }
         }
@@ -616,13 +679,7 @@ impl DofMap {
 
     /// A vector over unknowns extended to all vertices, with `boundary` on ∂Ω_n.
     pub fn to_vertices(&self, x: &[f64], boundary: f64) -> Vec<f64> {
-        use rayon::prelude::*;
-        let at = |d: &Option<u32>| d.map_or(boundary, |i| x[i as usize]);
-        if self.dof.len() >= 1 << 16 {
-            self.dof.par_iter().with_min_len(4096).map(at).collect()
-        } else {
-            self.dof.iter().map(at).collect()
-        }
+        self.gather(|i| x[i], boundary)
     }
 
     /// A vector over all vertices restricted to the unknowns.

@@ -1,7 +1,7 @@
 //! Assembly of the model (SPEC §2; §5 for boundary heights, free edges, mixed and second
 //! bodies) with the data checks that only assembly can make.
 
-use super::body::{Body, FoundationMatrix};
+use super::body::{Body, FoundationMatrix, VertexValues};
 use super::boundary::boundary_heights;
 use super::checks::{check_centroids, check_vertices};
 use super::data::{BodyData, BodyStiffness, Extensions, Foundation, ProblemData, Sampling};
@@ -76,7 +76,7 @@ impl Model {
             foundation: data.foundation,
             sampling: data.sampling,
         };
-        let pattern = Arc::new(unknowns_pattern(mesh, &dofs, adj, boundary));
+        let pattern = Arc::new(unknowns_pattern(mesh, &dofs, adj, boundary)?);
         // S and the upper body's consistent L share one pass over the rows.
         let masked = Masked::new(upper);
         let consistent_h = match (masked.elastic(), data.foundation) {
@@ -138,7 +138,7 @@ impl Model {
             can_touch,
             rigid,
             foundation,
-            phi_vertices,
+            phi_fixed,
             h_vertices,
             epsilon,
         } = body;
@@ -151,7 +151,7 @@ impl Model {
             phi,
             can_touch,
             foundation,
-            phi_vertices,
+            phi_fixed,
             h_vertices,
             total_load,
             epsilon,
@@ -270,24 +270,36 @@ pub(super) fn assemble_body(
         Some(h) if !wholly_rigid => {
             check_centroids(mesh, loads, names.stiffness, h, true)?;
             // One value everywhere: it was checked, and it is every vertex's average.
-            let mut hv = match loads.uniform(h) {
-                Some(v) => vec_of(mesh.n_vertices(), v),
-                None => {
-                    let hv = vertex_average(mesh, adj, h);
-                    check_vertices(mesh, names.stiffness, &hv, true)?;
-                    hv
-                }
-            };
-            if let Some(r) = &rigid_vertex {
-                for (h, &rv) in hv.iter_mut().zip(r) {
-                    if rv {
-                        *h = f64::INFINITY;
+            let uniform = loads.uniform(h);
+            match (uniform, &rigid_vertex) {
+                (Some(value), None) => VertexValues::Uniform {
+                    value,
+                    n: mesh.n_vertices(),
+                },
+                _ => {
+                    let mut hv = match uniform {
+                        Some(v) => vec_of(mesh.n_vertices(), v),
+                        None => {
+                            let hv = vertex_average(mesh, adj, h);
+                            check_vertices(mesh, names.stiffness, &hv, true)?;
+                            hv
+                        }
+                    };
+                    if let Some(r) = &rigid_vertex {
+                        for (h, &rv) in hv.iter_mut().zip(r) {
+                            if rv {
+                                *h = f64::INFINITY;
+                            }
+                        }
                     }
+                    VertexValues::from_values(hv)
                 }
             }
-            hv
         }
-        _ => vec_of(mesh.n_vertices(), f64::INFINITY),
+        _ => VertexValues::Uniform {
+            value: f64::INFINITY,
+            n: mesh.n_vertices(),
+        },
     };
     let l = match (masked.elastic(), l_consistent) {
         _ if wholly_rigid => FoundationMatrix::Rigid,
@@ -325,13 +337,15 @@ pub(super) fn assemble_body(
     };
     check_vertices(mesh, names.shape, &phi_vertices, false)?;
     let phi = dofs.to_unknowns(&phi_vertices);
+    let phi_fixed = super::body::fixed_values(dofs, &phi_vertices);
+    drop(phi_vertices);
     Ok(Body {
         l,
         phi,
         can_touch,
         rigid,
         foundation: data.foundation,
-        phi_vertices,
+        phi_fixed,
         h_vertices,
         epsilon,
     })

@@ -2,6 +2,7 @@
 //! lumped diagonal, or rigid), sampled surface and the unknowns it can touch.
 
 use super::data::Foundation;
+use crate::mesh::DofMap;
 use crate::sparse::Csr;
 use rayon::prelude::*;
 
@@ -19,10 +20,11 @@ pub struct Body {
     pub rigid: Option<Vec<bool>>,
     /// Which foundation was asked for.
     pub foundation: Foundation,
-    /// φ_low at every vertex.
-    pub phi_vertices: Vec<f64>,
+    /// φ_low at the vertices that carry no unknown, `(vertex, value)` (at the unknowns it
+    /// is `phi`): with `phi`, φ_low at every vertex ([`Body::phi_vertices`]).
+    pub phi_fixed: Vec<(u32, f64)>,
     /// h_low at every vertex (∞ where rigid).
-    pub h_vertices: Vec<f64>,
+    pub h_vertices: VertexValues,
     /// The mollifier radius used, when φ_low was mollified.
     pub epsilon: Option<f64>,
 }
@@ -34,6 +36,11 @@ impl Body {
         self.l.is_rigid() || self.rigid.as_ref().is_some_and(|r| r[i])
     }
 
+    /// φ_low at every vertex of the mesh of `dofs` (the body's own model's unknowns).
+    pub fn phi_vertices(&self, dofs: &DofMap) -> Vec<f64> {
+        with_fixed(dofs.to_vertices(&self.phi, 0.0), &self.phi_fixed)
+    }
+
     /// `q = (φ_low − V)⁺` on the unknowns the body can touch (zero elsewhere).
     pub fn penetration(&self, v: &[f64]) -> Vec<f64> {
         v.par_iter()
@@ -42,6 +49,93 @@ impl Body {
             .zip(&self.can_touch)
             .map(|((vi, fi), &c)| if c { (fi - vi).max(0.0) } else { 0.0 })
             .collect()
+    }
+}
+
+/// `at_vertices` with the values `fixed` put in at their vertices.
+pub(crate) fn with_fixed(mut at_vertices: Vec<f64>, fixed: &[(u32, f64)]) -> Vec<f64> {
+    for &(v, x) in fixed {
+        at_vertices[v as usize] = x;
+    }
+    at_vertices
+}
+
+/// The values of the vertices that carry no unknown (`dof[v]` is `None`), in vertex order.
+pub(crate) fn fixed_values(dofs: &DofMap, at_vertices: &[f64]) -> Vec<(u32, f64)> {
+    dofs.per_vertex()
+        .zip(at_vertices)
+        .enumerate()
+        .filter(|(_, (d, _))| d.is_none())
+        .map(|(v, (_, &x))| (v as u32, x))
+        .collect()
+}
+
+/// Values at the mesh vertices that a model keeps for its outputs only (h at the
+/// vertices): one number when they are all the same (a uniform stiffness), one per vertex
+/// otherwise.
+#[derive(Debug, Clone, PartialEq)]
+pub enum VertexValues {
+    /// `value` at every one of `n` vertices.
+    Uniform {
+        /// The value.
+        value: f64,
+        /// The number of vertices.
+        n: usize,
+    },
+    /// One value per vertex.
+    Each(Vec<f64>),
+}
+
+impl VertexValues {
+    /// `values`, as one number when they are all the same.
+    pub fn from_values(values: Vec<f64>) -> VertexValues {
+        match values.first() {
+            Some(&x) if values.par_iter().all(|&y| y.to_bits() == x.to_bits()) => {
+                VertexValues::Uniform {
+                    value: x,
+                    n: values.len(),
+                }
+            }
+            _ => VertexValues::Each(values),
+        }
+    }
+
+    /// The number of vertices.
+    pub fn len(&self) -> usize {
+        match self {
+            VertexValues::Uniform { n, .. } => *n,
+            VertexValues::Each(v) => v.len(),
+        }
+    }
+
+    /// `true` for no vertex.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// The value at vertex `v`.
+    #[inline]
+    pub fn get(&self, v: usize) -> f64 {
+        match self {
+            VertexValues::Uniform { value, .. } => *value,
+            VertexValues::Each(x) => x[v],
+        }
+    }
+
+    /// The values, one per vertex.
+    pub fn to_vec(&self) -> Vec<f64> {
+        match self {
+            VertexValues::Uniform { value, n } => vec![*value; *n],
+            VertexValues::Each(x) => x.clone(),
+        }
+    }
+
+    /// Every value replaced by `f` of it.
+    pub fn map(&mut self, f: impl Fn(f64) -> f64 + Sync) {
+        match self {
+            VertexValues::Uniform { value, .. } => *value = f(*value),
+            VertexValues::Each(x) => x.par_iter_mut().for_each(|v| *v = f(*v)),
+        }
     }
 }
 

@@ -227,7 +227,7 @@ impl Model {
         }
         let pat = &self.s.pattern;
         for i in 0..n {
-            for &j in &pat.col[pat.row_ptr[i]..pat.row_ptr[i + 1]] {
+            for &j in &pat.col[pat.ptr(i)..pat.ptr(i + 1)] {
                 let (a, b) = (find(&mut parent, i as u32), find(&mut parent, j));
                 if a != b {
                     parent[a.max(b) as usize] = a.min(b);
@@ -250,7 +250,7 @@ impl Model {
             let anchored = adj.of(v as usize).iter().any(|&k| {
                 mesh.triangles[k as usize]
                     .iter()
-                    .any(|&w| self.dofs.dof[w as usize].is_none())
+                    .any(|&w| self.dofs.is_fixed(w as usize))
             });
             let r = find(&mut parent, i as u32) as usize;
             let g = &mut groups[r];

@@ -15,7 +15,7 @@ pub(crate) mod testing;
 #[cfg(test)]
 mod tests;
 
-pub use body::{Body, FoundationMatrix};
+pub use body::{Body, FoundationMatrix, VertexValues};
 pub use boundary::{fixed_heights, fixed_heights_on};
 pub use checks::{
     assemble_checked, assemble_checked_on, check_boundary_data, check_model, OVERFLOW_HINT,

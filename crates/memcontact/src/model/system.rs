@@ -1,6 +1,6 @@
 //! The discrete model of the paper's §2: S, L, D, φₙ, M and the energy J of Problem 2b.
 
-use super::body::{foundation_energy, Body, FoundationMatrix};
+use super::body::{foundation_energy, Body, FoundationMatrix, VertexValues};
 use super::data::Foundation;
 use crate::mesh::DofMap;
 use crate::sparse::{norm_inf, Csr};
@@ -25,10 +25,12 @@ pub struct Model {
     pub can_touch: Vec<bool>,
     /// Which foundation was asked for (for reports).
     pub foundation: Foundation,
-    /// φ sampled at every vertex (boundary included; for outputs).
-    pub phi_vertices: Vec<f64>,
+    /// φ sampled at the vertices that carry no unknown, `(vertex, value)` (at the unknowns
+    /// it is `phi`): with `phi`, φ at every vertex for the outputs
+    /// ([`Model::phi_vertices`]).
+    pub phi_fixed: Vec<(u32, f64)>,
     /// h at every vertex (average over the triangles around it; ∞ when rigid).
-    pub h_vertices: Vec<f64>,
+    pub h_vertices: VertexValues,
     /// `∫_{Ω_n} f`.
     pub total_load: f64,
     /// The mollifier radius used, when φ was mollified.
@@ -83,10 +85,15 @@ impl Model {
                 .is_none_or(|b| !b.l.is_rigid() && !b.can_touch.iter().any(|&c| c))
     }
 
+    /// φ sampled at every vertex (boundary included).
+    pub fn phi_vertices(&self) -> Vec<f64> {
+        super::body::with_fixed(self.dofs.to_vertices(&self.phi, 0.0), &self.phi_fixed)
+    }
+
     /// U over all vertices: the unknowns' values, and the heights g (0 by default) on the
     /// fixed boundary.
     pub fn to_vertices(&self, u: &[f64]) -> Vec<f64> {
-        if self.boundary_values.len() != self.dofs.dof.len() {
+        if self.boundary_values.len() != self.dofs.n_vertices() {
             return self.dofs.to_vertices(u, 0.0);
         }
         let mut out = self.boundary_values.clone();

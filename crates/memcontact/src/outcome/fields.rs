@@ -124,19 +124,25 @@ fn nodal_areas(mesh: &Mesh) -> Vec<f64> {
 
 /// A body's pressure at every vertex: `h × penetration`, or where it is rigid (h = ∞),
 /// its nodal force per nodal area.
-fn pressure(h: &[f64], penetration: &[f64], force: &[f64], nodal_area: &[f64]) -> Vec<f64> {
+fn pressure(
+    h: &crate::model::VertexValues,
+    penetration: &[f64],
+    force: &[f64],
+    nodal_area: &[f64],
+) -> Vec<f64> {
     (0..h.len())
         .into_par_iter()
         .with_min_len(4096)
         .map(|v| {
-            if h[v].is_infinite() {
+            let hv = h.get(v);
+            if hv.is_infinite() {
                 if nodal_area[v] > 0.0 {
                     force[v] / nodal_area[v]
                 } else {
                     0.0
                 }
             } else {
-                h[v] * penetration[v]
+                hv * penetration[v]
             }
         })
         .collect()
@@ -148,16 +154,16 @@ fn gather<T: Copy + Send + Sync>(
     value: impl Fn(usize) -> T + Sync,
     boundary: T,
 ) -> Vec<T> {
-    dofs.dof
-        .par_iter()
-        .with_min_len(4096)
-        .map(|d| d.map_or(boundary, |i| value(i as usize)))
-        .collect()
+    dofs.gather(value, boundary)
 }
 
-/// A copy of `x`, made on all threads.
-fn par_copy(x: &[f64]) -> Vec<f64> {
-    x.par_iter().with_min_len(4096).copied().collect()
+/// The vertices where the stiffness `h` is positive (a body lies there).
+fn covered_by(h: &crate::model::VertexValues) -> Vec<bool> {
+    (0..h.len())
+        .into_par_iter()
+        .with_min_len(4096)
+        .map(|v| h.get(v) > 0.0)
+        .collect()
 }
 
 /// Computes the vertex fields and totals of the iterate `u` (over the unknowns).
@@ -195,7 +201,7 @@ pub fn derive_from(mesh: &Mesh, model: &Model, u_dofs: &[f64]) -> (NodalFields, 
     };
     let sum = |x: &[f64]| sum_blocks(x.len(), |r| x[r].iter().sum());
     let contact_area = area_where(&|v| state[v] >= 0);
-    let covered: Vec<bool> = model.h_vertices.par_iter().map(|&h| h > 0.0).collect();
+    let covered: Vec<bool> = covered_by(&model.h_vertices);
     let liftoff_area = area_where(&|v| covered[v] && state[v] < 0 && !mesh_boundary(dofs, v));
     let max_pressure = fold(&pressure_up, 0.0, f64::max);
     let max_u = fold(&u, f64::NEG_INFINITY, f64::max);
@@ -217,7 +223,7 @@ pub fn derive_from(mesh: &Mesh, model: &Model, u_dofs: &[f64]) -> (NodalFields, 
             );
             let force_low = dofs.to_vertices(&forces.low, 0.0);
             let pressure_low = pressure(&low.h_vertices, &penetration_low, &force_low, &nodal_area);
-            let covered_low: Vec<bool> = low.h_vertices.par_iter().map(|&h| h > 0.0).collect();
+            let covered_low: Vec<bool> = covered_by(&low.h_vertices);
             let count_low = |s: i8| states_low.iter().filter(|&&x| x == s).count();
             let totals = LowerTotals {
                 can_touch_low_vertices: low.can_touch.iter().filter(|&&c| c).count(),
@@ -237,7 +243,7 @@ pub fn derive_from(mesh: &Mesh, model: &Model, u_dofs: &[f64]) -> (NodalFields, 
                 }),
             };
             let fields = LowerFields {
-                phi: par_copy(&low.phi_vertices),
+                phi: low.phi_vertices(dofs),
                 penetration: penetration_low,
                 pressure: pressure_low,
                 contact_force: force_low,
@@ -266,7 +272,7 @@ pub fn derive_from(mesh: &Mesh, model: &Model, u_dofs: &[f64]) -> (NodalFields, 
     (
         NodalFields {
             u,
-            phi: par_copy(&model.phi_vertices),
+            phi: model.phi_vertices(),
             penetration,
             pressure: pressure_up,
             contact_force,
@@ -280,5 +286,5 @@ pub fn derive_from(mesh: &Mesh, model: &Model, u_dofs: &[f64]) -> (NodalFields, 
 
 /// `true` for a vertex that carries no unknown (on the fixed boundary).
 fn mesh_boundary(dofs: &crate::mesh::DofMap, v: usize) -> bool {
-    dofs.dof[v].is_none()
+    dofs.is_fixed(v)
 }

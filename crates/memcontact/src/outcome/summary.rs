@@ -328,7 +328,7 @@ impl Summary {
         let free = m.n().saturating_sub(quality.unknowns);
         let heights = m.boundary_values.iter().any(|&g| g != 0.0);
         if free > 0 || heights {
-            self.fixed_vertices = Some(m.dofs.dof.iter().filter(|d| d.is_none()).count());
+            self.fixed_vertices = Some(m.dofs.per_vertex().filter(|d| d.is_none()).count());
             self.free_boundary_vertices = Some(free);
         }
         self

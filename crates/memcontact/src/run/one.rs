@@ -54,10 +54,74 @@ impl Discretization {
         start: Option<&[f64]>,
         observer: &mut dyn Observer,
     ) -> Result<Report> {
+        let t0 = self.begin_solve(settings, observer)?;
+        let a = self.attempt(settings, start, observer)?;
+        self.finish_solve(a, settings, t0, 0.0, observer)
+    }
+
+    /// [`Discretization::solve`] for a discretisation made by
+    /// [`Discretization::for_one_solve`] whose finest mesh may be released
+    /// ([`Discretization::release_mesh`]): the mesh is built again after the solver is done
+    /// and before the fields are derived on it (its seconds count in the `mesh` phase, not
+    /// in `solve`).
+    pub fn solve_once(
+        &mut self,
+        settings: &Settings,
+        observer: &mut dyn Observer,
+    ) -> Result<Report> {
+        let t0 = self.begin_solve(settings, observer)?;
+        let a = self.attempt(settings, None, observer)?;
+        // Only the solver reads the multigrid levels: they go before the mesh comes back.
+        self.release_levels();
+        let t_mesh = Instant::now();
+        self.restore_mesh(&mut crate::solve::Silent)?;
+        let rebuilt = t_mesh.elapsed().as_secs_f64();
+        self.finish_solve(a, settings, t0, rebuilt, observer)
+    }
+
+    /// The checks before a solve (not released, fits in memory); starts its phase.
+    fn begin_solve(&self, settings: &Settings, observer: &mut dyn Observer) -> Result<Instant> {
+        if self.is_released() {
+            return Err(Error::Solver {
+                solver: self.method_for(settings).name().into(),
+                message: "this discretisation was solved once and its matrices released: \
+                          build it again to solve it again"
+                    .into(),
+            });
+        }
         self.check_memory(settings)?;
         observer.phase_started("solve");
-        let t0 = Instant::now();
-        let a = solve::attempt_from(&self.model, self.levels(), settings, start, observer)?;
+        Ok(Instant::now())
+    }
+
+    /// The solver's attempt on the model (with the levels built beforehand, if any).
+    fn attempt(
+        &self,
+        settings: &Settings,
+        start: Option<&[f64]>,
+        observer: &mut dyn Observer,
+    ) -> Result<solve::Attempt> {
+        solve::attempt_with_levels(
+            &self.model,
+            self.levels(),
+            self.built_levels(),
+            settings,
+            start,
+            observer,
+        )
+    }
+
+    /// The report of an attempt: its answer checked, its fields and totals derived on the
+    /// mesh and checked, the phase ended after `t0` (less `excluded` seconds spent on
+    /// something else).
+    fn finish_solve(
+        &self,
+        a: solve::Attempt,
+        settings: &Settings,
+        t0: Instant,
+        excluded: f64,
+        observer: &mut dyn Observer,
+    ) -> Result<Report> {
         crate::outcome::checks::check_solution(
             a.solution.energy,
             a.solution.certificate.kkt(),
@@ -68,7 +132,7 @@ impl Discretization {
         let (fields, totals) = derive_from(self.mesh(), &self.model, &a.solution.u);
         crate::outcome::checks::check_results(self.mesh(), &fields, &totals)?;
         let derived = Some(std::sync::Arc::new((fields, totals)));
-        let seconds = t0.elapsed().as_secs_f64();
+        let seconds = (t0.elapsed().as_secs_f64() - excluded).max(0.0);
         observer.phase_finished("solve", seconds);
         let mut phases = self.phases.clone();
         phases.push(Phase {
@@ -110,27 +174,9 @@ impl Discretization {
 /// A case with steps (`[sweep]`, `[[load_case]]`) is refused: [`super::run_sweep`] runs
 /// those.
 pub fn run(case: &Case, observer: &mut dyn Observer) -> Result<Outcome> {
-    if case.is_sweep() {
-        return Err(Error::Case {
-            file: None,
-            line: None,
-            key: if case.sweep.is_some() {
-                "sweep".into()
-            } else {
-                "load_case".into()
-            },
-            message: "the case has steps to solve in turn: run them as a sweep".into(),
-        });
-    }
+    refuse_steps(case)?;
     case.validate().map_err(Invalid::into_error)?;
-    if case.adapt.is_some() {
-        return Err(Error::Case {
-            file: None,
-            line: None,
-            key: "adapt".into(),
-            message: "the case refines its mesh adaptively: run its adaptive loop".into(),
-        });
-    }
+    refuse_adapt(case)?;
     let observer = &mut solve::Cancellable {
         inner: observer,
         cancel: &case.settings.cancel,
@@ -139,6 +185,32 @@ pub fn run(case: &Case, observer: &mut dyn Observer) -> Result<Outcome> {
     case.settings.cancel.check()?;
     check_case_on_mesh(case, discretization.mesh(), false)?;
     let report = discretization.solve(&case.settings, observer)?;
+    Ok(Outcome {
+        discretization,
+        report,
+    })
+}
+
+/// [`run`] for a run whose outcome is only written afterwards (`memcontact solve`): the
+/// discretisation keeps only what the solve and then the writers read
+/// ([`Discretization::for_one_solve`], [`Discretization::release_solver_data`]), so that
+/// the peak memory of a large run is lower. The outcome's discretisation cannot be solved
+/// again.
+pub fn run_for_writing(case: &Case, observer: &mut dyn Observer) -> Result<Outcome> {
+    refuse_steps(case)?;
+    case.validate().map_err(Invalid::into_error)?;
+    refuse_adapt(case)?;
+    let observer = &mut solve::Cancellable {
+        inner: observer,
+        cancel: &case.settings.cancel,
+    };
+    let mut discretization =
+        Discretization::for_one_solve(&case.problem, &case.settings, observer)?;
+    case.settings.cancel.check()?;
+    check_case_on_mesh(case, discretization.mesh(), false)?;
+    discretization.release_mesh(&case.problem.mesh);
+    let report = discretization.solve_once(&case.settings, observer)?;
+    discretization.release_solver_data();
     Ok(Outcome {
         discretization,
         report,
@@ -164,4 +236,34 @@ pub fn run_problem(
         discretization,
         report,
     })
+}
+
+/// A case with steps is refused by the one-step runs.
+fn refuse_steps(case: &Case) -> Result<()> {
+    if case.is_sweep() {
+        return Err(Error::Case {
+            file: None,
+            line: None,
+            key: if case.sweep.is_some() {
+                "sweep".into()
+            } else {
+                "load_case".into()
+            },
+            message: "the case has steps to solve in turn: run them as a sweep".into(),
+        });
+    }
+    Ok(())
+}
+
+/// A case with `[adapt]` is refused by the one-step runs.
+fn refuse_adapt(case: &Case) -> Result<()> {
+    if case.adapt.is_some() {
+        return Err(Error::Case {
+            file: None,
+            line: None,
+            key: "adapt".into(),
+            message: "the case refines its mesh adaptively: run its adaptive loop".into(),
+        });
+    }
+    Ok(())
 }

@@ -32,7 +32,7 @@ pub fn apply(base: &Model, parameter: SweepParameter, value: f64) -> Model {
                 FoundationMatrix::Rigid => {}
             }
             if !m.is_rigid() {
-                m.h_vertices.iter_mut().for_each(|h| *h *= value);
+                m.h_vertices.map(|h| h * value);
                 // M is where L_ii > 0: a zero factor leaves nothing to touch.
                 for i in 0..m.can_touch.len() {
                     m.can_touch[i] =
@@ -43,7 +43,7 @@ pub fn apply(base: &Model, parameter: SweepParameter, value: f64) -> Model {
         SweepParameter::Tension => m.set_tension(value),
         SweepParameter::ObstacleOffset => {
             m.phi.iter_mut().for_each(|p| *p += value);
-            m.phi_vertices.iter_mut().for_each(|p| *p += value);
+            m.phi_fixed.iter_mut().for_each(|(_, p)| *p += value);
         }
     }
     m

@@ -44,6 +44,33 @@ pub fn line_data(model: &Model, dir: &[f64], r: &[f64]) -> (f64, f64) {
     (g0, s2)
 }
 
+/// [`line_data`] with `r = SV − D` computed on the way from the iterate `v` instead of
+/// read from a vector (the same values as [`crate::solve::newton::newton_system`]'s `r`,
+/// summed in the same order): S's rows are read once for both products.
+pub fn line_data_at(model: &Model, dir: &[f64], v: &[f64]) -> (f64, f64) {
+    let s = &model.s;
+    let pat = &s.pattern;
+    let block = |b: usize| -> [f64; 2] {
+        let (lo, hi) = (b * BLOCK, ((b + 1) * BLOCK).min(dir.len()));
+        let mut acc = [0.0; 2];
+        for i in lo..hi {
+            if dir[i] != 0.0 {
+                let (cols, vals) = (pat.cols(i), &s.val[pat.ptr(i)..pat.ptr(i + 1)]);
+                let (mut sv, mut sd) = (0.0, 0.0);
+                for (&j, &sij) in cols.iter().zip(vals) {
+                    sv += sij * v[j as usize];
+                    sd += sij * dir[j as usize];
+                }
+                acc[0] += dir[i] * (sv - model.d[i]);
+                acc[1] += dir[i] * sd;
+            }
+        }
+        acc
+    };
+    let [g0, s2] = reduce(dir.len(), block, |a, b| [a[0] + b[0], a[1] + b[1]]);
+    (g0, s2)
+}
+
 /// Runs `block` over the fixed blocks of `0..n` (in parallel for large n) and folds the
 /// results in block order.
 fn reduce<T: Send + Copy>(

@@ -461,6 +461,7 @@ fn run_method(
     method: Method,
     model: &Model,
     hierarchy: Option<&Hierarchy>,
+    built: Option<&multigrid::Levels>,
     settings: &Settings,
     start: Option<&[f64]>,
     observer: &mut dyn Observer,
@@ -475,7 +476,10 @@ fn run_method(
                 (HierarchyChoice::Algebraic, _) | (HierarchyChoice::Auto, None) => {
                     multigrid::Coarsening::Algebraic
                 }
-                (_, Some(h)) => multigrid::Coarsening::Geometric(h),
+                (_, Some(h)) => match built {
+                    Some(levels) => multigrid::Coarsening::Built(levels),
+                    None => multigrid::Coarsening::Geometric(h),
+                },
                 (HierarchyChoice::Geometric, None) => {
                     return Err(Error::Solver {
                         solver: "multigrid".into(),
@@ -601,6 +605,21 @@ pub fn attempt_from(
     start: Option<&[f64]>,
     observer: &mut dyn Observer,
 ) -> Result<Attempt> {
+    attempt_with_levels(model, hierarchy, None, settings, start, observer)
+}
+
+/// [`attempt_from`] with the hierarchy's geometric multigrid levels built beforehand
+/// (`built`, for the model's unknowns and pattern): multigrid on the mesh's levels uses
+/// them instead of building its own from `hierarchy`, which then only tells `auto` how
+/// deep the hierarchy is.
+pub fn attempt_with_levels(
+    model: &Model,
+    hierarchy: Option<&Hierarchy>,
+    built: Option<&multigrid::Levels>,
+    settings: &Settings,
+    start: Option<&[f64]>,
+    observer: &mut dyn Observer,
+) -> Result<Attempt> {
     settings.validate().map_err(|e| e.into_error())?;
     if let Some(s) = start {
         if s.len() != model.n() || s.iter().any(|v| !v.is_finite()) {
@@ -616,7 +635,7 @@ pub fn attempt_from(
         m => (m, Choice::Requested),
     };
     let (mut solution, mut status, mut message) =
-        run_method(method, model, hierarchy, settings, start, observer)?;
+        run_method(method, model, hierarchy, built, settings, start, observer)?;
     let mut fallback = None;
     if settings.method == Method::Auto
         && method == Method::Multigrid
@@ -632,6 +651,7 @@ pub fn attempt_from(
             Method::ActiveSet,
             model,
             hierarchy,
+            built,
             settings,
             start,
             observer,

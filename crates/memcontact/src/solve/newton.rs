@@ -117,7 +117,7 @@ pub fn newton_system(
     g: &mut [f64],
     r: &mut [f64],
 ) {
-    newton_system_into(model, v, st, Hessian::Rows(a, rows), g, r)
+    newton_system_into(model, v, st, Hessian::Rows(a, rows), g, Some(r))
 }
 
 /// The truncated Newton matrix as TNNMG keeps it between iterations.
@@ -129,6 +129,11 @@ pub enum NewtonMatrix {
     /// the diagonal and in the truncated rows and columns: the diagonal added to S alone,
     /// read with S as a [`Shifted`](super::multigrid::operator::Shifted) operator (one vector instead of a copy of S's values).
     Diagonal(Vec<f64>),
+    /// The paper's model (no body below, no rigid regions) with a lumped foundation: the
+    /// diagonal added to S is `l_i` on the penetrating unknowns, read from the model and
+    /// the states ([`LumpedShifted`](super::multigrid::operator::LumpedShifted)); nothing
+    /// is stored.
+    Implicit,
 }
 
 impl NewtonMatrix {
@@ -137,6 +142,8 @@ impl NewtonMatrix {
         let consistent = |l: &FoundationMatrix| matches!(l, FoundationMatrix::Consistent(_));
         if consistent(&model.l) || model.lower.as_ref().is_some_and(|b| consistent(&b.l)) {
             NewtonMatrix::Assembled(Csr::zeros(model.s.pattern.clone()))
+        } else if !model.is_extended() && matches!(model.l, FoundationMatrix::Lumped(_)) {
+            NewtonMatrix::Implicit
         } else {
             NewtonMatrix::Diagonal(zeroed(model.n()))
         }
@@ -144,6 +151,9 @@ impl NewtonMatrix {
 
     /// [`newton_system`] into this matrix (a [`NewtonMatrix::Diagonal`] is always refilled
     /// whole: it is one vector).
+    ///
+    /// Without `r`, `SV − D` is not kept: the caller recomputes it where it needs it
+    /// ([`crate::solve::line_search::line_data_at`]), one vector less.
     pub fn fill(
         &mut self,
         model: &Model,
@@ -151,11 +161,12 @@ impl NewtonMatrix {
         st: &NewtonStates,
         rows: Option<&[bool]>,
         g: &mut [f64],
-        r: &mut [f64],
+        r: Option<&mut [f64]>,
     ) {
         let target = match self {
             NewtonMatrix::Assembled(a) => Hessian::Rows(a, rows),
             NewtonMatrix::Diagonal(d) => Hessian::Diagonal(d),
+            NewtonMatrix::Implicit => Hessian::None,
         };
         newton_system_into(model, v, st, target, g, r)
     }
@@ -167,6 +178,8 @@ enum Hessian<'x> {
     Rows(&'x mut Csr, Option<&'x [bool]>),
     /// The diagonal added to S (lumped and rigid foundations only), zero on truncated rows.
     Diagonal(&'x mut [f64]),
+    /// Not stored (the gradient and `r` only).
+    None,
 }
 
 /// [`newton_system`] into either form of the Hessian.
@@ -176,7 +189,7 @@ fn newton_system_into(
     st: &NewtonStates,
     hessian: Hessian,
     g: &mut [f64],
-    r: &mut [f64],
+    r: Option<&mut [f64]>,
 ) {
     if model.is_extended() {
         newton_system_with::<true>(model, v, st, hessian, g, r)
@@ -194,7 +207,7 @@ fn newton_system_with<const EXT: bool>(
     st: &NewtonStates,
     hessian: Hessian,
     g: &mut [f64],
-    r: &mut [f64],
+    r: Option<&mut [f64]>,
 ) {
     let pat = model.s.pattern.clone();
     let sval = &model.s.val;
@@ -207,7 +220,7 @@ fn newton_system_with<const EXT: bool>(
         }
     };
     let gradient = |i: usize, gi: &mut f64, ri: &mut f64| {
-        let (s, e) = (pat.row_ptr[i], pat.row_ptr[i + 1]);
+        let (s, e) = (pat.ptr(i), pat.ptr(i + 1));
         let cols = &pat.col[s..e];
         let mut sv = 0.0;
         for (&j, &sij) in cols.iter().zip(&sval[s..e]) {
@@ -272,7 +285,7 @@ fn newton_system_with<const EXT: bool>(
         d
     };
     let matrix_row = |i: usize, arow: &mut [f64]| {
-        let (s, e) = (pat.row_ptr[i], pat.row_ptr[i + 1]);
+        let (s, e) = (pat.ptr(i), pat.ptr(i + 1));
         let cols = &pat.col[s..e];
         for (k, &j) in cols.iter().enumerate() {
             let j = j as usize;
@@ -298,55 +311,113 @@ fn newton_system_with<const EXT: bool>(
             }
         }
     };
+    // The chunks of `r`, or none of them when it is not kept.
+    let n_chunks = v.len().div_ceil(CHUNK);
+    let r_chunks = |r| chunks_or_none(r, n_chunks);
+    let r_chunks_serial = |r| chunks_or_none_serial(r, n_chunks);
+    // Row i's gradient into gi, and SV − D into the chunk's slot k when kept.
+    let row_gradient = |i: usize, k: usize, gi: &mut f64, rc: &mut Option<&mut [f64]>| {
+        let mut scratch = 0.0;
+        let ri = match rc {
+            Some(rc) => &mut rc[k],
+            None => &mut scratch,
+        };
+        gradient(i, gi, ri);
+    };
+    let parallel = v.len() >= VECTOR_ROWS;
     match hessian {
         Hessian::Rows(a, rows) => {
             let blocks = row_chunks(&pat, &mut a.val, CHUNK);
-            type Block<'a> = ((usize, &'a mut [f64]), (&'a mut [f64], &'a mut [f64]));
-            let work = |((start, vals), (gc, rc)): Block| {
+            type Block<'a> = (
+                (usize, &'a mut [f64]),
+                (&'a mut [f64], Option<&'a mut [f64]>),
+            );
+            let work = |((start, vals), (gc, mut rc)): Block| {
                 let mut off = 0;
-                for (k, (gi, ri)) in gc.iter_mut().zip(rc.iter_mut()).enumerate() {
+                for (k, gi) in gc.iter_mut().enumerate() {
                     let i = start + k;
-                    let len = pat.row_ptr[i + 1] - pat.row_ptr[i];
-                    gradient(i, gi, ri);
+                    let len = pat.ptr(i + 1) - pat.ptr(i);
+                    row_gradient(i, k, gi, &mut rc);
                     if rows.is_none_or(|d| d[i]) {
                         matrix_row(i, &mut vals[off..off + len]);
                     }
                     off += len;
                 }
             };
-            if v.len() >= VECTOR_ROWS {
+            if parallel {
                 blocks
                     .into_par_iter()
-                    .zip(g.par_chunks_mut(CHUNK).zip(r.par_chunks_mut(CHUNK)))
+                    .zip(g.par_chunks_mut(CHUNK).zip(r_chunks(r)))
                     .for_each(work);
             } else {
                 blocks
                     .into_iter()
-                    .zip(g.chunks_mut(CHUNK).zip(r.chunks_mut(CHUNK)))
+                    .zip(g.chunks_mut(CHUNK).zip(r_chunks_serial(r)))
+                    .for_each(work);
+            }
+        }
+        Hessian::None => {
+            type Block<'a> = (&'a mut [f64], Option<&'a mut [f64]>);
+            let work = |(block, (gc, mut rc)): (usize, Block)| {
+                for (k, gi) in gc.iter_mut().enumerate() {
+                    row_gradient(block * CHUNK + k, k, gi, &mut rc);
+                }
+            };
+            if parallel {
+                g.par_chunks_mut(CHUNK)
+                    .zip(r_chunks(r))
+                    .enumerate()
+                    .for_each(work);
+            } else {
+                g.chunks_mut(CHUNK)
+                    .zip(r_chunks_serial(r))
+                    .enumerate()
                     .for_each(work);
             }
         }
         Hessian::Diagonal(d) => {
-            type Block<'a> = (&'a mut [f64], (&'a mut [f64], &'a mut [f64]));
-            let work = |(block, (dc, (gc, rc))): (usize, Block)| {
-                for (k, (di, (gi, ri))) in dc.iter_mut().zip(gc.iter_mut().zip(rc)).enumerate() {
+            type Block<'a> = (&'a mut [f64], (&'a mut [f64], Option<&'a mut [f64]>));
+            let work = |(block, (dc, (gc, mut rc))): (usize, Block)| {
+                for (k, (di, gi)) in dc.iter_mut().zip(gc.iter_mut()).enumerate() {
                     let i = block * CHUNK + k;
-                    gradient(i, gi, ri);
+                    row_gradient(i, k, gi, &mut rc);
                     *di = shift(i);
                 }
             };
-            if v.len() >= VECTOR_ROWS {
+            if parallel {
                 d.par_chunks_mut(CHUNK)
-                    .zip(g.par_chunks_mut(CHUNK).zip(r.par_chunks_mut(CHUNK)))
+                    .zip(g.par_chunks_mut(CHUNK).zip(r_chunks(r)))
                     .enumerate()
                     .for_each(work);
             } else {
                 d.chunks_mut(CHUNK)
-                    .zip(g.chunks_mut(CHUNK).zip(r.chunks_mut(CHUNK)))
+                    .zip(g.chunks_mut(CHUNK).zip(r_chunks_serial(r)))
                     .enumerate()
                     .for_each(work);
             }
         }
+    }
+}
+
+/// The `CHUNK`-row chunks of `r`, or `n_chunks` times `None` without it.
+fn chunks_or_none(
+    r: Option<&mut [f64]>,
+    n_chunks: usize,
+) -> impl IndexedParallelIterator<Item = Option<&mut [f64]>> {
+    match r {
+        Some(r) => rayon::iter::Either::Left(r.par_chunks_mut(CHUNK).map(Some)),
+        None => rayon::iter::Either::Right((0..n_chunks).into_par_iter().map(|_| None)),
+    }
+}
+
+/// [`chunks_or_none`], serially.
+fn chunks_or_none_serial(
+    r: Option<&mut [f64]>,
+    n_chunks: usize,
+) -> impl Iterator<Item = Option<&mut [f64]>> {
+    match r {
+        Some(r) => rayon::iter::Either::Left(r.chunks_mut(CHUNK).map(Some)),
+        None => rayon::iter::Either::Right((0..n_chunks).map(|_| None)),
     }
 }
 
@@ -387,7 +458,7 @@ pub fn mark_dirty(
     });
     let changed: &[bool] = changed;
     par_rows(dirty, |i, d| {
-        *d = pattern.col[pattern.row_ptr[i]..pattern.row_ptr[i + 1]]
+        *d = pattern.col[pattern.ptr(i)..pattern.ptr(i + 1)]
             .iter()
             .any(|&j| changed[j as usize]);
     });
@@ -473,14 +544,34 @@ mod tests {
             // operator, it is the assembled matrix entry by entry, with the same gradient.
             let mut m = NewtonMatrix::for_model(&model);
             let (mut g2, mut r2) = (vec![0.0; n], vec![0.0; n]);
-            m.fill(&model, &v, &st, None, &mut g2, &mut r2);
+            m.fill(&model, &v, &st, None, &mut g2, Some(&mut r2));
             assert_eq!((&g2, &r2), (&g, &r));
+            // Without r: the same gradient.
+            let mut g3 = vec![0.0; n];
+            m.fill(&model, &v, &st, None, &mut g3, None);
+            assert_eq!(g3, g);
             match (&m, f) {
                 (NewtonMatrix::Assembled(b), Foundation::Consistent) => assert_eq!(b.val, a.val),
                 (NewtonMatrix::Diagonal(d), Foundation::Lumped) => {
                     let op = crate::solve::multigrid::operator::Shifted {
                         s: &model.s,
                         shift: d,
+                        held: &st.truncated,
+                    };
+                    let mut vals = vec![0.0; a.val.len()];
+                    crate::solve::multigrid::operator::values_into(&op, &mut vals);
+                    for (p, q) in vals.iter().zip(&a.val) {
+                        assert!((p - q).abs() <= 1e-12 * q.abs(), "{p} against {q}");
+                    }
+                }
+                (NewtonMatrix::Implicit, Foundation::Lumped) => {
+                    let FoundationMatrix::Lumped(l) = &model.l else {
+                        unreachable!()
+                    };
+                    let op = crate::solve::multigrid::operator::LumpedShifted {
+                        s: &model.s,
+                        l,
+                        penetrating: &st.penetrating,
                         held: &st.truncated,
                     };
                     let mut vals = vec![0.0; a.val.len()];
@@ -497,7 +588,7 @@ mod tests {
             let rows: Vec<bool> = (0..n).map(|i| i % 3 == 0).collect();
             newton_system(&model, &v, &st, &mut b, Some(&rows), &mut g, &mut r);
             for i in 0..n {
-                let (s, e) = (b.pattern.row_ptr[i], b.pattern.row_ptr[i + 1]);
+                let (s, e) = (b.pattern.ptr(i), b.pattern.ptr(i + 1));
                 if rows[i] {
                     assert_eq!(&b.val[s..e], &a.val[s..e]);
                 } else {

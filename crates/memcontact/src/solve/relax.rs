@@ -55,7 +55,7 @@ pub fn local_problem(
     match &model.l {
         FoundationMatrix::Consistent(l) => {
             // S and the consistent L share the pattern: one pass over the row.
-            let lvals = &l.val[l.pattern.row_ptr[i]..l.pattern.row_ptr[i + 1]];
+            let lvals = &l.val[l.pattern.ptr(i)..l.pattern.ptr(i + 1)];
             let mut lii = 0.0;
             let mut c = 0.0;
             for ((&j, &s), &lv) in cols.iter().zip(svals).zip(lvals) {
@@ -219,7 +219,7 @@ pub fn local_problem_two(
     i: usize,
 ) -> (f64, f64, Kink, Kink) {
     let (cols, svals) = model.s.row(i);
-    let (start, end) = (model.s.pattern.row_ptr[i], model.s.pattern.row_ptr[i + 1]);
+    let (start, end) = (model.s.pattern.ptr(i), model.s.pattern.ptr(i + 1));
     let mut sii = 0.0;
     let mut sv = 0.0;
     for (&j, &s) in cols.iter().zip(svals) {
@@ -337,7 +337,7 @@ fn sweep(
             let mut seams = Vec::new();
             for i in lo..hi {
                 // Columns are sorted: the row is inside when its first and last are.
-                let (s, e) = (pat.row_ptr[i], pat.row_ptr[i + 1]);
+                let (s, e) = (pat.ptr(i), pat.ptr(i + 1));
                 let inside = e > s && pat.col[s] as usize >= lo && (pat.col[e - 1] as usize) < hi;
                 if inside {
                     changed |= relax(model, xs, lo, i);
@@ -431,7 +431,7 @@ mod tests {
             let inside = |i: usize| {
                 let lo = i / block * block;
                 let hi = (lo + block).min(n);
-                let cols = &pat.col[pat.row_ptr[i]..pat.row_ptr[i + 1]];
+                let cols = &pat.col[pat.ptr(i)..pat.ptr(i + 1)];
                 cols[0] as usize >= lo && (cols[cols.len() - 1] as usize) < hi
             };
             let order: Vec<usize> = (0..n)

@@ -476,14 +476,16 @@ pub fn contact_estimate(mesh: &Mesh, model: &Model, u: &[f64]) -> ContactEstimat
     } else if model.lower.is_some() && !model.can_touch.iter().any(|&c| c) {
         0.0
     } else {
-        penetrated_area(&|v| uv[v] - model.phi_vertices[v])
+        let phi = model.phi_vertices();
+        penetrated_area(&|v| uv[v] - phi[v])
     };
     let lower = match &model.lower {
         Some(low) if low.l.is_rigid() => {
             touching_area(&|i, _| low.can_touch[i] && u[i] == low.phi[i])
         }
         Some(low) if low.can_touch.iter().any(|&c| c) => {
-            penetrated_area(&|v| low.phi_vertices[v] - uv[v])
+            let phi = low.phi_vertices(&model.dofs);
+            penetrated_area(&|v| phi[v] - uv[v])
         }
         _ => 0.0,
     };

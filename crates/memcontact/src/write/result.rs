@@ -139,13 +139,15 @@ pub fn file_record(path: &Path) -> Result<FileRecord> {
     .into())
 }
 
-/// Writes `solution.vtu` (with `run_id` in its field data) and `nodes.csv` of `fields` on
-/// the outcome's mesh into `dir`; returns their names and records, hashed as written.
+/// Writes `solution.vtu` (with `run_id` in its field data) and, when `csv`, `nodes.csv` of
+/// `fields` on the outcome's mesh into `dir`; returns their names and records, hashed as
+/// written.
 pub fn write_fields(
     dir: &Path,
     outcome: &Outcome,
     fields: &NodalFields,
     vtu: VtuFormat,
+    csv: bool,
     run_id: &str,
     cell_data: &[(String, Vec<f64>)],
 ) -> Result<Vec<(String, FileRecord)>> {
@@ -211,12 +213,13 @@ pub fn write_fields(
                 &[("run_id", run_id)],
             )
         },
-        || write_columns_csv(&dir.join("nodes.csv"), &columns),
+        || csv.then(|| write_columns_csv(&dir.join("nodes.csv"), &columns)),
     );
-    Ok(vec![
-        ("solution.vtu".to_string(), vtu_written?.into()),
-        ("nodes.csv".to_string(), csv_written?.into()),
-    ])
+    let mut files = vec![("solution.vtu".to_string(), vtu_written?.into())];
+    if let Some(written) = csv_written {
+        files.push(("nodes.csv".to_string(), written?.into()));
+    }
+    Ok(files)
 }
 
 /// Writes the files of `outcome` into the directory `dir` (which must exist and is not
@@ -247,6 +250,7 @@ pub fn write_files(
                 outcome,
                 &fields,
                 options.vtu,
+                case.output.writes_csv(),
                 &run_id,
                 &options.cell_data,
             )

@@ -33,7 +33,8 @@ pub struct Multigrid<'a> {
     top: usize,
     /// Operators of levels `0..top` (the finest is the caller's).
     coarse: Vec<Csr>,
-    /// `1 / A_ii`, or 0 on zero rows, for levels `0..=top`.
+    /// `1 / A_ii`, or 0 on zero rows, for levels `0..top` (and for level 0 when it is the
+    /// top); the top level's sweeps divide by the diagonal they read ([`InvDiag`]).
     inv_diag: Vec<Vec<f64>>,
     /// Iterate, right-hand side and residual per level `0..top`, and the residual on top.
     /// A level's residual vector is also the block smoother's copy of the iterate
@@ -66,7 +67,7 @@ impl<'a> Multigrid<'a> {
             levels,
             top,
             coarse,
-            inv_diag: (0..=top).map(zeros).collect(),
+            inv_diag: (0..top.max(1)).map(zeros).collect(),
             x: (0..top).map(zeros).collect(),
             b: (0..top).map(zeros).collect(),
             r: (0..=top).map(zeros).collect(),
@@ -240,6 +241,24 @@ impl<'a> Multigrid<'a> {
         Arc::ptr_eq(&fine.matrix().pattern, &self.levels.patterns[self.top])
     }
 
+    /// Where the top level's sweeps find `1 / A_ii`: divided on the way, with the
+    /// diagonal's offsets of the top level's pattern when the operator's pattern is it
+    /// (`fused`); stored only when the top is the coarsest level.
+    fn top_inv<'b>(
+        levels: &'b Levels,
+        inv_diag: &'b [Vec<f64>],
+        top: usize,
+        fused: bool,
+    ) -> InvDiag<'b> {
+        if top == 0 {
+            InvDiag::Stored(&inv_diag[0])
+        } else if fused {
+            InvDiag::Rows(&levels.sweep_rows[top])
+        } else {
+            InvDiag::Search
+        }
+    }
+
     /// Pre-smoothing on the top level and its residual into `r[top]`; from `x = 0` when
     /// `from_zero` (then fused into one pass when A's pattern is the top level's own).
     fn presmooth_top<A: TopOperator>(
@@ -252,7 +271,8 @@ impl<'a> Multigrid<'a> {
         let top = self.top;
         let nu1 = self.smoothing.0;
         if from_zero && nu1 == 1 && self.fused_on_top(fine) {
-            let (inv, rows) = (&self.inv_diag[top], &self.levels.sweep_rows[top]);
+            let inv = Self::top_inv(self.levels, &self.inv_diag, top, self.fused_on_top(fine));
+            let rows = &self.levels.sweep_rows[top];
             gauss_seidel_from_zero(fine, inv, x, b, &mut self.r[top], rows);
             return;
         }
@@ -262,7 +282,8 @@ impl<'a> Multigrid<'a> {
             zero_held(fine, x);
         }
         for _ in 0..nu1 {
-            gauss_seidel(fine, &self.inv_diag[top], x, b, &mut self.r[top], false);
+            let inv = Self::top_inv(self.levels, &self.inv_diag, top, self.fused_on_top(fine));
+            gauss_seidel(fine, inv, x, b, &mut self.r[top], false);
         }
         residual(fine, x, b, &mut self.r[top]);
     }
@@ -299,12 +320,14 @@ impl<'a> Multigrid<'a> {
         zero_held(fine, x);
         let nu2 = self.smoothing.1;
         if let Some(y) = product.filter(|_| nu2 == 1 && self.fused_on_top(fine)) {
-            let (inv, rows) = (&self.inv_diag[top], &self.levels.sweep_rows[top]);
+            let inv = Self::top_inv(self.levels, &self.inv_diag, top, self.fused_on_top(fine));
+            let rows = &self.levels.sweep_rows[top];
             gauss_seidel_back_with_product(fine, inv, x, b, &mut self.r[top], y, rows);
             return true;
         }
         for _ in 0..nu2 {
-            gauss_seidel(fine, &self.inv_diag[top], x, b, &mut self.r[top], true);
+            let inv = Self::top_inv(self.levels, &self.inv_diag, top, self.fused_on_top(fine));
+            gauss_seidel(fine, inv, x, b, &mut self.r[top], true);
         }
         false
     }
@@ -369,7 +392,7 @@ impl<'a> Multigrid<'a> {
     /// On coarse level `k ≥ 1`: `x[k] = 0`, `ν₁` Gauss-Seidel sweeps on `A_k x[k] = b[k]`,
     /// and the residual restricted into `b[k − 1]`.
     fn presmooth_and_restrict(&mut self, k: usize) {
-        let (a, inv) = (&self.coarse[k], &self.inv_diag[k]);
+        let (a, inv) = (&self.coarse[k], InvDiag::Stored(&self.inv_diag[k]));
         let (xk, bk) = (&mut self.x[k], &self.b[k]);
         if self.smoothing.0 == 1 {
             gauss_seidel_from_zero(a, inv, xk, bk, &mut self.r[k], &self.levels.sweep_rows[k]);
@@ -392,7 +415,7 @@ impl<'a> Multigrid<'a> {
         self.levels.transfers[k - 1].prolongate_add(&xl[k - 1], &mut xu[0]);
         let (a, inv, b, r) = (
             &self.coarse[k],
-            &self.inv_diag[k],
+            InvDiag::Stored(&self.inv_diag[k]),
             &self.b[k],
             &mut self.r[k],
         );
@@ -438,7 +461,9 @@ impl<'a> Multigrid<'a> {
                 ),
             });
         }
-        fill_inv_diag(fine, &mut self.inv_diag[top]);
+        if top == 0 {
+            fill_inv_diag(fine, &mut self.inv_diag[0]);
+        }
         let first = self.chol.is_none();
         for k in (0..top).rev() {
             let t = &self.levels.transfers[k];
@@ -478,7 +503,7 @@ impl<'a> Multigrid<'a> {
             let pat = self.coarsest.pattern.clone();
             for i in 0..pat.n() {
                 if self.inv_diag[0][i] == 0.0 {
-                    for k in pat.row_ptr[i]..pat.row_ptr[i + 1] {
+                    for k in pat.ptr(i)..pat.ptr(i + 1) {
                         self.coarsest.val[k] = if pat.col[k] as usize == i { 1.0 } else { 0.0 };
                     }
                 }

@@ -8,7 +8,7 @@ use super::smoother::*;
 use super::tnnmg::{coarse_model, setup_matrix, Coarsening};
 use crate::error::Result;
 use crate::model::Model;
-use crate::solve::line_search::{apply_step, exact_step, line_data};
+use crate::solve::line_search::{apply_step, exact_step, line_data, line_data_at};
 use crate::solve::newton::{mark_dirty, newton_system, NewtonStates};
 use crate::solve::relax::sweep_forward;
 use crate::sparse::Csr;
@@ -40,6 +40,7 @@ pub fn kernel_timings(
     time("levels setup", &mut || {
         levels = match coarsening {
             Coarsening::Geometric(h) => Levels::new(h, &model.dofs, model.s.pattern.clone()).ok(),
+            Coarsening::Built(l) => Some(l.clone()),
             Coarsening::Algebraic => Some(Levels::algebraic(
                 &setup_matrix(model),
                 aggregation::COARSEST,
@@ -93,31 +94,23 @@ pub fn kernel_timings(
         b.copy_from_slice(&rhs);
         mg.fcg(&a, &mut delta, &mut b, 0.0, 3, &st.truncated, &mut work);
     });
-    let inv: Vec<f64> = (0..n)
-        .map(|i| {
-            let d = a.get(i, i);
-            if d > 0.0 {
-                1.0 / d
-            } else {
-                0.0
-            }
-        })
-        .collect();
-    let mut snap = vec![0.0; n];
-    time("gauss-seidel sweep", &mut || {
-        gauss_seidel(&a, &inv, &mut delta, &rhs, &mut snap, false)
-    });
+    // The top level's sweeps divide by the diagonal they read (no stored inverse).
     let rows = SweepRows::of(&a.pattern);
     time("sweep rows (setup)", &mut || {
         std::hint::black_box(SweepRows::of(&a.pattern));
     });
+    let inv = InvDiag::Rows(&rows);
+    let mut snap = vec![0.0; n];
+    time("gauss-seidel sweep", &mut || {
+        gauss_seidel(&a, inv, &mut delta, &rhs, &mut snap, false)
+    });
     let mut res = vec![0.0; n];
     time("sweep from zero + residual", &mut || {
-        gauss_seidel_from_zero(&a, &inv, &mut delta, &rhs, &mut res, &rows)
+        gauss_seidel_from_zero(&a, inv, &mut delta, &rhs, &mut res, &rows)
     });
     let mut prod = vec![0.0; n];
     time("backward sweep + product", &mut || {
-        gauss_seidel_back_with_product(&a, &inv, &mut delta, &rhs, &mut snap, &mut prod, &rows)
+        gauss_seidel_back_with_product(&a, inv, &mut delta, &rhs, &mut snap, &mut prod, &rows)
     });
     time("residual", &mut || residual(&a, &delta, &rhs, &mut res));
     time("matrix-vector product", &mut || {
@@ -130,6 +123,9 @@ pub fn kernel_timings(
     }
     let mut gs = (0.0, 0.0);
     time("line data", &mut || gs = line_data(model, &delta, &r));
+    time("line data, r on the way", &mut || {
+        gs = line_data_at(model, &delta, &v)
+    });
     let mut alpha = None;
     time("exact step", &mut || {
         alpha = exact_step(model, &v, &delta, gs.0, gs.1)

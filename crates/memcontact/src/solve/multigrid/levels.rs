@@ -3,7 +3,7 @@
 //! coarse operators, computed once.
 
 use super::smoother::SweepRows;
-use super::transfer::{galerkin_patterns, Transfer};
+use super::transfer::Transfer;
 use crate::error::{Error, Result};
 use crate::mesh::refine::{Hierarchy, Refinement};
 use crate::mesh::{DofMap, Mesh};
@@ -46,22 +46,44 @@ impl Levels {
     /// pattern is `pattern`) and builds the transfers and Galerkin patterns. A hierarchy
     /// that does not fit is an error.
     pub fn new(hierarchy: &Hierarchy, finest: &DofMap, pattern: Arc<Pattern>) -> Result<Levels> {
-        let nl = hierarchy.levels.len();
-        if nl == 0 || hierarchy.refinements.len() + 1 != nl {
-            return Err(Error::Mesh(format!(
-                "a hierarchy of {nl} levels needs {} refinement relations, it has {}",
-                nl.saturating_sub(1),
-                hierarchy.refinements.len()
-            )));
-        }
-        let last = hierarchy.finest();
-        if last.n_vertices() != finest.dof.len() || pattern.n() != finest.len() {
+        let counts: Vec<usize> = hierarchy.levels.iter().map(Mesh::n_vertices).collect();
+        Levels::from_relations(
+            &hierarchy.refinements,
+            &counts,
+            hierarchy.levels.last(),
+            finest,
+            pattern,
+        )
+    }
+
+    /// [`Levels::new`] from what it reads of a hierarchy: the refinement relations, the
+    /// vertex count of every level (coarsest first) and the finest mesh (`None` for a
+    /// hierarchy without levels, an error). The coarser meshes themselves are not needed.
+    pub fn from_relations(
+        refinements: &[Refinement],
+        vertex_counts: &[usize],
+        last: Option<&Mesh>,
+        finest: &DofMap,
+        pattern: Arc<Pattern>,
+    ) -> Result<Levels> {
+        let nl = vertex_counts.len();
+        let last = match last {
+            Some(m) if nl > 0 && refinements.len() + 1 == nl => m,
+            _ => {
+                return Err(Error::Mesh(format!(
+                    "a hierarchy of {nl} levels needs {} refinement relations, it has {}",
+                    nl.saturating_sub(1),
+                    refinements.len()
+                )))
+            }
+        };
+        if last.n_vertices() != finest.n_vertices() || pattern.n() != finest.len() {
             return Err(Error::Mesh(format!(
                 "the finest level of the hierarchy has {} vertices, but the model was \
                  assembled on a mesh of {} vertices: the hierarchy must end with the model's \
                  mesh",
                 last.n_vertices(),
-                finest.dof.len()
+                finest.n_vertices()
             )));
         }
         check_pattern(last, finest, &pattern)?;
@@ -71,8 +93,8 @@ impl Levels {
         let mut dofs: Vec<DofMap> = Vec::with_capacity(nl - 1);
         for k in (0..nl - 1).rev() {
             let coarse = coarse_dofs(
-                &hierarchy.refinements[k],
-                hierarchy.levels[k].n_vertices(),
+                &refinements[k],
+                vertex_counts[k],
                 dofs.last().unwrap_or(finest),
             )?;
             dofs.push(coarse);
@@ -82,13 +104,21 @@ impl Levels {
         // Levels without unknowns cannot carry a correction: start above them.
         let first = (0..nl).position(|k| !level(k).is_empty()).unwrap_or(nl - 1);
         let mut transfers = Vec::with_capacity(nl - 1 - first);
-        for k in first..nl - 1 {
-            let t = Transfer::new(&hierarchy.refinements[k], level(k), level(k + 1))?;
-            transfers.push(t);
+        for (k, refinement) in refinements.iter().enumerate().skip(first) {
+            transfers.push(Transfer::new(refinement, level(k), level(k + 1))?);
         }
         let sizes = (first..nl).map(|k| level(k).len()).collect();
         let dofs: Vec<DofMap> = dofs.into_iter().skip(first).collect();
-        let patterns = galerkin_patterns(&transfers, pattern);
+        // Coarsest last: each transfer reads its columns from the pattern of its fine
+        // level, known once the finer levels' Galerkin patterns are.
+        let mut patterns = vec![pattern];
+        for t in transfers.iter_mut().rev() {
+            let fine = patterns.last().expect("the finest pattern");
+            *t = std::mem::replace(t, Transfer::aggregation(&[], 0)).with_columns_from(fine);
+            let coarse = t.galerkin_pattern(fine);
+            patterns.push(Arc::new(coarse));
+        }
+        patterns.reverse();
         Ok(Levels {
             kind: Kind::Geometric,
             sizes,
@@ -133,12 +163,12 @@ impl Levels {
 /// refined from it: coarse vertex `c` is interior iff the fine vertex on it (parents
 /// `[c, c]`) is. A coarse vertex without such a fine vertex is an error.
 fn coarse_dofs(refinement: &Refinement, n_vertices: usize, fine: &DofMap) -> Result<DofMap> {
-    if refinement.parents.len() != fine.dof.len() {
+    if refinement.parents.len() != fine.n_vertices() {
         return Err(Error::Mesh(format!(
             "the refinement relation names parents for {} vertices, but the finer level has \
              {} vertices",
             refinement.parents.len(),
-            fine.dof.len()
+            fine.n_vertices()
         )));
     }
     use rayon::prelude::*;
@@ -163,11 +193,7 @@ fn coarse_dofs(refinement: &Refinement, n_vertices: usize, fine: &DofMap) -> Res
                 return Some((v, a, b));
             }
             if a == b {
-                let on = if fine.dof[v].is_some() {
-                    INTERIOR
-                } else {
-                    FIXED
-                };
+                let on = if !fine.is_fixed(v) { INTERIOR } else { FIXED };
                 state[a as usize].fetch_max(on, Relaxed);
             }
             None
@@ -205,7 +231,7 @@ fn check_pattern(mesh: &Mesh, dofs: &DofMap, pattern: &Pattern) -> Result<()> {
         .find_any(|(_, t)| {
             t.iter().any(|&a| {
                 t.iter()
-                    .any(|&b| match (dofs.dof[a as usize], dofs.dof[b as usize]) {
+                    .any(|&b| match (dofs.of(a as usize), dofs.of(b as usize)) {
                         (Some(i), Some(j)) => pattern.find(i as usize, j as usize).is_none(),
                         _ => false,
                     })

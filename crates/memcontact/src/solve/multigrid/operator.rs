@@ -70,6 +70,42 @@ impl TopOperator for Shifted<'_> {
     }
 }
 
+/// [`Shifted`] for the paper's model with a lumped foundation, its shift read from the
+/// model's lumped `l` and the penetrating flags instead of a stored vector:
+/// `shift_i = l_i` on penetrating unknowns, 0 elsewhere (a penetrating unknown is never
+/// held). The same values as the stored shift, without its vector (8 bytes per unknown).
+#[derive(Debug, Clone, Copy)]
+pub struct LumpedShifted<'a> {
+    /// S (the stiffness matrix).
+    pub s: &'a Csr,
+    /// The lumped foundation's diagonal.
+    pub l: &'a [f64],
+    /// The penetrating unknowns (`V_i > φ_i` on M).
+    pub penetrating: &'a [bool],
+    /// The truncated unknowns.
+    pub held: &'a [bool],
+}
+
+impl TopOperator for LumpedShifted<'_> {
+    const PLAIN: bool = false;
+    #[inline(always)]
+    fn matrix(&self) -> &Csr {
+        self.s
+    }
+    #[inline(always)]
+    fn shift(&self, i: usize) -> f64 {
+        if self.penetrating[i] {
+            self.l[i]
+        } else {
+            0.0
+        }
+    }
+    #[inline(always)]
+    fn held(&self, i: usize) -> bool {
+        self.held[i]
+    }
+}
+
 /// The operator's entry `(i, j)` whose stored value is `v`.
 #[inline(always)]
 pub(crate) fn entry<A: TopOperator>(a: &A, i: usize, j: usize, v: f64) -> f64 {
@@ -118,7 +154,7 @@ pub fn values_into<A: TopOperator>(a: &A, out: &mut [f64]) {
     let m = a.matrix();
     let pat = &m.pattern;
     for i in 0..pat.n() {
-        let (s, e) = (pat.row_ptr[i], pat.row_ptr[i + 1]);
+        let (s, e) = (pat.ptr(i), pat.ptr(i + 1));
         for ((o, &j), &v) in out[s..e].iter_mut().zip(&pat.col[s..e]).zip(&m.val[s..e]) {
             *o = entry(a, i, j as usize, v);
         }
@@ -141,7 +177,7 @@ mod tests {
                 col.push(j as u32);
                 val.push(if i == j { 2.0 } else { -1.0 });
             }
-            row_ptr.push(col.len());
+            row_ptr.push(col.len() as u32);
         }
         Csr {
             pattern: Arc::new(Pattern { row_ptr, col }),

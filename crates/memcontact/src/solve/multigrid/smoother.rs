@@ -10,7 +10,7 @@ pub(crate) fn fill_inv_diag<A: TopOperator>(op: &A, inv: &mut [f64]) {
     let a = op.matrix();
     let pat = &a.pattern;
     par_rows(inv, |i, d| {
-        let (s, e) = (pat.row_ptr[i], pat.row_ptr[i + 1]);
+        let (s, e) = (pat.ptr(i), pat.ptr(i + 1));
         let k = pat.col[s..e].partition_point(|&j| (j as usize) < i);
         let aii = if s + k < e && pat.col[s + k] as usize == i {
             super::operator::entry(op, i, i, a.val[s + k])
@@ -19,6 +19,41 @@ pub(crate) fn fill_inv_diag<A: TopOperator>(op: &A, inv: &mut [f64]) {
         };
         *d = if aii > 0.0 { 1.0 / aii } else { 0.0 };
     });
+}
+
+/// Where a sweep finds `1 / A_ii` (0 where `A_ii ≤ 0`, as [`fill_inv_diag`] stores it):
+/// a stored vector, or A's diagonal entry of the row the sweep reads anyway, divided on the
+/// way (the top level, whose vector would be the size of the problem). Both give the same
+/// number, so that a sweep's result does not depend on which.
+#[derive(Clone, Copy)]
+pub(crate) enum InvDiag<'a> {
+    /// The vector filled by [`fill_inv_diag`].
+    Stored(&'a [f64]),
+    /// From the row, the diagonal's offset looked up in the pattern's [`SweepRows`].
+    Rows(&'a SweepRows),
+    /// From the row, the diagonal searched (A's pattern has no [`SweepRows`] at hand).
+    Search,
+}
+
+impl InvDiag<'_> {
+    /// `1 / A_ii` of row `i`, whose sorted columns and stored values are `cols`, `vals`.
+    #[inline(always)]
+    pub(crate) fn at<A: TopOperator>(&self, op: &A, i: usize, cols: &[u32], vals: &[f64]) -> f64 {
+        let k = match self {
+            InvDiag::Stored(inv) => return inv[i],
+            InvDiag::Rows(rows) => rows.diag_of(i, cols),
+            InvDiag::Search => cols.partition_point(|&j| (j as usize) < i),
+        };
+        let aii = match cols.get(k) {
+            Some(&c) if c as usize == i => super::operator::entry(op, i, i, vals[k]),
+            _ => 0.0,
+        };
+        if aii > 0.0 {
+            1.0 / aii
+        } else {
+            0.0
+        }
+    }
 }
 
 /// `r = b − A x` (x zero on held unknowns).
@@ -30,7 +65,7 @@ pub(crate) fn residual<A: TopOperator>(op: &A, x: &[f64], b: &[f64], r: &mut [f6
             *ri = b[i];
             return;
         }
-        let (s, e) = (pat.row_ptr[i], pat.row_ptr[i + 1]);
+        let (s, e) = (pat.ptr(i), pat.ptr(i + 1));
         *ri = b[i] - (row_sum(&pat.col[s..e], &a.val[s..e], |j| x[j]) + shift_term(op, i, x[i]));
     });
 }
@@ -121,7 +156,7 @@ fn block_row_sum(
 /// Gauss-Seidel, kept in `snapshot`). `x` is zero on held unknowns, and stays so.
 pub(crate) fn gauss_seidel<A: TopOperator>(
     op: &A,
-    inv: &[f64],
+    inv: InvDiag,
     x: &mut [f64],
     b: &[f64],
     snapshot: &mut [f64],
@@ -134,12 +169,12 @@ pub(crate) fn gauss_seidel<A: TopOperator>(
     let sweep = |lo: usize, xs: &mut [f64], outside: &[f64]| {
         let hi = lo + xs.len();
         let mut relax = |i: usize| {
-            let d = inv[i];
+            let (s, e) = (pat.ptr(i), pat.ptr(i + 1));
+            let (cols, vals) = (&pat.col[s..e], &a.val[s..e]);
+            let d = inv.at(op, i, cols, vals);
             if d == 0.0 {
                 return;
             }
-            let (s, e) = (pat.row_ptr[i], pat.row_ptr[i + 1]);
-            let (cols, vals) = (&pat.col[s..e], &a.val[s..e]);
             let inside = within(cols, lo, hi);
             let ax =
                 block_row_sum(cols, vals, lo, xs, outside, inside) + shift_term(op, i, xs[i - lo]);
@@ -186,7 +221,7 @@ impl SweepRows {
         use rayon::prelude::*;
         let n = pattern.n();
         let block = gs_block(n);
-        let row = |i: usize| &pattern.col[pattern.row_ptr[i]..pattern.row_ptr[i + 1]];
+        let row = |i: usize| &pattern.col[pattern.ptr(i)..pattern.ptr(i + 1)];
         let seams = if n <= block {
             Vec::new()
         } else {
@@ -236,7 +271,7 @@ impl SweepRows {
 /// keep `x = 0` and `r = b`.
 pub(crate) fn gauss_seidel_from_zero<A: TopOperator>(
     op: &A,
-    inv: &[f64],
+    inv: InvDiag,
     x: &mut [f64],
     b: &[f64],
     r: &mut [f64],
@@ -249,7 +284,7 @@ pub(crate) fn gauss_seidel_from_zero<A: TopOperator>(
     let sweep = |lo: usize, xs: &mut [f64], rs: &mut [f64]| {
         let hi = lo + xs.len();
         for (k, i) in (lo..hi).enumerate() {
-            let (s, e) = (pat.row_ptr[i], pat.row_ptr[i + 1]);
+            let (s, e) = (pat.ptr(i), pat.ptr(i + 1));
             let (cols, vals) = (&pat.col[s..e], &a.val[s..e]);
             // Columns are sorted: those of the block before i are `first..diag` (the ones
             // before the block, and i's later neighbours, are still 0 in this sweep).
@@ -265,7 +300,7 @@ pub(crate) fn gauss_seidel_from_zero<A: TopOperator>(
                 .zip(lv)
                 .map(|(&c, &v)| v * xs[c as usize - lo])
                 .sum();
-            let xi = (b[i] - lower) * inv[i];
+            let xi = (b[i] - lower) * inv.at(op, i, cols, vals);
             xs[k] = xi;
             let aii = match cols.get(diag) {
                 Some(&c) if c as usize == i => vals[diag] + shift_term(op, i, 1.0),
@@ -323,7 +358,7 @@ fn add_outside_blocks(
         let to = seams.partition_point(|&i| (i as usize) < hi);
         for &i in &seams[from..to] {
             let i = i as usize;
-            let (s, e) = (pat.row_ptr[i], pat.row_ptr[i + 1]);
+            let (s, e) = (pat.ptr(i), pat.ptr(i + 1));
             let outside: f64 = pat.col[s..e]
                 .iter()
                 .zip(&a.val[s..e])
@@ -345,7 +380,7 @@ fn add_outside_blocks(
 /// Held rows keep x and get `y = 0`, as [`apply`] gives.
 pub(crate) fn gauss_seidel_back_with_product<A: TopOperator>(
     op: &A,
-    inv: &[f64],
+    inv: InvDiag,
     x: &mut [f64],
     b: &[f64],
     snapshot: &mut [f64],
@@ -360,11 +395,11 @@ pub(crate) fn gauss_seidel_back_with_product<A: TopOperator>(
         let hi = lo + xs.len();
         for k in (0..xs.len()).rev() {
             let i = lo + k;
-            let (s, e) = (pat.row_ptr[i], pat.row_ptr[i + 1]);
+            let (s, e) = (pat.ptr(i), pat.ptr(i + 1));
             let (cols, vals) = (&pat.col[s..e], &a.val[s..e]);
             let inside = within(cols, lo, hi);
             let ax = block_row_sum(cols, vals, lo, xs, outside, inside) + shift_term(op, i, xs[k]);
-            let d = inv[i];
+            let d = inv.at(op, i, cols, vals);
             if d == 0.0 {
                 ys[k] = ax;
                 continue;

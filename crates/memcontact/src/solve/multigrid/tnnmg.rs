@@ -10,11 +10,12 @@ use crate::error::Result;
 use crate::mesh::refine::Hierarchy;
 use crate::model::{FoundationMatrix, Model};
 use crate::solve::active_set::start_from;
-use crate::solve::line_search::{apply_step, exact_step, line_data};
+use crate::solve::line_search::{apply_step, exact_step, line_data_at};
 use crate::solve::newton::{mark_dirty, NewtonMatrix, NewtonStates};
 use crate::solve::relax::sweep_forward;
 use crate::solve::{IterationRecord, Method, Observer, PhaseTimer, Settings, Solution};
 use crate::sparse::{filled, par_rows, zeroed, Csr};
+use std::sync::Arc;
 use std::time::Instant;
 
 pub(crate) const MAX_ITERATIONS: usize = 300;
@@ -110,6 +111,9 @@ pub enum Coarsening<'a> {
     /// Nested meshes of uniform refinement; the last must be the mesh the model was
     /// assembled on (anything else is an error).
     Geometric(&'a Hierarchy),
+    /// Geometric levels built beforehand ([`Levels::new`]) for the model's unknowns and
+    /// matrix pattern.
+    Built(&'a Levels),
     /// An aggregation hierarchy built from the model's matrices ([`aggregation`]).
     Algebraic,
 }
@@ -119,6 +123,7 @@ impl Coarsening<'_> {
     pub fn kind(&self) -> Kind {
         match self {
             Coarsening::Geometric(_) => Kind::Geometric,
+            Coarsening::Built(l) => l.kind,
             Coarsening::Algebraic => Kind::Algebraic,
         }
     }
@@ -159,7 +164,7 @@ pub(super) fn setup_matrix(model: &Model) -> Csr {
     crate::sparse::row_chunks(pat, &mut val, ROWS)
         .into_par_iter()
         .for_each(|(first, block)| {
-            let base = pat.row_ptr[first];
+            let base = pat.ptr(first);
             for i in first..(first + ROWS).min(pat.n()) {
                 let Some(k) = pat.find(i, i) else { continue };
                 let v = &mut block[k - base];
@@ -188,10 +193,29 @@ pub fn solve_with(
     observer: &mut dyn Observer,
 ) -> Result<(Solution, TnnmgReport)> {
     let mut timer = PhaseTimer::default();
-    let levels = timer.time("setup", || match coarsening {
-        Coarsening::Geometric(h) => Levels::new(h, &model.dofs, model.s.pattern.clone()),
-        Coarsening::Algebraic => Ok(Levels::algebraic(&setup_matrix(model), options.coarsest)),
-    })?;
+    let built;
+    let levels: &Levels = match coarsening {
+        Coarsening::Built(l) => {
+            if !Arc::ptr_eq(&l.patterns[l.len() - 1], &model.s.pattern) {
+                return Err(crate::error::Error::Mesh(
+                    "the multigrid levels were built for another matrix than the model's".into(),
+                ));
+            }
+            l
+        }
+        Coarsening::Geometric(h) => {
+            built = timer.time("setup", || {
+                Levels::new(h, &model.dofs, model.s.pattern.clone())
+            })?;
+            &built
+        }
+        Coarsening::Algebraic => {
+            built = timer.time("setup", || {
+                Levels::algebraic(&setup_matrix(model), options.coarsest)
+            });
+            &built
+        }
+    };
     let top = levels.len() - 1;
     let max = settings.max_iterations.unwrap_or(MAX_ITERATIONS);
     let mut report = TnnmgReport::default();
@@ -206,9 +230,9 @@ pub fn solve_with(
     let mut models: Vec<Model> = Vec::new();
     if first < top {
         timer.time("setup", || {
-            let mut m = coarse_model(model, &levels.transfers[top - 1], &levels, top - 1);
+            let mut m = coarse_model(model, &levels.transfers[top - 1], levels, top - 1);
             for k in (first..top - 1).rev() {
-                let next = coarse_model(&m, &levels.transfers[k], &levels, k);
+                let next = coarse_model(&m, &levels.transfers[k], levels, k);
                 models.push(m);
                 m = next;
             }
@@ -254,7 +278,7 @@ pub fn solve_with(
         };
         let out = level_solve(LevelSolve {
             model: m,
-            levels: &levels,
+            levels,
             top: k,
             v: &mut v,
             tolerance: tol,
@@ -346,8 +370,8 @@ pub(super) fn coarse_model(fine: &Model, t: &Transfer, levels: &Levels, k: usize
             can_touch,
             rigid,
             foundation: low.foundation,
-            phi_vertices: Vec::new(),
-            h_vertices: Vec::new(),
+            phi_fixed: Vec::new(),
+            h_vertices: crate::model::VertexValues::Each(Vec::new()),
             epsilon: low.epsilon,
         }
     });
@@ -355,7 +379,6 @@ pub(super) fn coarse_model(fine: &Model, t: &Transfer, levels: &Levels, k: usize
         Kind::Geometric => levels.dofs[k].clone(),
         Kind::Algebraic => crate::mesh::DofMap::all(t.n_coarse),
     };
-    let phi_vertices = dofs.to_vertices(&phi, 0.0);
     Model {
         d: restrict(&fine.d),
         tension: fine.tension,
@@ -365,8 +388,8 @@ pub(super) fn coarse_model(fine: &Model, t: &Transfer, levels: &Levels, k: usize
         can_touch,
         foundation: fine.foundation,
         // Only the solver uses this model: vertex fields are not needed beyond φ.
-        h_vertices: Vec::new(),
-        phi_vertices,
+        h_vertices: crate::model::VertexValues::Each(Vec::new()),
+        phi_fixed: Vec::new(),
         total_load: fine.total_load,
         epsilon: fine.epsilon,
         dofs,
@@ -387,9 +410,15 @@ pub(super) const FINISH_FACTOR: f64 = 1e3;
 /// is within [`FINISH_FACTOR`] of it. On the answer's piece of J the Newton step is then the
 /// answer, and the iteration that would only have finished the linear solve is saved; off
 /// it, the extra accuracy costs a few Krylov steps (at most a factor 4·10³ more reduction).
-pub(super) fn forcing(kkt: f64, tolerance: f64) -> f64 {
+///
+/// The finish is decided against the residual the iteration can reach: the tolerance, or
+/// the rounding floor when that lies above it (`floor`, already times
+/// [`crate::certificate::AT_FLOOR`]). Below the floor the tolerance cannot be met and the
+/// iteration stops at the floor, so a quadratic step taken first would only delay the
+/// finish by one iteration.
+pub(super) fn forcing(kkt: f64, tolerance: f64, floor: f64) -> f64 {
     let quadratic = kkt.min(0.5).powi(2);
-    if quadratic <= FINISH_FACTOR * tolerance {
+    if quadratic <= FINISH_FACTOR * tolerance.max(floor) {
         0.25 * tolerance
     } else {
         quadratic
@@ -410,6 +439,18 @@ macro_rules! with_operator {
                 let $op = &super::operator::Shifted {
                     s: &$model.s,
                     shift: d,
+                    held: &$st.truncated,
+                };
+                $body
+            }
+            NewtonMatrix::Implicit => {
+                let FoundationMatrix::Lumped(l) = &$model.l else {
+                    unreachable!("an implicit Newton matrix has a lumped foundation")
+                };
+                let $op = &super::operator::LumpedShifted {
+                    s: &$model.s,
+                    l,
+                    penetrating: &$st.penetrating,
                     held: &$st.truncated,
                 };
                 $body
@@ -466,7 +507,6 @@ pub(super) fn level_solve(ls: LevelSolve) -> Result<(usize, f64, Option<Certific
     mg.smoothing = options.smoothing;
     let mut delta = zeroed(n);
     let mut g = zeroed(n);
-    let mut r = zeroed(n);
     let mut prev: Option<NewtonStates> = None;
     let mut changed = filled(n, false);
     let mut dirty = filled(n, false);
@@ -478,12 +518,14 @@ pub(super) fn level_solve(ls: LevelSolve) -> Result<(usize, f64, Option<Certific
     let mut scale = 1.0;
     let mut skip_check = !check_start && max_iterations > 0;
     let mut kkt = f64::INFINITY;
+    let mut floor = 0.0;
     loop {
         cancel.check()?;
         if !std::mem::take(&mut skip_check) {
             let ev = timer.time("certificate", || crate::certificate::evaluate(model, v));
             scale = ev.certificate.force_scale;
             kkt = ev.certificate.kkt();
+            floor = crate::certificate::AT_FLOOR * ev.certificate.rounding_floor;
             if iterations > 0 {
                 let record = IterationRecord::new(iterations, &ev);
                 observer.iteration(&record);
@@ -520,7 +562,7 @@ pub(super) fn level_solve(ls: LevelSolve) -> Result<(usize, f64, Option<Certific
         let settled = dirty_rows.is_some_and(|d| d <= n / 1000);
         let rows = dirty_rows.map(|_| dirty.as_slice());
         timer.time("newton system", || {
-            a.fill(model, v, &st, rows, &mut g, &mut r)
+            a.fill(model, v, &st, rows, &mut g, None)
         });
         timer.time("coarse operators", || {
             with_operator!(a, model, st, |op| mg.update(op, rows))
@@ -532,7 +574,7 @@ pub(super) fn level_solve(ls: LevelSolve) -> Result<(usize, f64, Option<Certific
                 // Inexact Newton once the states repeat ([`forcing`]); until then, a few
                 // steps only.
                 let (eta, steps) = if settled {
-                    (forcing(kkt, tolerance), options.krylov_steps)
+                    (forcing(kkt, tolerance, floor), options.krylov_steps)
                 } else {
                     (0.0, options.cycles)
                 };
@@ -576,7 +618,7 @@ pub(super) fn level_solve(ls: LevelSolve) -> Result<(usize, f64, Option<Certific
             });
         });
         timer.time("line search", || {
-            let (g0, s2) = line_data(model, &delta, &r);
+            let (g0, s2) = line_data_at(model, &delta, v);
             if let Some(alpha) = exact_step(model, v, &delta, g0, s2) {
                 moved |= apply_step(model, v, &delta, alpha);
             }

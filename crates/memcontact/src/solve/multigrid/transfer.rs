@@ -17,6 +17,17 @@ use crate::sparse::{par_rows, row_chunks, Csr, Pattern, VECTOR_ROWS};
 use rayon::prelude::*;
 use std::sync::Arc;
 
+/// The weights a fine unknown can have for its two parents.
+const WEIGHTS: [[f32; 2]; 4] = [[0.0, 0.0], [1.0, 0.0], [0.5, 0.5], [0.5, 0.0]];
+
+/// The index of `w` in [`WEIGHTS`].
+fn weight_code(w: [f32; 2]) -> u8 {
+    WEIGHTS
+        .iter()
+        .position(|&x| x == w)
+        .expect("prolongation weights are 0, ½ or 1") as u8
+}
+
 /// The prolongation `P` from a coarse level's unknowns to a fine level's unknowns.
 #[derive(Debug, Clone)]
 pub struct Transfer {
@@ -26,32 +37,52 @@ pub struct Transfer {
     /// the first with weight 0, so that loops need no branch; a fine unknown with no
     /// interior parent at all has weights `[0, 0]`.
     pub parents: Vec<[u32; 2]>,
-    /// The weights of `parents` (½ and ½, or 1 and 0, or 0 where a parent was dropped).
-    /// Single precision holds them exactly, in half the memory.
-    pub weights: Vec<[f32; 2]>,
-    /// Columns of P: the children of coarse unknown `I` are
-    /// `children[child_ptr[I]..child_ptr[I + 1]]`, in increasing order.
-    pub child_ptr: Vec<usize>,
-    /// Fine unknowns, grouped by coarse parent.
-    pub children: Vec<u32>,
-    /// `P[child, I]` for every entry of `children` (exact in single precision).
-    pub child_weights: Vec<f32>,
+    /// The weights of `parents` (½ and ½, or 1 and 0, or 0 where a parent was dropped), as
+    /// an index into [`WEIGHTS`]: one byte per fine unknown instead of eight.
+    weight_code: Vec<u8>,
+    /// The columns of P: the children of every coarse unknown, in increasing order.
+    columns: Columns,
     /// Every fine unknown has at most one parent (an aggregation): the second parents
     /// need not be visited.
     pub single_parent: bool,
+}
+
+/// The columns of P (the children of each coarse unknown with their weights), stored or
+/// read from the fine level's pattern.
+#[derive(Debug, Clone)]
+enum Columns {
+    /// The children of coarse unknown `I` are `children[child_ptr[I]..child_ptr[I + 1]]`,
+    /// `P[child, I]` is 1 (code 0) or ½ (code 1) for each.
+    Stored {
+        child_ptr: Vec<usize>,
+        children: Vec<u32>,
+        child_code: Vec<u8>,
+    },
+    /// Nested meshes: the children of coarse unknown `I` are the fine unknown `on[I]` at
+    /// the same place and its neighbours that have `I` as a parent, i.e. the entries of
+    /// row `on[I]` of the fine level's pattern with `P[w, I] ≠ 0` (sorted like the stored
+    /// children, so that every sum over them is the same). Checked when chosen
+    /// ([`Transfer::with_columns_from`]); nothing per child is stored.
+    /// With `whole`, every entry of those rows is a child, of weight ½ but `on[I]` itself
+    /// (weight 1): the weights need not be looked up.
+    FineRows {
+        on: Vec<u32>,
+        fine: Arc<Pattern>,
+        whole: bool,
+    },
 }
 
 impl Transfer {
     /// P between the unknowns of two consecutive levels. `refinement.parents` must have one
     /// entry per fine vertex, each naming coarse vertices; anything else is an error.
     pub fn new(refinement: &Refinement, coarse: &DofMap, fine: &DofMap) -> Result<Transfer> {
-        let n_cv = coarse.dof.len();
-        if refinement.parents.len() != fine.dof.len() {
+        let n_cv = coarse.n_vertices();
+        if refinement.parents.len() != fine.n_vertices() {
             return Err(Error::Mesh(format!(
                 "the refinement relation names parents for {} vertices, but the finer level \
                  has {} vertices",
                 refinement.parents.len(),
-                fine.dof.len()
+                fine.n_vertices()
             )));
         }
         if let Some((v, p)) = refinement
@@ -69,7 +100,7 @@ impl Transfer {
         let n_fine = fine.len();
         let map = |&v: &u32| -> ([u32; 2], [f32; 2]) {
             let [a, b] = refinement.parents[v as usize];
-            let (da, db) = (coarse.dof[a as usize], coarse.dof[b as usize]);
+            let (da, db) = (coarse.of(a as usize), coarse.of(b as usize));
             if a == b {
                 match da {
                     Some(i) => ([i, i], [1.0, 0.0]),
@@ -118,18 +149,165 @@ impl Transfer {
             let (p, w) = (parents[v], weights[v]);
             [0, 1].map(|s| (w[s] != 0.0).then_some((p[s], (v as u32, w[s]))))
         });
-        let children = entries.par_iter().with_min_len(4096).map(|e| e.0).collect();
-        let child_weights = entries.par_iter().with_min_len(4096).map(|e| e.1).collect();
+        let children: Vec<u32> = entries.par_iter().with_min_len(4096).map(|e| e.0).collect();
+        let child_code = entries
+            .par_iter()
+            .with_min_len(4096)
+            .map(|e| {
+                let w = e.1;
+                assert!(w == 1.0 || w == 0.5, "a child's weight is 1 or ½, not {w}");
+                (w == 0.5) as u8
+            })
+            .collect();
+        drop(entries);
         let single_parent = weights.par_iter().with_min_len(4096).all(|w| w[1] == 0.0);
+        let weight_code = weights
+            .par_iter()
+            .with_min_len(4096)
+            .map(|&w| weight_code(w))
+            .collect();
         Transfer {
             n_coarse,
             parents,
-            weights,
-            child_ptr,
-            children,
-            child_weights,
+            weight_code,
+            columns: Columns::Stored {
+                child_ptr,
+                children,
+                child_code,
+            },
             single_parent,
         }
+    }
+
+    /// This transfer with its columns read from `fine`, the pattern of the fine level's
+    /// operator, when that pattern holds them: every coarse unknown has a fine unknown of
+    /// weight 1 on it whose row lists exactly its children (nested meshes, where a coarse
+    /// vertex's children are the fine vertex on it and the midpoints of its edges, all
+    /// neighbours of that vertex). Otherwise (aggregation, other patterns) unchanged. The
+    /// same children in the same order: every result is bitwise the same, and the columns
+    /// take 4 bytes per coarse unknown instead of about 7 per fine one.
+    pub fn with_columns_from(self, fine: &Arc<Pattern>) -> Transfer {
+        let Columns::Stored {
+            child_ptr,
+            children,
+            child_code,
+        } = &self.columns
+        else {
+            return self;
+        };
+        if fine.n() != self.n_fine() {
+            return self;
+        }
+        // The child of weight 1 of every coarse unknown, and its row's matching entries
+        // counted against the stored children.
+        // Per coarse unknown: (the fine unknown on it, whether its row holds nothing but
+        // its children, all of weight ½ but itself).
+        let on: Option<Vec<(u32, bool)>> = (0..self.n_coarse)
+            .into_par_iter()
+            .with_min_len(4096)
+            .map(|i| {
+                let (lo, hi) = (child_ptr[i], child_ptr[i + 1]);
+                let k = (lo..hi).find(|&k| child_code[k] == 0)?;
+                let v = children[k] as usize;
+                let row = &fine.col[fine.ptr(v)..fine.ptr(v + 1)];
+                let mut next = lo;
+                for &w in row {
+                    if self.weight_of(w as usize, i) != 0.0 {
+                        if next == hi || children[next] != w {
+                            return None;
+                        }
+                        next += 1;
+                    }
+                }
+                // Codes are 0 (weight 1) or 1 (weight ½): one child of weight 1, v itself.
+                let ones = child_code[lo..hi].iter().filter(|&&c| c == 0).count();
+                let whole = row.len() == hi - lo && ones == 1;
+                (next == hi).then_some((v as u32, whole))
+            })
+            .collect();
+        match on {
+            Some(on) => {
+                let whole = on.par_iter().all(|x| x.1);
+                Transfer {
+                    columns: Columns::FineRows {
+                        on: on.into_par_iter().map(|x| x.0).collect(),
+                        fine: fine.clone(),
+                        whole,
+                    },
+                    ..self
+                }
+            }
+            None => self,
+        }
+    }
+
+    /// `P[w, I]`: the weight of coarse unknown `i` in fine unknown `w` (0 unless a parent).
+    #[inline(always)]
+    fn weight_of(&self, w: usize, i: usize) -> f64 {
+        let [p0, p1] = self.parents[w];
+        let [w0, w1] = self.weights(w);
+        if p0 as usize == i && w0 != 0.0 {
+            f64::from(w0)
+        } else if p1 as usize == i && w1 != 0.0 {
+            f64::from(w1)
+        } else {
+            0.0
+        }
+    }
+
+    /// Calls `f(w, P[w, i])` for the children `w` of coarse unknown `i`, in increasing
+    /// order.
+    #[inline(always)]
+    fn for_children(&self, i: usize, mut f: impl FnMut(usize, f64)) {
+        match &self.columns {
+            Columns::Stored {
+                child_ptr,
+                children,
+                child_code,
+            } => {
+                for k in child_ptr[i]..child_ptr[i + 1] {
+                    f(
+                        children[k] as usize,
+                        f64::from([1.0f32, 0.5][child_code[k] as usize]),
+                    );
+                }
+            }
+            Columns::FineRows { on, fine, whole } => {
+                let v = on[i] as usize;
+                let row = &fine.col[fine.ptr(v)..fine.ptr(v + 1)];
+                if *whole {
+                    for &w in row {
+                        f(w as usize, if w as usize == v { 1.0 } else { 0.5 });
+                    }
+                } else {
+                    for &w in row {
+                        let wt = self.weight_of(w as usize, i);
+                        if wt != 0.0 {
+                            f(w as usize, wt);
+                        }
+                    }
+                }
+            }
+        }
+    }
+
+    /// Whether the columns are read from the fine level's pattern
+    /// ([`Transfer::with_columns_from`]).
+    pub fn columns_from_fine_rows(&self) -> bool {
+        matches!(self.columns, Columns::FineRows { .. })
+    }
+
+    /// Whether the columns are whole rows of the fine level's pattern (their weights then
+    /// follow from the place alone).
+    #[cfg(test)]
+    pub(crate) fn columns_are_whole_rows(&self) -> bool {
+        matches!(self.columns, Columns::FineRows { whole: true, .. })
+    }
+
+    /// The weights of fine unknown `v`'s two parents.
+    #[inline(always)]
+    pub fn weights(&self, v: usize) -> [f32; 2] {
+        WEIGHTS[self.weight_code[v] as usize]
     }
 
     /// Number of fine unknowns (rows of P).
@@ -141,7 +319,7 @@ impl Transfer {
     #[inline]
     fn row(&self, v: usize, xc: &[f64]) -> f64 {
         let [a, b] = self.parents[v];
-        let [wa, wb] = self.weights[v];
+        let [wa, wb] = self.weights(v);
         f64::from(wa) * xc[a as usize] + f64::from(wb) * xc[b as usize]
     }
 
@@ -166,9 +344,7 @@ impl Transfer {
     pub fn restrict(&self, rf: &[f64], rc: &mut [f64]) {
         par_rows(rc, |i, r| {
             let mut s = 0.0;
-            for k in self.child_ptr[i]..self.child_ptr[i + 1] {
-                s += f64::from(self.child_weights[k]) * rf[self.children[k] as usize];
-            }
+            self.for_children(i, |w, wt| s += wt * rf[w]);
             *r = s;
         });
     }
@@ -176,13 +352,20 @@ impl Transfer {
     /// The coarse unknown sitting on the same vertex as each fine unknown, inverted: for
     /// every coarse unknown, the fine unknown at the same place (the child of weight 1).
     pub fn injection(&self) -> Vec<u32> {
-        (0..self.n_coarse)
-            .map(|i| {
-                (self.child_ptr[i]..self.child_ptr[i + 1])
-                    .find(|&k| self.child_weights[k] == 1.0)
-                    .map_or(self.children[self.child_ptr[i]], |k| self.children[k])
-            })
-            .collect()
+        match &self.columns {
+            Columns::Stored {
+                child_ptr,
+                children,
+                child_code,
+            } => (0..self.n_coarse)
+                .map(|i| {
+                    (child_ptr[i]..child_ptr[i + 1])
+                        .find(|&k| child_code[k] == 0)
+                        .map_or(children[child_ptr[i]], |k| children[k])
+                })
+                .collect(),
+            Columns::FineRows { on, .. } => on.clone(),
+        }
     }
 
     /// The sparsity pattern of `Pᵀ A P` for A on `fine` (the symbolic Galerkin product,
@@ -203,10 +386,9 @@ impl Transfer {
                 r.clear();
                 r.push(i as u32);
                 seen[i] = i as u32;
-                for &v in &self.children[self.child_ptr[i]..self.child_ptr[i + 1]] {
-                    let v = v as usize;
-                    for &w in &fine.col[fine.row_ptr[v]..fine.row_ptr[v + 1]] {
-                        let (p, wt) = (self.parents[w as usize], self.weights[w as usize]);
+                self.for_children(i, |v, _| {
+                    for &w in &fine.col[fine.ptr(v)..fine.ptr(v + 1)] {
+                        let (p, wt) = (self.parents[w as usize], self.weights(w as usize));
                         for s in 0..2 {
                             if wt[s] != 0.0 && seen[p[s] as usize] != i as u32 {
                                 seen[p[s] as usize] = i as u32;
@@ -214,7 +396,7 @@ impl Transfer {
                             }
                         }
                     }
-                }
+                });
                 if r.len() <= SMALL {
                     // The row's columns by rank (the count of smaller ones): branch-free
                     // on the distinct columns, where a comparison sort mispredicts.
@@ -260,18 +442,16 @@ impl Transfer {
         let fine = op.matrix();
         let fpat = &fine.pattern;
         let row = |i: usize, vals: &mut [f64], marker: &mut [u32]| {
-            let cols = &cpat.col[cpat.row_ptr[i]..cpat.row_ptr[i + 1]];
+            let cols = &cpat.col[cpat.ptr(i)..cpat.ptr(i + 1)];
             for (k, &j) in cols.iter().enumerate() {
                 marker[j as usize] = k as u32;
                 vals[k] = 0.0;
             }
-            for c in self.child_ptr[i]..self.child_ptr[i + 1] {
-                let v = self.children[c] as usize;
+            self.for_children(i, |v, wv| {
                 if !A::PLAIN && op.held(v) {
-                    continue; // a zero row
+                    return; // a zero row
                 }
-                let wv = f64::from(self.child_weights[c]);
-                let (s, e) = (fpat.row_ptr[v], fpat.row_ptr[v + 1]);
+                let (s, e) = (fpat.ptr(v), fpat.ptr(v + 1));
                 for (&w, &a) in fpat.col[s..e].iter().zip(&fine.val[s..e]) {
                     let a = entry(op, v, w as usize, a);
                     if a == 0.0 {
@@ -280,7 +460,7 @@ impl Transfer {
                     let a = a * wv;
                     let w = w as usize;
                     let [p0, p1] = self.parents[w];
-                    let [w0, w1] = self.weights[w].map(f64::from);
+                    let [w0, w1] = self.weights(w).map(f64::from);
                     if w0 != 0.0 {
                         vals[marker[p0 as usize] as usize] += a * w0;
                         // A dropped second parent repeats the first with weight 0.
@@ -289,14 +469,14 @@ impl Transfer {
                         }
                     }
                 }
-            }
+            });
         };
         let chunks = row_chunks(&cpat, &mut coarse.val, 512);
         let work = |marker: &mut Vec<u32>, (start, vals): (usize, &mut [f64])| {
             let mut off = 0;
             let end = (start + 512).min(n_coarse);
             for i in start..end {
-                let len = cpat.row_ptr[i + 1] - cpat.row_ptr[i];
+                let len = cpat.ptr(i + 1) - cpat.ptr(i);
                 if dirty.is_none_or(|d| d[i]) {
                     row(i, &mut vals[off..off + len], marker);
                 }
@@ -318,9 +498,9 @@ impl Transfer {
     /// Coarse rows to recompute when the fine rows flagged `dirty_fine` changed.
     pub fn coarse_dirty(&self, dirty_fine: &[bool], dirty_coarse: &mut [bool]) {
         par_rows(dirty_coarse, |i, d| {
-            *d = self.children[self.child_ptr[i]..self.child_ptr[i + 1]]
-                .iter()
-                .any(|&v| dirty_fine[v as usize]);
+            let mut any = false;
+            self.for_children(i, |v, _| any |= dirty_fine[v]);
+            *d = any;
         });
     }
 }
