@@ -22,7 +22,7 @@ CASE FILE (TOML; paths relative to the case file; unknown keys are errors)
               max_iterations             per method by default
               accept_rounding_floor = true   accept an answer at the rounding floor of
                                          double precision above the tolerance (reported)
-[output]      vtu = binary               or ascii
+[output]      vtu = binary               or ascii | compressed
               csv = true                 false: no nodes.csv (solution.vtu has the fields)
               plots = [\"deflection\", \"pressure\", \"liftoff\", \"profile\"]  (default all; [] none)
               allowable_pressure = p     force/area: pressure.png maps pressure / p

@@ -1,7 +1,8 @@
 //! A reader for the VTK XML UnstructuredGrid (`.vtu`) files of triangle meshes that
 //! `memcontact::io::vtu` writes: ASCII arrays, or one raw appended block
-//! (`<AppendedData encoding="raw">`, `UInt32` or `UInt64` size headers, little-endian).
-//! Base64 and compressed files are refused with a clear message.
+//! (`<AppendedData encoding="raw">`, `UInt32` or `UInt64` size headers, little-endian),
+//! plain or zlib-compressed in blocks (`compressor="vtkZLibDataCompressor"`). Base64 and
+//! other compressors are refused with a clear message.
 
 use memcontact::{Error, Result};
 use std::path::Path;
@@ -127,9 +128,11 @@ fn parse(bytes: &[u8]) -> std::result::Result<VtuMesh, String> {
     if attr(vtk, "byte_order").is_some_and(|b| b != "LittleEndian") {
         return Err("big-endian VTU files are not supported".into());
     }
-    if attr(vtk, "compressor").is_some() {
-        return Err("compressed VTU files are not supported".into());
-    }
+    let zlib = match attr(vtk, "compressor") {
+        None => false,
+        Some("vtkZLibDataCompressor") => true,
+        Some(c) => return Err(format!("compressor {c} is not supported (zlib is)")),
+    };
     let header_size = match attr(vtk, "header_type") {
         None | Some("UInt32") => 4,
         Some("UInt64") => 8,
@@ -235,20 +238,22 @@ fn parse(bytes: &[u8]) -> std::result::Result<VtuMesh, String> {
                     )
                 })?;
                 let at = base + *off;
-                let hdr = bytes.get(at..at + header_size).ok_or_else(|| {
-                    format!("array `{}`: offset beyond the end of the file", a.name)
-                })?;
-                let nbytes = if header_size == 8 {
-                    u64::from_le_bytes(hdr.try_into().unwrap_or([0; 8])) as usize
+                let data = if zlib {
+                    inflate(bytes, at, header_size)
+                        .map_err(|e| format!("array `{}`: {e}", a.name))?
                 } else {
-                    u32::from_le_bytes(hdr.try_into().unwrap_or([0; 4])) as usize
-                };
-                let size = type_size(&a.vtk_type).unwrap_or(1);
-                let data = bytes
-                    .get(at + header_size..at + header_size + nbytes)
-                    .ok_or_else(|| {
-                        format!("array `{}`: data runs past the end of the file", a.name)
+                    let nbytes = word(bytes, at, header_size).ok_or_else(|| {
+                        format!("array `{}`: offset beyond the end of the file", a.name)
                     })?;
+                    bytes
+                        .get(at + header_size..at + header_size + nbytes)
+                        .ok_or_else(|| {
+                            format!("array `{}`: data runs past the end of the file", a.name)
+                        })?
+                        .to_vec()
+                };
+                let nbytes = data.len();
+                let size = type_size(&a.vtk_type).unwrap_or(1);
                 if nbytes % size != 0 {
                     return Err(format!(
                         "array `{}`: {nbytes} bytes is not a whole number of values",
@@ -338,6 +343,55 @@ fn parse(bytes: &[u8]) -> std::result::Result<VtuMesh, String> {
     })
 }
 
+/// The size header (`UInt32` or `UInt64`, little-endian) at `at`, if the file has it.
+fn word(bytes: &[u8], at: usize, size: usize) -> Option<usize> {
+    let b = bytes.get(at..at.checked_add(size)?)?;
+    Some(match size {
+        8 => u64::from_le_bytes(b.try_into().ok()?) as usize,
+        _ => u32::from_le_bytes(b.try_into().ok()?) as usize,
+    })
+}
+
+/// The bytes of a zlib-compressed appended array at `at`: VTK's header (block count,
+/// block size, size of a shorter last block or 0, each block's compressed size), then
+/// the blocks, each inflated and checked against the size the header gives.
+fn inflate(bytes: &[u8], at: usize, size: usize) -> std::result::Result<Vec<u8>, String> {
+    use std::io::Read;
+    let head = |k: usize| {
+        word(bytes, at + k * size, size).ok_or("the compression header runs past the end")
+    };
+    let (blocks, block, last) = (head(0)?, head(1)?, head(2)?);
+    if blocks > bytes.len() / size {
+        return Err(format!("a compression header of {blocks} blocks"));
+    }
+    let mut data = at + (3 + blocks) * size;
+    let mut out = Vec::with_capacity(block.saturating_mul(blocks).min(bytes.len() * 64));
+    for b in 0..blocks {
+        let c = head(3 + b)?;
+        let z = bytes
+            .get(data..data.saturating_add(c))
+            .ok_or("compressed data runs past the end of the file")?;
+        let want = if b + 1 == blocks && last != 0 {
+            last
+        } else {
+            block
+        };
+        let before = out.len();
+        flate2::read::ZlibDecoder::new(z)
+            .take(want as u64 + 1)
+            .read_to_end(&mut out)
+            .map_err(|e| format!("block {b} does not inflate: {e}"))?;
+        if out.len() - before != want {
+            return Err(format!(
+                "block {b} inflates to {} bytes, the header says {want}",
+                out.len() - before
+            ));
+        }
+        data += c;
+    }
+    Ok(out)
+}
+
 fn find(hay: &[u8], needle: &[u8]) -> Option<usize> {
     hay.windows(needle.len()).position(|w| w == needle)
 }
@@ -363,7 +417,11 @@ mod tests {
         let flags = [1i8, 0, 1, 0, 1];
         let region = [0, 1, 2, 3];
         let dir = tempfile::tempdir().unwrap();
-        for enc in [VtuEncoding::Binary, VtuEncoding::Ascii] {
+        for enc in [
+            VtuEncoding::Binary,
+            VtuEncoding::Ascii,
+            VtuEncoding::Compressed,
+        ] {
             let path = dir.path().join("a <&>.vtu");
             write_vtu(
                 &path,
@@ -412,5 +470,38 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(e.contains("missing.vtu"), "{e}");
+        // A compressed file cut short, or with a damaged block, is an error, not a panic.
+        let n = 20_000;
+        let mesh = Mesh::new(
+            (0..n).map(|i| [i as f64, (i % 2) as f64]).collect(),
+            (0..n as u32 - 2)
+                .map(|i| {
+                    if i % 2 == 0 {
+                        [i, i + 2, i + 1]
+                    } else {
+                        [i, i + 1, i + 2]
+                    }
+                })
+                .collect(),
+            vec![],
+            Default::default(),
+        )
+        .unwrap();
+        let u: Vec<f64> = (0..n).map(|i| (i as f64).cos()).collect();
+        let good = dir.path().join("z.vtu");
+        let u_data = [("u", DataArray::F64(&u))];
+        write_vtu(&good, &mesh, &u_data, &[], VtuEncoding::Compressed).unwrap();
+        assert_eq!(read_vtu(&good).unwrap().point_array("u").unwrap().values, u);
+        let bytes = std::fs::read(&good).unwrap();
+        std::fs::write(&p, &bytes[..bytes.len() / 2]).unwrap();
+        assert!(read_vtu(&p).is_err());
+        let mut damaged = bytes.clone();
+        let mid = bytes.len() * 3 / 4;
+        for b in &mut damaged[mid..mid + 64] {
+            *b ^= 0x5a;
+        }
+        std::fs::write(&p, &damaged).unwrap();
+        let e = read_vtu(&p).unwrap_err().to_string();
+        assert!(e.contains("block") || e.contains("inflate"), "{e}");
     }
 }

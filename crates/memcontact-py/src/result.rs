@@ -381,7 +381,7 @@ impl PyResult_ {
 
     /// Writes the result set the command-line tool writes (`solution.vtu`, `nodes.csv`,
     /// the pictures of the case's `[output] plots` unless `pictures` is false, and
-    /// `summary.json`) into `directory`, atomically; `vtu` ("binary" or "ascii") defaults
+    /// `summary.json`) into `directory`, atomically; `vtu` ("binary", "ascii" or "compressed") defaults
     /// to the case's `[output] vtu`. A directory holding other files is refused unless
     /// `force`. Returns the summary written.
     #[pyo3(signature = (directory, force=false, vtu=None, pictures=true))]
@@ -511,14 +511,15 @@ fn vec_bool(a: &Bound<'_, PyAny>) -> PyResult<Vec<bool>> {
     Ok(a.as_array().to_vec())
 }
 
-/// The encoding of `solution.vtu`: `vtu` ("binary" or "ascii"), or the case's.
+/// The encoding of `solution.vtu`: `vtu` ("binary", "ascii" or "compressed"), or the case's.
 pub fn vtu_format(vtu: Option<&str>, case: &Case) -> PyResult<VtuFormat> {
     match vtu {
         None => Ok(case.output.vtu),
         Some("binary") => Ok(VtuFormat::Binary),
         Some("ascii") => Ok(VtuFormat::Ascii),
+        Some("compressed") => Ok(VtuFormat::Compressed),
         Some(other) => Err(PyValueError::new_err(format!(
-            "vtu: \"{other}\" is unknown (choose binary or ascii)"
+            "vtu: \"{other}\" is unknown (choose binary, ascii or compressed)"
         ))),
     }
 }

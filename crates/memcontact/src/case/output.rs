@@ -144,4 +144,7 @@ pub enum VtuFormat {
     Binary,
     /// Text.
     Ascii,
+    /// Raw appended binary compressed with zlib in blocks, as ParaView reads it (smaller,
+    /// slower to write).
+    Compressed,
 }

@@ -209,6 +209,7 @@ pub fn write_fields(
                 match vtu {
                     VtuFormat::Binary => VtuEncoding::Binary,
                     VtuFormat::Ascii => VtuEncoding::Ascii,
+                    VtuFormat::Compressed => VtuEncoding::Compressed,
                 },
                 &[("run_id", run_id)],
             )
