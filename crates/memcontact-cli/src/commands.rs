@@ -184,7 +184,16 @@ pub fn check(case_path: &Path, sets: &[String]) -> Result<()> {
     // Building the mesh, binding and assembling checks the data on the mesh (regions,
     // signs, NaN), everything `solve` checks before it solves; the load cases' data are
     // assembled on the mesh too, and the profile line checked against it.
-    let d = Discretization::new(&case.problem, &mut Progress::new(Verbosity::Quiet))?;
+    // As `solve` builds it: the lean one-step run, or everything kept for a sweep or the
+    // adaptive loop (so that the memory estimate is the one `solve` checks).
+    // The memory available is read before the check's own mesh and model take theirs.
+    let (available, source) = memcontact::limits::available_memory();
+    let quiet = &mut Progress::new(Verbosity::Quiet);
+    let d = if case.is_sweep() || case.adapt.is_some() {
+        Discretization::new(&case.problem, quiet)?
+    } else {
+        Discretization::for_one_solve(&case.problem, &case.settings, quiet)?
+    };
     memcontact::run::check_case_on_mesh(&case, d.mesh(), true)?;
     d.check_memory(&case.settings)?;
     if let Some(a) = &case.adapt {
@@ -243,7 +252,6 @@ pub fn check(case_path: &Path, sets: &[String]) -> Result<()> {
         method.name(),
         choice.reason()
     );
-    let (available, source) = memcontact::limits::available_memory();
     println!(
         "  memory       about {} to solve ({} available: {source})",
         memcontact::limits::human_bytes(d.memory_estimate(&case.settings)),

@@ -58,10 +58,44 @@ impl MeshSize {
 }
 
 /// Bytes per vertex of the finest mesh that a run takes besides its solver's own
-/// factorisations: all mesh levels, the model (S, L, D, φ), the multigrid transfer and
-/// smoother data, the result fields and the writers' buffers. Measured at about 560 bytes
-/// per vertex (a 1 M-vertex square solved by multigrid, output written), with a margin.
+/// factorisations, for any run: all mesh levels, the model (S, L, D, φ), a second body,
+/// the multigrid transfer and smoother data, the result fields and the writers' buffers.
+/// Kept for the runs not measured apart below (a second body, convergence studies, the
+/// adaptive loop); a one-body run with the consistent foundation was measured at about
+/// 470 bytes per vertex (the square, N = 2048, everything kept).
 pub const RUN_BYTES_PER_VERTEX: f64 = 700.0;
+
+/// The same for one body with the consistent foundation: measured at 465–470 bytes per
+/// vertex (the square, N = 2048, every level and matrix kept), with a margin.
+pub const CONSISTENT_BYTES_PER_VERTEX: f64 = 540.0;
+
+/// The same for one body with a lumped or rigid foundation, whose Newton matrix is S and
+/// a diagonal: measured at 330–350 bytes per vertex with every level and matrix kept (the
+/// square, N = 2048), with a margin.
+pub const LUMPED_BYTES_PER_VERTEX: f64 = 400.0;
+
+/// The same for `memcontact solve` of one step with a lumped or rigid foundation, which
+/// releases what its solve and its writers no longer read: measured at 258 bytes per
+/// vertex at N = 8192 (16.5 GB), 282 at N = 4096 and 320 at N = 2048 (with the tool's
+/// fixed 100 MB), with a margin.
+pub const ONE_SOLVE_LUMPED_BYTES_PER_VERTEX: f64 = 320.0;
+
+/// Bytes per vertex of the finest mesh for a run of `problem`: one body with a lumped or
+/// rigid foundation, or with the consistent one, or anything else
+/// ([`RUN_BYTES_PER_VERTEX`]); `one_solve` for the lean one-step run of `memcontact solve`.
+pub fn bytes_per_vertex(problem: &crate::problem::Problem, one_solve: bool) -> f64 {
+    use crate::model::Foundation;
+    if problem.lower.is_some() {
+        return RUN_BYTES_PER_VERTEX;
+    }
+    let o = &problem.obstacle;
+    let lean = o.foundation == Foundation::Lumped || o.stiffness.is_rigid();
+    match (lean, one_solve) {
+        (true, true) => ONE_SOLVE_LUMPED_BYTES_PER_VERTEX,
+        (true, false) => LUMPED_BYTES_PER_VERTEX,
+        (false, _) => CONSISTENT_BYTES_PER_VERTEX,
+    }
+}
 
 /// Bytes per unknown and per binary digit of the unknowns' count that a sparse Cholesky
 /// factorisation of S (+ L) adds (nested-dissection fill grows like n log n): measured at
@@ -159,6 +193,17 @@ pub fn run_bytes(finest: MeshSize) -> f64 {
 /// indices of the mesh). `what` names the source of the size in the message (`"mesh.refine
 /// = 12 on a mesh of 128 triangles"`). Called before anything is refined.
 pub fn check_mesh_fits(base: MeshSize, refinements: usize, what: &str) -> Result<()> {
+    check_mesh_fits_at(base, refinements, what, RUN_BYTES_PER_VERTEX)
+}
+
+/// [`check_mesh_fits`] for a run that takes `per_vertex` bytes per vertex of the finest
+/// mesh ([`bytes_per_vertex`]).
+pub fn check_mesh_fits_at(
+    base: MeshSize,
+    refinements: usize,
+    what: &str,
+    per_vertex: f64,
+) -> Result<()> {
     let finest = base.refined(refinements);
     if finest.vertices > u32::MAX as f64 || finest.triangles > u32::MAX as f64 {
         return Err(Error::Data(format!(
@@ -167,7 +212,7 @@ pub fn check_mesh_fits(base: MeshSize, refinements: usize, what: &str) -> Result
             finest.vertices, finest.triangles
         )));
     }
-    check_bytes(run_bytes(finest), finest, what)
+    check_bytes(per_vertex * finest.vertices, finest, what)
 }
 
 /// Refuses `need` bytes for a mesh of `finest` counts when more than is available.

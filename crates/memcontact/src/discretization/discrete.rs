@@ -2,7 +2,7 @@
 //! or generated, refined, renumbered for locality) and the model assembled on the finest.
 
 use super::binding::BoundData;
-use super::meshing::build_mesh;
+use super::meshing::build_mesh_checked;
 use crate::error::{Invalid, Result};
 use crate::mesh::refine::Hierarchy;
 use crate::mesh::{Mesh, MeshQuality};
@@ -47,6 +47,9 @@ pub struct Discretization {
     /// regions are released until [`Discretization::restore_mesh`] builds them again from
     /// this spec; the hash checks that they come back the same.
     mesh_released: Option<(MeshSpec, u64)>,
+    /// The run's bytes per vertex of the finest mesh, for its memory estimate
+    /// ([`crate::limits::bytes_per_vertex`]).
+    per_vertex: f64,
 }
 
 impl Discretization {
@@ -55,7 +58,8 @@ impl Discretization {
         problem.validate().map_err(Invalid::into_error)?;
         observer.phase_started("mesh");
         let t0 = Instant::now();
-        let (hierarchy, warnings) = build_mesh(&problem.mesh)?;
+        let per_vertex = crate::limits::bytes_per_vertex(problem, false);
+        let (hierarchy, warnings) = build_mesh_checked(&problem.mesh, Some(per_vertex))?;
         let t_mesh = t0.elapsed().as_secs_f64();
         observer.phase_finished("mesh", t_mesh);
         if observer.cancelled() {
@@ -102,7 +106,8 @@ impl Discretization {
         problem.validate().map_err(Invalid::into_error)?;
         observer.phase_started("mesh");
         let t0 = Instant::now();
-        let (hierarchy, warnings) = build_mesh(&problem.mesh)?;
+        let per_vertex = crate::limits::bytes_per_vertex(problem, true);
+        let (hierarchy, warnings) = build_mesh_checked(&problem.mesh, Some(per_vertex))?;
         let t_mesh = t0.elapsed().as_secs_f64();
         observer.phase_finished("mesh", t_mesh);
         if observer.cancelled() {
@@ -118,6 +123,7 @@ impl Discretization {
             m.numbering = None;
         }
         let mut d = Discretization::assemble_reordered(problem, hierarchy, t_reorder, observer)?;
+        d.per_vertex = per_vertex;
         d.warnings = warnings;
         d.phases.insert(
             0,
@@ -203,7 +209,7 @@ impl Discretization {
         };
         observer.phase_started("mesh");
         let t0 = Instant::now();
-        let (hierarchy, _) = super::meshing::build_mesh_checked(&spec, false)?;
+        let (hierarchy, _) = build_mesh_checked(&spec, None)?;
         let mesh = hierarchy.levels.into_iter().last().expect("a level");
         let mesh = match crate::mesh::reorder::renumbering_for_locality(&mesh) {
             Some(r) => Arc::new(r).apply_shared(&mesh),
@@ -282,6 +288,7 @@ impl Discretization {
             built: None,
             released: false,
             mesh_released: None,
+            per_vertex: crate::limits::bytes_per_vertex(problem, false),
             phases: vec![
                 Phase {
                     name: "reorder".into(),
@@ -394,4 +401,12 @@ fn geometry_hash(mesh: &Mesh) -> u64 {
         h.update(&d.to_le_bytes());
     }
     h.digest()
+}
+
+impl Discretization {
+    /// The estimated memory of the run on this mesh besides a solver's factorisation
+    /// (bytes): [`crate::limits::bytes_per_vertex`] of its problem and kind of run.
+    pub fn run_bytes(&self) -> f64 {
+        self.per_vertex * self.mesh().n_vertices() as f64
+    }
 }

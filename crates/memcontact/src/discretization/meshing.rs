@@ -2,7 +2,7 @@
 //! the memory of the run checked before the work.
 
 use crate::error::Result;
-use crate::limits::{check_mesh_fits, MeshSize};
+use crate::limits::{check_mesh_fits_at, MeshSize, RUN_BYTES_PER_VERTEX};
 use crate::mesh::generate::{self, Diagonal, PolygonSpec, RectangleSpec};
 use crate::mesh::refine::Hierarchy;
 use crate::problem::{MeshSource, MeshSpec};
@@ -12,14 +12,22 @@ use crate::problem::{MeshSource, MeshSpec};
 /// checked before the base mesh is generated (when its size is known beforehand) and
 /// again, exactly, before it is refined.
 pub fn build_mesh(spec: &MeshSpec) -> Result<(Hierarchy, Vec<String>)> {
-    build_mesh_checked(spec, true)
+    build_mesh_checked(spec, Some(RUN_BYTES_PER_VERTEX))
 }
 
-/// [`build_mesh`], the memory check made only when `check` (a mesh built again for the
-/// writers of a run that already holds its data is not checked against what is left).
-pub(crate) fn build_mesh_checked(spec: &MeshSpec, check: bool) -> Result<(Hierarchy, Vec<String>)> {
-    if let Some(base) = expected_size(spec).filter(|_| check) {
-        check_mesh_fits(base, spec.refine, &describe_refinement(spec, &base))?;
+/// [`build_mesh`] for a run that takes `per_vertex` bytes per vertex of the finest mesh
+/// ([`crate::limits::bytes_per_vertex`]), or unchecked when `None` (a mesh built again for
+/// the writers of a run that already holds its data is not checked against what is left).
+pub(crate) fn build_mesh_checked(
+    spec: &MeshSpec,
+    per_vertex: Option<f64>,
+) -> Result<(Hierarchy, Vec<String>)> {
+    let check = |base: MeshSize| match per_vertex {
+        Some(b) => check_mesh_fits_at(base, spec.refine, &describe_refinement(spec, &base), b),
+        None => Ok(()),
+    };
+    if let Some(base) = expected_size(spec) {
+        check(base)?;
     }
     let mut warnings = Vec::new();
     let mut hierarchy = match &spec.source {
@@ -85,9 +93,7 @@ pub(crate) fn build_mesh_checked(spec: &MeshSpec, check: bool) -> Result<(Hierar
     };
     if spec.refine > 0 {
         let base = MeshSize::of(hierarchy.finest());
-        if check {
-            check_mesh_fits(base, spec.refine, &describe_refinement(spec, &base))?;
-        }
+        check(base)?;
         hierarchy.refine(spec.refine);
     }
     Ok((hierarchy, warnings))

@@ -33,10 +33,10 @@ impl Discretization {
     }
 
     /// The estimated peak memory of solving with `settings` (bytes): the run's data on
-    /// this mesh ([`crate::limits::run_bytes`]) and the solver's factorisation ([`crate::solve::solver_bytes`]).
+    /// this mesh ([`Discretization::run_bytes`]) and the solver's factorisation
+    /// ([`crate::solve::solver_bytes`]).
     pub fn memory_estimate(&self, settings: &Settings) -> f64 {
-        crate::limits::run_bytes(crate::limits::MeshSize::of(self.mesh()))
-            + crate::solve::solver_bytes(self.method_for(settings), self.model.n())
+        self.run_bytes() + crate::solve::solver_bytes(self.method_for(settings), self.model.n())
     }
 
     /// Solves the discrete problem with `settings`.
