@@ -461,6 +461,35 @@ fn resources_beyond_the_machine_are_refused_before_allocation() {
         .unwrap()
         .status
         .success());
+    // The estimate follows the kind of run (bytes per vertex: 320 for one solve with a
+    // lumped foundation, 540 with the consistent one): 66 049 vertices fit in 30 MB
+    // lumped (21 MB), not consistent (36 MB); solve agrees with check.
+    let lean = case(
+        &dir,
+        "lean",
+        "generator = \"rectangle\"\nnx = 256",
+        "tension = 1\nload = 8",
+        "shape = 0.1\nstiffness = 100\nfoundation = \"lumped\"",
+    );
+    for (foundation, fits) in [("lumped", true), ("consistent", false)] {
+        for command in ["check", "solve"] {
+            let mut c = bin();
+            c.env("MEMCONTACT_MEMORY_LIMIT", "30M")
+                .arg(command)
+                .arg(&lean)
+                .args(["--set", &format!("obstacle.foundation={foundation}")]);
+            if command == "solve" {
+                c.arg("-q").arg("-o").arg(dir.join("lean-out"));
+            }
+            let o = c.output().unwrap();
+            let t = text(&o);
+            assert_eq!(o.status.success(), fits, "{foundation} {command}: {t}");
+            if !fits {
+                assert!(t.contains("MB of memory") && t.contains("30.00 MB"), "{t}");
+            }
+            let _ = std::fs::remove_dir_all(dir.join("lean-out"));
+        }
+    }
     // A direct solver's factorisation is checked too, by check as by solve.
     let square = case(
         &dir,

@@ -80,23 +80,6 @@ pub const LUMPED_BYTES_PER_VERTEX: f64 = 400.0;
 /// fixed 100 MB), with a margin.
 pub const ONE_SOLVE_LUMPED_BYTES_PER_VERTEX: f64 = 320.0;
 
-/// Bytes per vertex of the finest mesh for a run of `problem`: one body with a lumped or
-/// rigid foundation, or with the consistent one, or anything else
-/// ([`RUN_BYTES_PER_VERTEX`]); `one_solve` for the lean one-step run of `memcontact solve`.
-pub fn bytes_per_vertex(problem: &crate::problem::Problem, one_solve: bool) -> f64 {
-    use crate::model::Foundation;
-    if problem.lower.is_some() {
-        return RUN_BYTES_PER_VERTEX;
-    }
-    let o = &problem.obstacle;
-    let lean = o.foundation == Foundation::Lumped || o.stiffness.is_rigid();
-    match (lean, one_solve) {
-        (true, true) => ONE_SOLVE_LUMPED_BYTES_PER_VERTEX,
-        (true, false) => LUMPED_BYTES_PER_VERTEX,
-        (false, _) => CONSISTENT_BYTES_PER_VERTEX,
-    }
-}
-
 /// Bytes per unknown and per binary digit of the unknowns' count that a sparse Cholesky
 /// factorisation of S (+ L) adds (nested-dissection fill grows like n log n): measured at
 /// about 60 (1 M unknowns, active-set), with a margin.
@@ -197,7 +180,7 @@ pub fn check_mesh_fits(base: MeshSize, refinements: usize, what: &str) -> Result
 }
 
 /// [`check_mesh_fits`] for a run that takes `per_vertex` bytes per vertex of the finest
-/// mesh ([`bytes_per_vertex`]).
+/// mesh (the discretisation picks it for its problem and kind of run).
 pub fn check_mesh_fits_at(
     base: MeshSize,
     refinements: usize,

@@ -48,7 +48,7 @@ pub struct Discretization {
     /// this spec; the hash checks that they come back the same.
     mesh_released: Option<(MeshSpec, u64)>,
     /// The run's bytes per vertex of the finest mesh, for its memory estimate
-    /// ([`crate::limits::bytes_per_vertex`]).
+    /// ([`super::meshing::bytes_per_vertex`]).
     per_vertex: f64,
 }
 
@@ -58,7 +58,7 @@ impl Discretization {
         problem.validate().map_err(Invalid::into_error)?;
         observer.phase_started("mesh");
         let t0 = Instant::now();
-        let per_vertex = crate::limits::bytes_per_vertex(problem, false);
+        let per_vertex = super::meshing::bytes_per_vertex(problem, false);
         let (hierarchy, warnings) = build_mesh_checked(&problem.mesh, Some(per_vertex))?;
         let t_mesh = t0.elapsed().as_secs_f64();
         observer.phase_finished("mesh", t_mesh);
@@ -106,7 +106,7 @@ impl Discretization {
         problem.validate().map_err(Invalid::into_error)?;
         observer.phase_started("mesh");
         let t0 = Instant::now();
-        let per_vertex = crate::limits::bytes_per_vertex(problem, true);
+        let per_vertex = super::meshing::bytes_per_vertex(problem, true);
         let (hierarchy, warnings) = build_mesh_checked(&problem.mesh, Some(per_vertex))?;
         let t_mesh = t0.elapsed().as_secs_f64();
         observer.phase_finished("mesh", t_mesh);
@@ -288,7 +288,7 @@ impl Discretization {
             built: None,
             released: false,
             mesh_released: None,
-            per_vertex: crate::limits::bytes_per_vertex(problem, false),
+            per_vertex: super::meshing::bytes_per_vertex(problem, false),
             phases: vec![
                 Phase {
                     name: "reorder".into(),
@@ -405,7 +405,7 @@ fn geometry_hash(mesh: &Mesh) -> u64 {
 
 impl Discretization {
     /// The estimated memory of the run on this mesh besides a solver's factorisation
-    /// (bytes): [`crate::limits::bytes_per_vertex`] of its problem and kind of run.
+    /// (bytes): [`super::meshing::bytes_per_vertex`] of its problem and kind of run.
     pub fn run_bytes(&self) -> f64 {
         self.per_vertex * self.mesh().n_vertices() as f64
     }

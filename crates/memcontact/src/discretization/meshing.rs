@@ -16,7 +16,7 @@ pub fn build_mesh(spec: &MeshSpec) -> Result<(Hierarchy, Vec<String>)> {
 }
 
 /// [`build_mesh`] for a run that takes `per_vertex` bytes per vertex of the finest mesh
-/// ([`crate::limits::bytes_per_vertex`]), or unchecked when `None` (a mesh built again for
+/// ([`bytes_per_vertex`]), or unchecked when `None` (a mesh built again for
 /// the writers of a run that already holds its data is not checked against what is left).
 pub(crate) fn build_mesh_checked(
     spec: &MeshSpec,
@@ -140,4 +140,25 @@ fn describe_refinement(spec: &MeshSpec, base: &MeshSize) -> String {
 fn delaunay_size(area: f64, size: f64) -> MeshSize {
     let triangles = (area / (size * size * 3f64.sqrt() / 4.0)).max(1.0);
     MeshSize::simply_connected(triangles / 2.0, triangles)
+}
+
+/// Bytes per vertex of the finest mesh for a run of `problem` (the constants of
+/// [`crate::limits`]): one body with a lumped or rigid foundation, one with the consistent
+/// foundation, or anything else ([`RUN_BYTES_PER_VERTEX`]); `one_solve` for the lean
+/// one-step run of `memcontact solve`.
+pub(crate) fn bytes_per_vertex(problem: &crate::problem::Problem, one_solve: bool) -> f64 {
+    use crate::limits::{
+        CONSISTENT_BYTES_PER_VERTEX, LUMPED_BYTES_PER_VERTEX, ONE_SOLVE_LUMPED_BYTES_PER_VERTEX,
+    };
+    use crate::model::Foundation;
+    if problem.lower.is_some() {
+        return RUN_BYTES_PER_VERTEX;
+    }
+    let o = &problem.obstacle;
+    let lean = o.foundation == Foundation::Lumped || o.stiffness.is_rigid();
+    match (lean, one_solve) {
+        (true, true) => ONE_SOLVE_LUMPED_BYTES_PER_VERTEX,
+        (true, false) => LUMPED_BYTES_PER_VERTEX,
+        (false, _) => CONSISTENT_BYTES_PER_VERTEX,
+    }
 }

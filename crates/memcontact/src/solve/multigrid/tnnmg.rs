@@ -31,10 +31,10 @@ pub struct TnnmgOptions {
     /// Multigrid cycles per Newton correction while the vertex states change (flexible CG
     /// steps preconditioned by the cycle when `krylov_steps > 0`). Three rather than two:
     /// an imported Gmsh mesh of 10⁶ vertices on algebraic levels takes 5 iterations instead
-    /// of 6 (whole run 2.43–2.45 s against 2.68–2.71 s, lumped), the square at N = 2048
-    /// lumped 1.97 s of solve against 2.08 s with the same 3 iterations; consistent
-    /// foundations take as long (four cycles were faster still with a lumped foundation,
-    /// 3 % slower with a consistent one).
+    /// of 6 (lumped; solve 1.54–1.61 s against 1.61–1.67 s in alternating runs), the square
+    /// at N = 2048 lumped 1.93–1.97 s of solve against 2.02–2.08 s with the same 3
+    /// iterations; consistent foundations take as long (four cycles were faster still with
+    /// a lumped foundation, 3 % slower with a consistent one).
     pub cycles: usize,
     /// Once the vertex states (nearly) repeat from one iteration to the next, up to this
     /// many flexible CG steps preconditioned by the cycle per Newton correction. The
