@@ -1,12 +1,16 @@
 """Type stub of the native module (the Rust part of memcontact)."""
 
 from os import PathLike
-from typing import Any, Dict, List, Mapping, Optional, Sequence, Tuple, Union
+from typing import Any, Dict, List, Literal, Mapping, Optional, Sequence, Tuple, Union
 
 import numpy as np
 import numpy.typing as npt
 
 __version__: str
+
+#: The encodings of ``solution.vtu`` (``[output] vtu``): raw appended binary, text, or
+#: zlib-compressed appended binary.
+_VtuEncoding = Literal["binary", "ascii", "compressed"]
 
 class Case:
     """A case file's content: mesh, membrane, obstacle, solver, output, exact."""
@@ -113,7 +117,7 @@ class Result:
         self,
         directory: Union[str, PathLike[str]],
         force: bool = False,
-        vtu: Optional[str] = None,
+        vtu: Optional[_VtuEncoding] = None,
         pictures: bool = True,
     ) -> Dict[str, Any]: ...
 
@@ -160,7 +164,7 @@ class Sweep:
         self,
         directory: Union[str, PathLike[str]],
         force: bool = False,
-        vtu: Optional[str] = None,
+        vtu: Optional[_VtuEncoding] = None,
         pictures: bool = True,
     ) -> List[Dict[str, Any]]:
         """Writes the command-line tool's result set (a directory per step, ``sweep.csv``,
@@ -232,7 +236,7 @@ class Adapt:
         self,
         directory: Union[str, PathLike[str]],
         force: bool = False,
-        vtu: Optional[str] = None,
+        vtu: Optional[_VtuEncoding] = None,
         pictures: bool = True,
     ) -> Dict[str, Any]:
         """Writes the command-line tool's result set (the final step's files with the
