@@ -5,7 +5,7 @@ use crate::report::{self, print_warnings};
 pub use crate::solve_flags::SolveFlags;
 use anyhow::{bail, Result};
 use memcontact::write::WriteOptions;
-use memcontact::{Case, Discretization, Outcome};
+use memcontact::{Case, Outcome};
 use memcontact_plot::write::{self, SweepWriter};
 use std::path::Path;
 use std::time::Instant;
@@ -184,16 +184,9 @@ pub fn check(case_path: &Path, sets: &[String]) -> Result<()> {
     // Building the mesh, binding and assembling checks the data on the mesh (regions,
     // signs, NaN), everything `solve` checks before it solves; the load cases' data are
     // assembled on the mesh too, and the profile line checked against it.
-    // As `solve` builds it: the lean one-step run, or everything kept for a sweep or the
-    // adaptive loop (so that the memory estimate is the one `solve` checks).
     // The memory available is read before the check's own mesh and model take theirs.
     let (available, source) = memcontact::limits::available_memory();
-    let quiet = &mut Progress::new(Verbosity::Quiet);
-    let d = if case.is_sweep() || case.adapt.is_some() {
-        Discretization::new(&case.problem, quiet)?
-    } else {
-        Discretization::for_one_solve(&case.problem, &case.settings, quiet)?
-    };
+    let d = memcontact::run::discretize_as_run(&case, &mut Progress::new(Verbosity::Quiet))?;
     memcontact::run::check_case_on_mesh(&case, d.mesh(), true)?;
     d.check_memory(&case.settings)?;
     if let Some(a) = &case.adapt {
