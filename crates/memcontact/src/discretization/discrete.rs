@@ -238,7 +238,7 @@ impl Discretization {
     }
 
     /// Releases the multigrid levels built beforehand (a solve builds its own again).
-    pub fn release_levels(&mut self) {
+    pub(crate) fn release_levels(&mut self) {
         self.built = None;
     }
 
