@@ -200,9 +200,9 @@ impl PyAdapt {
     /// Writes the result set `memcontact solve` writes for this case into `directory`,
     /// atomically: the final step's `solution.vtu` (with the estimator per triangle),
     /// `nodes.csv`, the pictures (with `mesh.png`; none when `pictures` is false),
-    /// `adapt.csv` and `summary.json` with the loop's totals. `vtu` ("binary", "ascii" or "compressed")
-    /// defaults to the case's `[output] vtu`. A directory holding other files is refused
-    /// unless `force`. Returns the summary.
+    /// `adapt.csv` and `summary.json` with the loop's totals. `vtu` ("binary", "ascii" or
+    /// "compressed") defaults to the case's `[output] vtu`. A directory holding other files
+    /// is refused unless `force`. Returns the summary.
     #[pyo3(signature = (directory, force=false, vtu=None, pictures=true))]
     fn write<'py>(
         &self,

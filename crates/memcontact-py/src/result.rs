@@ -381,9 +381,9 @@ impl PyResult_ {
 
     /// Writes the result set the command-line tool writes (`solution.vtu`, `nodes.csv`,
     /// the pictures of the case's `[output] plots` unless `pictures` is false, and
-    /// `summary.json`) into `directory`, atomically; `vtu` ("binary", "ascii" or "compressed") defaults
-    /// to the case's `[output] vtu`. A directory holding other files is refused unless
-    /// `force`. Returns the summary written.
+    /// `summary.json`) into `directory`, atomically; `vtu` ("binary", "ascii" or
+    /// "compressed") defaults to the case's `[output] vtu`. A directory holding other files
+    /// is refused unless `force`. Returns the summary written.
     #[pyo3(signature = (directory, force=false, vtu=None, pictures=true))]
     fn write<'py>(
         &self,

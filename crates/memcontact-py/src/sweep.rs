@@ -181,9 +181,9 @@ impl PySweep {
     /// `directory`, atomically: a directory per step solved (`step-000`, ... or the load
     /// case's name) with `solution.vtu`, `nodes.csv`, the pictures of the case's `[output]
     /// plots` (unless `pictures` is false) and `summary.json`; then `sweep.csv` and
-    /// `sweep.png`. `vtu` ("binary", "ascii" or "compressed") defaults to the case's `[output] vtu`. A
-    /// directory holding other files is refused unless `force`. Returns the steps'
-    /// summaries.
+    /// `sweep.png`. `vtu` ("binary", "ascii" or "compressed") defaults to the case's
+    /// `[output] vtu`. A directory holding other files is refused unless `force`. Returns
+    /// the steps' summaries.
     #[pyo3(signature = (directory, force=false, vtu=None, pictures=true))]
     fn write<'py>(
         &self,
