@@ -81,21 +81,32 @@ fn rel_diff(a: &[f64], b: &[f64]) -> f64 {
     num / norm_inf(b).max(1e-300)
 }
 
-/// Algebraic TNNMG, with and without nested iteration on the aggregation levels, against
-/// the active-set method, with its energy history monotone.
+/// Algebraic TNNMG, with and without nested iteration on the aggregation levels (and with
+/// nested iteration passing over the level below the finest), against the active-set
+/// method, with its energy history monotone.
 fn agrees_with_active_set(model: &Model, what: &str) {
     let reference = active_set::solve(model, &settings(), None, &mut Silent).unwrap();
-    for nested in [true, false] {
-        let what = format!("{what}, nested {nested}");
+    for (nested, pass_over) in [(true, false), (true, true), (false, false)] {
+        let what = format!("{what}, nested {nested}, passing over {pass_over}");
         let options = TnnmgOptions {
             nested,
+            nested_pass_over_algebraic: if pass_over { 0 } else { usize::MAX },
             ..options()
         };
         let rep = agrees_with(model, &options, &reference.u, &what);
         let levels = Levels::algebraic(&setup_matrix(model), options.coarsest).len();
         let solved = if nested { levels } else { 1 };
-        assert_eq!(rep.levels.len(), solved, "{what}: levels solved");
-        assert!(levels >= 2, "{what}: {levels} levels");
+        assert_eq!(rep.levels.len(), solved, "{what}: levels reported");
+        assert!(levels >= 3, "{what}: {levels} levels");
+        // Only the level below the finest is passed over, and only when asked.
+        for (k, level) in rep.levels.iter().enumerate() {
+            let skipped = nested && pass_over && k + 2 == levels;
+            assert_eq!(
+                level.iterations == 0,
+                skipped,
+                "{what}: level {k}: {level:?}"
+            );
+        }
     }
 }
 
