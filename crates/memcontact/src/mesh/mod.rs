@@ -82,6 +82,24 @@ pub struct MeshQuality {
     pub area: f64,
 }
 
+/// Which of `n` vertices the triangles use (all vertex indices below `n`), marked on all
+/// threads.
+pub(crate) fn used_vertices(n: usize, triangles: &[[u32; 3]]) -> Vec<bool> {
+    use rayon::prelude::*;
+    use std::sync::atomic::{AtomicBool, Ordering::Relaxed};
+    let used: Vec<AtomicBool> = (0..n)
+        .into_par_iter()
+        .with_min_len(8192)
+        .map(|_| AtomicBool::new(false))
+        .collect();
+    triangles.par_iter().with_min_len(8192).for_each(|t| {
+        for &v in t {
+            used[v as usize].store(true, Relaxed);
+        }
+    });
+    used.into_par_iter().map(AtomicBool::into_inner).collect()
+}
+
 impl Mesh {
     /// Builds a mesh and checks it: finite coordinates, valid indices, no degenerate or
     /// inverted triangle, no duplicate or unused vertex, no non-manifold edge. A mesh whose
@@ -222,12 +240,7 @@ impl Mesh {
     /// Unused and duplicate vertices are errors.
     fn check_vertices(&self) -> Result<()> {
         use rayon::prelude::*;
-        let mut used = vec![false; self.points.len()];
-        for t in &self.triangles {
-            for &v in t {
-                used[v as usize] = true;
-            }
-        }
+        let used = used_vertices(self.points.len(), &self.triangles);
         if let Some(v) = used.iter().position(|u| !u) {
             let count = used.iter().filter(|u| !**u).count();
             return Err(Error::Mesh(format!(

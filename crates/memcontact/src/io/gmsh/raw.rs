@@ -88,31 +88,31 @@ impl Raw {
                  a 2-D triangle mesh is needed"
             )));
         }
+        use rayon::prelude::*;
         // Planarity: z must vanish up to round-off relative to the extent of the mesh.
         let extent = nodes
-            .iter()
+            .par_iter()
+            .with_min_len(8192)
             .map(|(_, p)| p[0].abs().max(p[1].abs()))
-            .fold(1.0, f64::max);
-        for (tag, p) in &nodes {
-            if p[2].is_nan() || p[2].abs() > 1e-12 * extent {
-                return Err(ParseOrMesh::Parse(format!(
-                    "$Nodes: node {tag} at ({}, {}, {}) has z ≠ 0: the mesh must lie in the \
-                     plane z = 0",
-                    p[0], p[1], p[2]
-                )));
-            }
+            .reduce(|| 1.0, f64::max);
+        let off_plane = |(_, p): (u64, [f64; 3])| p[2].is_nan() || p[2].abs() > 1e-12 * extent;
+        if let Some(k) = crate::sparse::first_where(&nodes, off_plane) {
+            let (tag, p) = nodes[k];
+            return Err(ParseOrMesh::Parse(format!(
+                "$Nodes: node {tag} at ({}, {}, {}) has z ≠ 0: the mesh must lie in the \
+                 plane z = 0",
+                p[0], p[1], p[2]
+            )));
         }
         // Tag → file index: a table when the tags are dense (as Gmsh writes them), else
         // by sorting (node tags may be sparse and unordered).
         let lookup = TagLookup::new(&nodes).map_err(ParseOrMesh::Parse)?;
-        let mut new_index = vec![u32::MAX; nodes.len()];
         let resolve = |t: &[u64; 3]| -> Option<[u32; 3]> {
             Some([lookup.find(t[0])?, lookup.find(t[1])?, lookup.find(t[2])?])
         };
         // Straight into the triangle array on all threads; a missing node is then named
         // by a scan in file order (the first triangle that references one).
         let resolved: Option<Vec<[u32; 3]>> = {
-            use rayon::prelude::*;
             triangles
                 .par_iter()
                 .with_min_len(8192)
@@ -132,29 +132,38 @@ impl Raw {
                 "$Elements: triangle {etag} references node {n}, which is not in $Nodes"
             )));
         };
-        let regions: Vec<u32> = triangles.iter().map(|t| t.2).collect();
+        let regions: Vec<u32> = triangles
+            .par_iter()
+            .with_min_len(8192)
+            .map(|t| t.2)
+            .collect();
         drop(triangles);
         // Keep the used nodes, in file order (usually all of them: then nothing moves).
-        for t in &tris {
-            for &v in t {
-                new_index[v as usize] = 0;
+        let used = crate::mesh::used_vertices(nodes.len(), &tris);
+        let (points, new_index): (Vec<[f64; 2]>, Vec<u32>) = if used.iter().all(|&u| u) {
+            let points = nodes
+                .par_iter()
+                .with_min_len(8192)
+                .map(|(_, p)| [p[0], p[1]])
+                .collect();
+            (points, Vec::new())
+        } else {
+            let mut new_index = vec![u32::MAX; nodes.len()];
+            let mut points = Vec::with_capacity(nodes.len());
+            for (i, slot) in new_index.iter_mut().enumerate() {
+                if used[i] {
+                    *slot = points.len() as u32;
+                    points.push([nodes[i].1[0], nodes[i].1[1]]);
+                }
             }
-        }
-        let mut points = Vec::with_capacity(nodes.len());
-        for (i, slot) in new_index.iter_mut().enumerate() {
-            if *slot == 0 {
-                *slot = points.len() as u32;
-                points.push([nodes[i].1[0], nodes[i].1[1]]);
-            }
-        }
-        if points.len() < nodes.len() {
-            use rayon::prelude::*;
             tris.par_iter_mut().with_min_len(8192).for_each(|t| {
                 for v in t.iter_mut() {
                     *v = new_index[*v as usize];
                 }
             });
-        }
+            (points, new_index)
+        };
+        drop(used);
         for (&t, &count) in &skipped {
             let name = element_type(t).map_or("unknown type", |e| e.1);
             warnings.push(format!("skipped {count} elements of type {t} ({name})"));
@@ -172,7 +181,15 @@ impl Raw {
             Err(e) => return Err(ParseOrMesh::Mesh(e, warnings)),
         };
         // Lines of physical curves, as vertex pairs (`u32::MAX`: a node no triangle uses).
-        let vertex = |tag: u64| lookup.find(tag).map_or(u32::MAX, |i| new_index[i as usize]);
+        let vertex = |tag: u64| {
+            lookup.find(tag).map_or(u32::MAX, |i| {
+                if new_index.is_empty() {
+                    i
+                } else {
+                    new_index[i as usize]
+                }
+            })
+        };
         let lines: Vec<([u32; 2], u32)> = lines
             .iter()
             .map(|&([a, b], phys)| ([vertex(a), vertex(b)], phys))

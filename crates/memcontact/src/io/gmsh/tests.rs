@@ -315,6 +315,26 @@ fn hand_written_files_read_independently_of_the_writer() {
     assert!(e.to_string().contains("sq41bad.msh"), "{e}");
 }
 
+/// Nodes no triangle uses are dropped with a warning; the triangles and the boundary
+/// curves are renumbered onto the nodes kept, in file order.
+#[test]
+fn unused_nodes_are_dropped_and_the_rest_renumbered() {
+    let (kept, _) = read_msh(&write_text("sq22k.msh", SQUARE_22)).unwrap();
+    let with_unused = SQUARE_22
+        .replace("$Nodes\n5\n10 0 0 0\n", "$Nodes\n7\n5 3 3 0\n10 0 0 0\n")
+        .replace("40 0 1 0\n", "40 0 1 0\n41 -2 5 0\n");
+    let (m, w) = read_msh(&write_text("sq22u.msh", &with_unused)).unwrap();
+    assert_eq!(m.points, kept.points);
+    assert_eq!(m.triangles, kept.triangles);
+    assert_eq!(m.regions, kept.regions);
+    assert_eq!(m.boundary.edges, vec![[0, 1], [1, 2]]);
+    assert_eq!(m.boundary.tags, vec![7, 7]);
+    assert!(
+        w.contains(&"dropped 2 of 7 nodes that no triangle uses".to_string()),
+        "{w:?}"
+    );
+}
+
 #[test]
 fn writer_round_trips_in_all_flavours() {
     let (mesh, _) = read_msh(&data("disk_v41_ascii.msh")).unwrap();
