@@ -107,19 +107,19 @@ impl Raw {
         // Tag → file index: a table when the tags are dense (as Gmsh writes them), else
         // by sorting (node tags may be sparse and unordered).
         let lookup = TagLookup::new(&nodes).map_err(ParseOrMesh::Parse)?;
-        let resolve = |t: &[u64; 3]| -> Option<[u32; 3]> {
-            Some([lookup.find(t[0])?, lookup.find(t[1])?, lookup.find(t[2])?])
-        };
-        // Straight into the triangle array on all threads; a missing node is then named
-        // by a scan in file order (the first triangle that references one).
-        let resolved: Option<Vec<[u32; 3]>> = {
-            triangles
-                .par_iter()
-                .with_min_len(8192)
-                .map(|(_, t, _)| resolve(t))
-                .collect()
-        };
-        let Some(mut tris) = resolved else {
+        // Straight into the triangle array on all threads (an indexed collect, in place),
+        // `u32::MAX` for a missing node; a missing node is then named by a scan in file
+        // order (the first triangle that references one).
+        let mut tris: Vec<[u32; 3]> = triangles
+            .par_iter()
+            .with_min_len(8192)
+            .map(|(_, t, _)| t.map(|tag| lookup.find(tag).unwrap_or(u32::MAX)))
+            .collect();
+        if tris
+            .par_iter()
+            .with_min_len(8192)
+            .any(|t| t.contains(&u32::MAX))
+        {
             let (etag, n) = triangles
                 .iter()
                 .find_map(|(etag, t, _)| {
@@ -131,7 +131,7 @@ impl Raw {
             return Err(ParseOrMesh::Parse(format!(
                 "$Elements: triangle {etag} references node {n}, which is not in $Nodes"
             )));
-        };
+        }
         let regions: Vec<u32> = triangles
             .par_iter()
             .with_min_len(8192)
