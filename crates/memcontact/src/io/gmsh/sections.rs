@@ -398,6 +398,14 @@ pub(super) fn read_elements_v4(
         };
     }
     let blocks = c.check_count(head[0], 8, "the number of element blocks")?;
+    // Room for every element as a triangle (usually most are), so that the blocks' triangles
+    // are not moved as the array grows: capacity only, the pages unused are never touched.
+    let total = c.check_count(
+        head[1],
+        if binary { 8 } else { 2 },
+        "the number of elements",
+    )?;
+    raw.triangles.reserve(total);
     for _ in 0..blocks {
         let (dim, entity, ty, n) = if binary {
             (
