@@ -269,10 +269,23 @@ pub(crate) mod tests {
                 "{x:e} written {text}"
             );
         }
-        for (x, text) in [(0.1, "0.1"), (1e16, "1e16"), (1e-7, "1e-7"), (-0.0, "-0.0")] {
+        for (x, text) in [
+            (0.1, "0.1"),
+            (1e16, "1e16"),
+            (1e-7, "1e-7"),
+            (-0.0, "-0.0"),
+            (0.0, "0.0"),
+        ] {
             buf.clear();
             push_shortest(&mut buf, x);
             assert_eq!(std::str::from_utf8(&buf).unwrap(), text);
+        }
+        // Zero is written without the formatter: as the formatter writes it.
+        for x in [0.0, -0.0] {
+            buf.clear();
+            push_shortest(&mut buf, x);
+            let mut b = zmij::Buffer::new();
+            assert_eq!(buf, b.format_finite(x).as_bytes());
         }
     }
 

@@ -32,6 +32,16 @@ impl DataArray<'_> {
 /// exponents written without a plus sign (`1e16`, `2.5e-7`), the form of every text file
 /// memcontact writes.
 pub fn push_shortest(buf: &mut Vec<u8>, x: f64) {
+    // Zero, the most frequent value of the contact columns (every clear vertex), without
+    // the formatter: the same text it writes.
+    if x == 0.0 {
+        buf.extend_from_slice(if x.is_sign_negative() {
+            b"-0.0"
+        } else {
+            b"0.0"
+        });
+        return;
+    }
     let mut b = zmij::Buffer::new();
     let text = b.format_finite(x).as_bytes();
     // Only numbers of magnitude 1e16 and more are written with a positive exponent.
