@@ -174,9 +174,7 @@ impl Discretization {
 /// A case with steps (`[sweep]`, `[[load_case]]`) is refused: [`super::run_sweep`] runs
 /// those.
 pub fn run(case: &Case, observer: &mut dyn Observer) -> Result<Outcome> {
-    refuse_steps(case)?;
-    case.validate().map_err(Invalid::into_error)?;
-    refuse_adapt(case)?;
+    check_one_step(case)?;
     let observer = &mut solve::Cancellable {
         inner: observer,
         cancel: &case.settings.cancel,
@@ -197,9 +195,7 @@ pub fn run(case: &Case, observer: &mut dyn Observer) -> Result<Outcome> {
 /// the peak memory of a large run is lower. The outcome's discretisation cannot be solved
 /// again.
 pub fn run_for_writing(case: &Case, observer: &mut dyn Observer) -> Result<Outcome> {
-    refuse_steps(case)?;
-    case.validate().map_err(Invalid::into_error)?;
-    refuse_adapt(case)?;
+    check_one_step(case)?;
     let observer = &mut solve::Cancellable {
         inner: observer,
         cancel: &case.settings.cancel,
@@ -248,6 +244,14 @@ pub fn run_problem(
         discretization,
         report,
     })
+}
+
+/// What the one-step runs ([`run`], [`run_for_writing`]) refuse before any work: a case
+/// with steps, an invalid case, a case with `[adapt]`.
+fn check_one_step(case: &Case) -> Result<()> {
+    refuse_steps(case)?;
+    case.validate().map_err(Invalid::into_error)?;
+    refuse_adapt(case)
 }
 
 /// A case with steps is refused by the one-step runs.

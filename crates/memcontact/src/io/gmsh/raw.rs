@@ -140,13 +140,14 @@ impl Raw {
         drop(triangles);
         // Keep the used nodes, in file order (usually all of them: then nothing moves).
         let used = crate::mesh::used_vertices(nodes.len(), &tris);
-        let (points, new_index): (Vec<[f64; 2]>, Vec<u32>) = if used.iter().all(|&u| u) {
+        // The new index of every node kept, when some are dropped.
+        let (points, renumbered): (Vec<[f64; 2]>, Option<Vec<u32>>) = if used.iter().all(|&u| u) {
             let points = nodes
                 .par_iter()
                 .with_min_len(8192)
                 .map(|(_, p)| [p[0], p[1]])
                 .collect();
-            (points, Vec::new())
+            (points, None)
         } else {
             let mut new_index = vec![u32::MAX; nodes.len()];
             let mut points = Vec::with_capacity(nodes.len());
@@ -161,7 +162,7 @@ impl Raw {
                     *v = new_index[*v as usize];
                 }
             });
-            (points, new_index)
+            (points, Some(new_index))
         };
         drop(used);
         for (&t, &count) in &skipped {
@@ -183,11 +184,7 @@ impl Raw {
         // Lines of physical curves, as vertex pairs (`u32::MAX`: a node no triangle uses).
         let vertex = |tag: u64| {
             lookup.find(tag).map_or(u32::MAX, |i| {
-                if new_index.is_empty() {
-                    i
-                } else {
-                    new_index[i as usize]
-                }
+                renumbered.as_ref().map_or(i, |r| r[i as usize])
             })
         };
         let lines: Vec<([u32; 2], u32)> = lines

@@ -56,71 +56,33 @@ const MATCH_BLOCK: usize = 1 << 16;
 fn pairwise(a: &Csr) -> (Vec<u32>, usize) {
     use rayon::prelude::*;
     let n = a.n();
-    let mut agg = vec![NONE; n];
     if n < 2 * MATCH_BLOCK {
-        let count = pairwise_range(a, 0, &mut agg, &mut MatchScratch::default());
-        return (agg, count);
+        return pairwise_range(a, 0, n);
     }
-    // Each block numbers its aggregates from 0 in its own part of `agg` (the scratch
-    // space reused from block to block on a thread), then the blocks' offsets are added.
-    let counts: Vec<usize> = agg
-        .par_chunks_mut(MATCH_BLOCK)
-        .enumerate()
-        .map_init(MatchScratch::default, |scratch, (b, part)| {
-            pairwise_range(a, b * MATCH_BLOCK, part, scratch)
-        })
+    let parts: Vec<(Vec<u32>, usize)> = (0..n.div_ceil(MATCH_BLOCK))
+        .into_par_iter()
+        .map(|b| pairwise_range(a, b * MATCH_BLOCK, ((b + 1) * MATCH_BLOCK).min(n)))
         .collect();
-    let offsets: Vec<u32> = counts
-        .iter()
-        .scan(0u32, |sum, &c| {
-            let first = *sum;
-            *sum += c as u32;
-            Some(first)
-        })
-        .collect();
-    agg.par_chunks_mut(MATCH_BLOCK)
-        .zip(offsets)
-        .for_each(|(part, offset)| {
-            for g in part.iter_mut().filter(|g| **g != NONE) {
-                *g += offset;
-            }
-        });
-    (agg, counts.iter().sum())
+    let mut agg = Vec::with_capacity(n);
+    let mut count = 0usize;
+    for (local, c) in parts {
+        let offset = count as u32;
+        agg.extend(
+            local
+                .iter()
+                .map(|&g| if g == NONE { NONE } else { g + offset }),
+        );
+        count += c;
+    }
+    (agg, count)
 }
 
-/// The work space of [`pairwise_range`], kept from one block to the next.
-#[derive(Default)]
-struct MatchScratch {
-    free: Vec<bool>,
-    threshold: Vec<f64>,
-    /// The strong neighbours of row `i` are `col[start[i]..start[i + 1]]` (local indices),
-    /// with their couplings in `val`.
-    start: Vec<usize>,
-    col: Vec<u32>,
-    val: Vec<f64>,
-    degree: Vec<u32>,
-    buckets: Vec<Vec<u32>>,
-    renumber: Vec<u32>,
-}
-
-/// [`pairwise`] on the rows `lo..lo + agg.len()` alone (couplings to other rows ignored):
-/// the aggregate of each row into `agg` (numbered from 0, [`NONE`] for none); returns the
-/// number of aggregates.
-fn pairwise_range(a: &Csr, lo: usize, agg: &mut [u32], scratch: &mut MatchScratch) -> usize {
-    let m = agg.len();
-    let hi = lo + m;
-    let MatchScratch {
-        free,
-        threshold,
-        start,
-        col,
-        val,
-        degree,
-        buckets,
-        renumber,
-    } = scratch;
-    free.clear();
-    threshold.clear();
+/// [`pairwise`] on the rows `lo..hi` alone (couplings to other rows ignored); aggregates
+/// numbered from 0.
+fn pairwise_range(a: &Csr, lo: usize, hi: usize) -> (Vec<u32>, usize) {
+    let m = hi - lo;
+    let mut free = vec![true; m];
+    let mut threshold = vec![0.0; m];
     for i in lo..hi {
         let (cols, vals) = a.row(i);
         let (mut diag, mut off, mut strongest) = (0.0, 0.0, 0.0f64);
@@ -132,15 +94,14 @@ fn pairwise_range(a: &Csr, lo: usize, agg: &mut [u32], scratch: &mut MatchScratc
                 strongest = strongest.max(-v);
             }
         }
-        free.push(diag > 0.0 && diag < DOMINANT * off);
-        threshold.push(BETA * strongest);
+        free[i - lo] = diag > 0.0 && diag < DOMINANT * off;
+        threshold[i - lo] = BETA * strongest;
     }
     // The strong neighbours of every row taking part, listed once (the matching visits
     // them up to three times): negative couplings above [`BETA`] times the strongest of
     // the row, to rows of the range taking part. Local indices, in column order.
-    start.clear();
-    col.clear();
-    val.clear();
+    let mut start = Vec::with_capacity(m + 1);
+    let mut strong: Vec<(u32, f64)> = Vec::with_capacity(8 * m);
     start.push(0);
     for i in lo..hi {
         if free[i - lo] {
@@ -149,23 +110,18 @@ fn pairwise_range(a: &Csr, lo: usize, agg: &mut [u32], scratch: &mut MatchScratc
             for (&j, &v) in cols.iter().zip(vals) {
                 let j = j as usize;
                 if j != i && (lo..hi).contains(&j) && free[j - lo] && -v > t {
-                    col.push((j - lo) as u32);
-                    val.push(v);
+                    strong.push(((j - lo) as u32, v));
                 }
             }
         }
-        start.push(col.len());
+        start.push(strong.len());
     }
-    let of = |i: usize| start[i]..start[i + 1];
-    agg.fill(NONE);
+    let of = |i: usize| &strong[start[i]..start[i + 1]];
+    let mut agg = vec![NONE; m];
     // A bucket queue by the number of unmatched strong neighbours, with lazy deletion.
-    degree.clear();
-    degree.extend(start.windows(2).map(|w| (w[1] - w[0]) as u32));
+    let mut degree: Vec<u32> = (0..m).map(|i| of(i).len() as u32).collect();
     let top = degree.iter().copied().max().unwrap_or(0) as usize;
-    buckets.iter_mut().for_each(Vec::clear);
-    if buckets.len() < top + 1 {
-        buckets.resize_with(top + 1, Vec::new);
-    }
+    let mut buckets: Vec<Vec<u32>> = vec![Vec::new(); top + 1];
     for i in (0..m).rev() {
         if free[i] {
             buckets[degree[i] as usize].push(i as u32);
@@ -174,7 +130,7 @@ fn pairwise_range(a: &Csr, lo: usize, agg: &mut [u32], scratch: &mut MatchScratc
     let mut lowest = 0usize;
     let mut count = 0u32;
     loop {
-        while lowest <= top && buckets[lowest].is_empty() {
+        while lowest < buckets.len() && buckets[lowest].is_empty() {
             lowest += 1;
         }
         let Some(i) = buckets.get_mut(lowest).and_then(Vec::pop) else {
@@ -185,15 +141,14 @@ fn pairwise_range(a: &Csr, lo: usize, agg: &mut [u32], scratch: &mut MatchScratc
             continue; // matched, or queued again with a smaller degree
         }
         let mut best: Option<(usize, f64)> = None;
-        for e in of(i) {
-            let (j, v) = (col[e], val[e]);
+        for &(j, v) in of(i) {
             if agg[j as usize] == NONE && best.is_none_or(|(_, b)| v < b) {
                 best = Some((j as usize, v));
             }
         }
         for r in std::iter::once(i).chain(best.map(|b| b.0)) {
             agg[r] = count;
-            for &k in &col[of(r)] {
+            for &(k, _) in of(r) {
                 let k = k as usize;
                 if agg[k] == NONE && degree[k] > 0 {
                     degree[k] -= 1;
@@ -204,17 +159,16 @@ fn pairwise_range(a: &Csr, lo: usize, agg: &mut [u32], scratch: &mut MatchScratc
         }
         count += 1;
     }
-    number_in_row_order(agg, count as usize, renumber);
-    count as usize
+    number_in_row_order(&mut agg, count as usize);
+    (agg, count as usize)
 }
 
 /// Renumbers the aggregates `agg` (`NONE` for none) by their first row, so that the coarse
 /// unknowns follow the fine rows' order: the matching numbers them in the order the bucket
 /// queue visits them, scattered over the rows, and the coarse levels would lose the
 /// fine level's locality (in the Galerkin products, the transfers and the smoothing sweeps).
-fn number_in_row_order(agg: &mut [u32], count: usize, new: &mut Vec<u32>) {
-    new.clear();
-    new.resize(count, NONE);
+fn number_in_row_order(agg: &mut [u32], count: usize) {
+    let mut new = vec![NONE; count];
     let mut next = 0u32;
     for g in agg.iter_mut().filter(|g| **g != NONE) {
         let slot = &mut new[*g as usize];
@@ -243,18 +197,10 @@ pub fn hierarchy(a: &Csr, coarsest: usize) -> (Vec<Transfer>, Vec<usize>, Vec<Ar
             break;
         }
         // Two pairwise matchings, composed.
-        let t0 = std::time::Instant::now();
         let (first, n1) = pairwise(fine);
-        if std::env::var_os("MC_DBG").is_some() {
-            eprintln!("DBG pair1 n={n} {:.4}", t0.elapsed().as_secs_f64());
-        }
         let t1 = Transfer::aggregation(&first, n1);
         let a1 = galerkin(fine, &t1);
-        let t0 = std::time::Instant::now();
         let (second, n2) = pairwise(&a1);
-        if std::env::var_os("MC_DBG").is_some() {
-            eprintln!("DBG pair2 n={} {:.4}", a1.n(), t0.elapsed().as_secs_f64());
-        }
         let agg: Vec<u32> = first
             .par_iter()
             .with_min_len(8192)

@@ -525,17 +525,7 @@ fn backward_sweep_with_product_is_the_sweep_and_its_product() {
             shift: &shift,
             held: &held,
         };
-        let b: Vec<f64> = (0..n).map(|i| ((i as f64) * 0.71).sin()).collect();
-        // A start that is zero on the held unknowns, as the cycle leaves it.
-        let x0: Vec<f64> = (0..n)
-            .map(|i| {
-                if held[i] {
-                    0.0
-                } else {
-                    ((i as f64) * 0.3).cos()
-                }
-            })
-            .collect();
+        let (b, x0) = rhs_and_start(&held);
         let rows = SweepRows::of(&model.s.pattern);
         let check = |name: &str,
                      fused: &dyn Fn(usize) -> (Vec<f64>, Vec<f64>),
@@ -739,16 +729,7 @@ fn sweeps_divide_by_the_diagonal_they_read_as_by_the_stored_inverse() {
         let mut inv = vec![0.0; n];
         fill_inv_diag(&op, &mut inv);
         assert!(inv.iter().filter(|&&d| d == 0.0).count() > n / 7);
-        let b: Vec<f64> = (0..n).map(|i| ((i as f64) * 0.71).sin()).collect();
-        let start: Vec<f64> = (0..n)
-            .map(|i| {
-                if held[i] {
-                    0.0
-                } else {
-                    ((i as f64) * 0.3).cos()
-                }
-            })
-            .collect();
+        let (b, start) = rhs_and_start(&held);
         let ways = [InvDiag::Stored(&inv), InvDiag::Rows(&rows), InvDiag::Search];
         let runs: Vec<[Vec<f64>; 5]> = ways
             .iter()
@@ -767,4 +748,21 @@ fn sweeps_divide_by_the_diagonal_they_read_as_by_the_stored_inverse() {
         assert_eq!(runs[0], runs[1], "{levels} levels: offsets");
         assert_eq!(runs[0], runs[2], "{levels} levels: searched");
     }
+}
+
+/// A right-hand side and a start for the smoother tests on `held.len()` unknowns: the start
+/// is zero on the held unknowns, as the cycle leaves it.
+fn rhs_and_start(held: &[bool]) -> (Vec<f64>, Vec<f64>) {
+    let n = held.len();
+    let b = (0..n).map(|i| ((i as f64) * 0.71).sin()).collect();
+    let start = (0..n)
+        .map(|i| {
+            if held[i] {
+                0.0
+            } else {
+                ((i as f64) * 0.3).cos()
+            }
+        })
+        .collect();
+    (b, start)
 }
