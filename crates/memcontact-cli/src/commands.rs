@@ -178,6 +178,14 @@ fn not_converged(outcome: &Outcome) -> String {
         .unwrap_or_default()
 }
 
+/// `memcontact check --fragment`: a fragment of a case, checked key by key
+/// ([`Case::from_fragment_str`]).
+pub fn check_fragment(path: &Path, sets: &[String]) -> Result<()> {
+    Case::load_fragment(path, sets)?;
+    println!("fragment {}: valid", path.display());
+    Ok(())
+}
+
 /// `memcontact check`.
 pub fn check(case_path: &Path, sets: &[String]) -> Result<()> {
     let case = Case::load(case_path, sets)?;

@@ -9,6 +9,7 @@
 mod adapt;
 mod exact;
 mod file;
+pub mod keys;
 mod output;
 mod overrides;
 mod sweep;
