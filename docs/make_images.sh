@@ -30,6 +30,8 @@ cp "$TMP/roof-corner/mesh.png" "$IMAGES/adapt-mesh.png"
 
 
 PYTHON="${PYTHON:-python3}"
+# A path to an interpreter (a virtual environment's) holds from the scratch directory too.
+case "$PYTHON" in */*) PYTHON="$(cd "$(dirname "$PYTHON")" && pwd)/$(basename "$PYTHON")" ;; esac
 if "$PYTHON" -c 'import memcontact, matplotlib' 2>/dev/null; then
     cp -r examples "$TMP/examples"
     (cd "$TMP" && MPLBACKEND=Agg "$PYTHON" - <<'PY'
