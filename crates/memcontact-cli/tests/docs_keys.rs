@@ -35,8 +35,7 @@ fn docs() -> PathBuf {
 /// row that starts with "| `". The page's title must name the section.
 fn documented_keys(page: &str, title: &str) -> Vec<String> {
     let path = docs().join(page);
-    let text = std::fs::read_to_string(&path)
-        .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    let text = std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
     let heading = text.lines().next().unwrap_or("");
     assert!(
         heading.starts_with("# ") && heading.contains(title),
