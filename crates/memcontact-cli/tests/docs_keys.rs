@@ -4,7 +4,6 @@
 //! drift from the other. A key the program accepts must have a sample here (the check is
 //! strict: a key not accepted is refused, naming it), and so a row in the docs.
 
-use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 mod common;
@@ -237,4 +236,45 @@ fn a_key_the_docs_do_not_list_is_refused_naming_it() {
     let o = run(&["check", path.to_str().unwrap()]);
     assert!(!o.status.success());
     assert!(text(&o).contains("freed"), "{}", text(&o));
+}
+
+/// The pages of the documentation list the sections and keys of the program's own key
+/// list (`memcontact::case::keys`), and `solve --help` and `check --help` print them all:
+/// the help, the docs and the parser cannot drift apart.
+#[test]
+fn the_help_prints_every_section_and_key_the_docs_list() {
+    let listed = memcontact::case::keys::SECTIONS;
+    assert_eq!(
+        listed.iter().map(|s| s.name).collect::<Vec<_>>(),
+        SECTIONS.iter().map(|s| s.0).collect::<Vec<_>>(),
+        "the docs' pages and the key list name the same sections, in the same order"
+    );
+    for command in ["solve", "check"] {
+        let o = run(&[command, "--help"]);
+        assert!(o.status.success());
+        let help = text(&o);
+        for ((name, page, title), section) in SECTIONS.iter().zip(listed) {
+            assert!(
+                help.contains(&section.heading()),
+                "{command} --help lacks {name}"
+            );
+            let mut documented = documented_keys(page, title);
+            documented.sort();
+            documented.dedup();
+            let mut keys: Vec<String> = section.keys.iter().map(|k| k.name.to_string()).collect();
+            keys.sort();
+            assert_eq!(
+                documented, keys,
+                "docs/case-file/{page} against the key list"
+            );
+            let block = &help[help.find(&section.heading()).unwrap()..];
+            for k in section.keys {
+                assert!(
+                    block.contains(k.name),
+                    "{command} --help: {name}.{}",
+                    k.name
+                );
+            }
+        }
+    }
 }

@@ -107,14 +107,6 @@ def scratch(tmp_path: Path) -> Path:
     return tmp_path
 
 
-@pytest.fixture(scope="session")
-def has_fragment(cli: Path) -> bool:
-    help_text = subprocess.run(
-        [str(cli), "check", "--help"], capture_output=True, text=True
-    ).stdout
-    return "--fragment" in help_text
-
-
 def is_complete(text: str) -> bool:
     return re.search(r"^\s*\[mesh\]\s*(#.*)?$", text, re.M) is not None
 
@@ -126,10 +118,8 @@ def test_the_docs_have_cases_and_snippets() -> None:
 
 
 @pytest.mark.parametrize("block", TOML, ids=_id)
-def test_toml_block(block: Block, cli: Path, scratch: Path, has_fragment: bool) -> None:
+def test_toml_block(block: Block, cli: Path, scratch: Path) -> None:
     complete = is_complete(block.text)
-    if not complete and not has_fragment:
-        pytest.xfail("memcontact check has no --fragment flag yet")
     # Inside the copy of examples/, so that `file = "disk.msh"` resolves.
     path = scratch / "examples" / "_docs_block.toml"
     path.write_text(block.text, encoding="utf-8")
