@@ -9,9 +9,9 @@ use crate::solve_flags::SolveFlags;
 use anyhow::{bail, Result};
 use memcontact::outcome::{AdaptRow, Outcome};
 use memcontact::solve::{IterationRecord, Observer};
+use memcontact::write::{adapt_pictures, pictures, plot_options};
 use memcontact::write::{AdaptHistory, AdaptSet, WriteOptions};
 use memcontact::Case;
-use memcontact_plot::write::{adapt_pictures, pictures, plot_options};
 use std::cell::RefCell;
 use std::time::Instant;
 
@@ -76,7 +76,7 @@ pub fn adapt(
             None => set.insert(AdaptSet::begin(flags.out, flags.force)?),
         };
         if keep && (outcome.report.accepted || flags.write_unconverged) {
-            let step_plots = memcontact_plot::PlotOptions {
+            let step_plots = memcontact::write::PlotOptions {
                 title: Some(format!("{label} [step {}]", row.step)),
                 ..plots.clone()
             };

@@ -5,8 +5,8 @@ use crate::report::{self, print_warnings};
 pub use crate::solve_flags::SolveFlags;
 use anyhow::{bail, Result};
 use memcontact::write::WriteOptions;
+use memcontact::write::{self, SweepWriter};
 use memcontact::{Case, Outcome};
-use memcontact_plot::write::{self, SweepWriter};
 use std::path::Path;
 use std::time::Instant;
 

@@ -1,5 +1,5 @@
 //! What `memcontact solve` shows: the human summary on the terminal. The result files are
-//! the library's (`memcontact::write`), with their pictures (`memcontact_plot::write`).
+//! the library's (`memcontact::write`), with their pictures.
 
 use memcontact::mesh::{Mesh, MeshQuality};
 use memcontact::{Discretization, Outcome, Summary};

@@ -15,12 +15,12 @@
 //! Maps are rasterised here (every pixel centre interpolates the nodal field in the
 //! triangle that covers it, see [`raster`]), in parallel and deterministically, so that a
 //! mesh of a million vertices is drawn in a fraction of a second. Also here: the log-log
-//! convergence plot and an x-y line plot (e.g. a force-deflection curve), and a reader for
-//! the VTU files the library writes, so that pictures can be redrawn from a result
-//! directory ([`result`]), and the writers of result sets with their pictures, single
-//! solves and sweeps alike ([`write`]).
+//! convergence plot and an x-y line plot (e.g. a force-deflection curve).
 //!
-//! The crate prints nothing: errors are returned, notes are handed back to the caller.
+//! The crate only draws: it takes plain arrays (points, triangles, nodal fields) and gives
+//! back pictures in memory ([`Canvas`], PNG bytes). It knows nothing of cases, solvers or
+//! files; the `memcontact` library writes the pictures into its result sets and redraws
+//! them from a result directory. It prints nothing: errors are returned.
 
 pub mod axes;
 pub mod bodies;
@@ -31,25 +31,41 @@ pub mod loglog;
 mod maps;
 pub mod profile;
 pub mod raster;
-pub mod result;
+pub mod segment;
 pub mod text;
 pub mod ticks;
-pub mod vtu;
-pub mod write;
 
 pub use axes::{hatch_color, HATCH_SPACING};
 pub use canvas::{Canvas, PixelRect};
-pub use lines::{line_plot, LinePlot, Series};
+pub use lines::{render_line_plot, LinePlot, Series};
 pub use loglog::loglog_plot;
 pub use maps::{
     field_plot, mesh_plot, MapLayout, Picture, CONTACT, NOT_COVERED, OUTLINE, PRESSURE_OUTLINE,
 };
 pub use raster::MapTransform;
 
-use memcontact::{Error, Result};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
-use std::path::{Path, PathBuf};
+
+/// Why a picture could not be drawn: the data or options at fault, named.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Error {
+    /// Bad data or options (lengths, indices, non-finite values, an empty plot).
+    Data(String),
+}
+
+impl std::fmt::Display for Error {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Error::Data(m) => f.write_str(m),
+        }
+    }
+}
+
+impl std::error::Error for Error {}
+
+/// The result of drawing.
+pub type Result<T> = std::result::Result<T, Error>;
 
 /// Width of the map pictures (deflection, pressure, lift-off), pixels.
 pub const MAP_WIDTH: u32 = 1300;
@@ -344,18 +360,4 @@ pub fn render_kind(
         PlotKind::Profile => profile::render(data, options),
         k => maps::render(k, layout, data, options),
     }
-}
-
-/// Draws the pictures `options.plots` into `dir` (`deflection.png`, `pressure.png`,
-/// `liftoff.png`, `profile.png`), each written atomically; returns the files written.
-pub fn draw_all(dir: &Path, data: &PlotData, options: &PlotOptions) -> Result<Vec<PathBuf>> {
-    let pictures = render(data, options)?;
-    pictures
-        .par_iter()
-        .map(|p| {
-            let path = dir.join(p.kind.file_name());
-            p.canvas.write_png(&path)?;
-            Ok(path)
-        })
-        .collect()
 }

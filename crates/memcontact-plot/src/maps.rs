@@ -12,10 +12,9 @@ use crate::colormap::{self, Colormap, Norm};
 use crate::raster::{self, Fragments, MapTransform, EMPTY};
 use crate::text::{self, Anchor, Style};
 use crate::ticks;
+use crate::{Error, Result};
 use crate::{PlotData, PlotKind, PlotOptions, Units, MAP_HEIGHT, MAP_WIDTH};
-use memcontact::{Error, Result};
 use rayon::prelude::*;
-use std::path::Path;
 
 /// The area the map frame is fitted into.
 const MAP_AREA: PixelRect = PixelRect {
@@ -723,23 +722,22 @@ pub(crate) fn titled(name: &str, options: &PlotOptions) -> String {
     }
 }
 
-/// Writes a colour map of any nodal field over a triangle mesh as a
+/// Draws a colour map of any nodal field over a triangle mesh as a
 /// [`MAP_WIDTH`] × [`MAP_HEIGHT`] PNG: smooth (P1-interpolated) viridis colours, labelled
 /// contour lines, the mesh boundary, axes of equal scale and a colour bar over the data
 /// range, titled `title`. For a quick look at a field the four standard pictures do not
 /// show. Errors: `values` not one per point, a triangle referring to a missing point, no
 /// finite value.
 pub fn field_plot(
-    path: &Path,
     points: &[[f64; 2]],
     triangles: &[[u32; 3]],
     values: &[f64],
     title: &str,
-) -> Result<()> {
+) -> Result<Canvas> {
     if values.len() != points.len() {
         return Err(Error::Data(format!(
             "field plot {}: {} values for {} points",
-            path.display(),
+            title,
             values.len(),
             points.len()
         )));
@@ -751,13 +749,13 @@ pub fn field_plot(
     {
         return Err(Error::Data(format!(
             "field plot {}: triangle {k} {t:?} refers to a missing point",
-            path.display()
+            title
         )));
     }
     let Some((lo, hi)) = range(values, |_| true) else {
         return Err(Error::Data(format!(
             "field plot {}: no finite value",
-            path.display()
+            title
         )));
     };
     if triangles.is_empty()
@@ -767,7 +765,7 @@ pub fn field_plot(
     {
         return Err(Error::Data(format!(
             "field plot {}: the mesh has no triangle or a non-finite coordinate",
-            path.display()
+            title
         )));
     }
     let mut b = [
@@ -818,20 +816,19 @@ pub fn field_plot(
         &entries,
         &mut boxes,
     );
-    canvas.write_png(path)
+    Ok(canvas)
 }
 
 /// The mesh picture of an adaptive run (`mesh.png`): every edge of the mesh, the
 /// boundary, and the outline of the contact zone (`contact`: per vertex, in contact with
 /// a body), titled `title`, with the vertex and triangle counts in the legend.
 pub fn mesh_plot(
-    path: &Path,
     points: &[[f64; 2]],
     triangles: &[[u32; 3]],
     contact: &[bool],
     title: &str,
     units: &Units,
-) -> Result<()> {
+) -> Result<Canvas> {
     if contact.len() != points.len()
         || triangles.is_empty()
         || points
@@ -844,7 +841,7 @@ pub fn mesh_plot(
         return Err(Error::Data(format!(
             "mesh picture {}: {} contact flags, {} points, {} triangles (a triangle out of \
              range or a non-finite coordinate?)",
-            path.display(),
+            title,
             contact.len(),
             points.len(),
             triangles.len()
@@ -915,5 +912,5 @@ pub fn mesh_plot(
         &entries,
         &mut boxes,
     );
-    canvas.write_png(path)
+    Ok(canvas)
 }

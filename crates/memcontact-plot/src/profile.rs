@@ -5,8 +5,8 @@
 use crate::axes::{self, Axes, Swatch};
 use crate::canvas::{Canvas, Coverage, PixelRect, Rgb};
 use crate::ticks;
+use crate::{Error, Result};
 use crate::{Picture, PlotData, PlotKind, PlotOptions, PROFILE_HEIGHT, PROFILE_WIDTH};
-use memcontact::{Error, Result};
 use rayon::prelude::*;
 
 /// Colour of u.
@@ -47,7 +47,7 @@ fn pieces(data: &PlotData, a: [f64; 2], b: [f64; 2]) -> Vec<Piece> {
             let mut out = Vec::new();
             for t in chunk {
                 let Some(([lo, hi], ab)) =
-                    memcontact::mesh::segment::clip(t.map(|v| data.points[v as usize]), a, d)
+                    crate::segment::clip(t.map(|v| data.points[v as usize]), a, d)
                 else {
                     continue;
                 };

@@ -161,7 +161,7 @@ impl PyStudy {
         crate::convert::detached(py, || {
             write_study(&directory, force, &self.case, &self.outcome, &mut |dir| {
                 if pictures {
-                    memcontact_plot::write::study_pictures(dir, &self.outcome, &file_name)
+                    memcontact::write::study_pictures(dir, &self.outcome, &file_name)
                 } else {
                     Ok(Vec::new())
                 }

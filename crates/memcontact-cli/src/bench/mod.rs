@@ -156,8 +156,8 @@ pub fn run_case(case: &Case, scratch: &Path, pictures: bool) -> Result<CaseRun> 
         cell_data: Vec::new(),
         adapt: None,
     };
-    let plots = memcontact_plot::write::plot_options(&case, "bench");
-    let written = memcontact_plot::write::write_result(&dir, &outcome, &case, &options, &plots);
+    let plots = memcontact::write::plot_options(&case, "bench");
+    let written = memcontact::write::write_result(&dir, &outcome, &case, &options, &plots);
     let write = t_write.elapsed().as_secs_f64();
     let total = started.elapsed().as_secs_f64();
     let stolen = stolen_seconds()

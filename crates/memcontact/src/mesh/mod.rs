@@ -8,7 +8,6 @@ pub mod mark;
 pub mod refine;
 pub mod regions;
 pub mod reorder;
-pub mod segment;
 
 pub use boundary::BoundaryRegions;
 

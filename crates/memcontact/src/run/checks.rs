@@ -40,7 +40,7 @@ pub fn check_profile_on_mesh(case: &Case, mesh: &Mesh) -> Result<()> {
     let Some([a, b]) = case.output.profile else {
         return Ok(());
     };
-    if crate::mesh::segment::crosses(&mesh.points, &mesh.triangles, a, b) {
+    if memcontact_plot::segment::crosses(&mesh.points, &mesh.triangles, a, b) {
         return Ok(());
     }
     let (mut x0, mut x1, mut y0, mut y1) = (

@@ -12,6 +12,8 @@
 
 mod adapt;
 mod manifest;
+mod pictures;
+mod redraw;
 mod result;
 mod study;
 mod sweep;
@@ -20,6 +22,13 @@ mod tests;
 
 pub use adapt::{write_adapt_csv, AdaptHistory, AdaptSet, ADAPT_CSV};
 pub use manifest::{write_manifest, Manifest, MANIFEST};
+pub use memcontact_plot::{PlotKind, PlotOptions, Units as PlotUnits};
+pub use pictures::{
+    adapt_pictures, draw_all, pictures, plot_options, steps_kind, study_pictures, sweep_picture,
+    write_png, write_result, SweepWriter, CONVERGENCE_PICTURE, H_SWEEP_PICTURE, MESH_PICTURE,
+    SWEEP_PICTURE,
+};
+pub use redraw::{load as load_result, Loaded, ResultData};
 pub use result::{
     file_record, input_hash, new_run_id, write_fields, write_files, write_result_set, WriteOptions,
     LOWER_FIELDS, NODAL_FIELDS,

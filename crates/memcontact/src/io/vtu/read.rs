@@ -1,10 +1,10 @@
-//! A reader for the VTK XML UnstructuredGrid (`.vtu`) files of triangle meshes that
-//! `memcontact::io::vtu` writes: ASCII arrays, or one raw appended block
+//! The reader of the VTK XML UnstructuredGrid (`.vtu`) files of triangle meshes that the
+//! writer beside it writes (so that `memcontact plot` redraws a result directory): ASCII arrays, or one raw appended block
 //! (`<AppendedData encoding="raw">`, `UInt32` or `UInt64` size headers, little-endian),
 //! plain or zlib-compressed in blocks (`compressor="vtkZLibDataCompressor"`). Base64 and
 //! other compressors are refused with a clear message.
 
-use memcontact::{Error, Result};
+use crate::error::{Error, Result};
 use std::path::Path;
 
 /// A data array of the file: name, VTK type, components, values (integers as exact f64).
@@ -399,8 +399,8 @@ fn find(hay: &[u8], needle: &[u8]) -> Option<usize> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use memcontact::io::vtu::{write_vtu, DataArray, VtuEncoding};
-    use memcontact::mesh::Mesh;
+    use crate::io::vtu::{write_vtu, DataArray, VtuEncoding};
+    use crate::mesh::Mesh;
 
     #[test]
     fn reads_back_what_the_library_writes_exactly() {

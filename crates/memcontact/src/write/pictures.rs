@@ -1,23 +1,27 @@
-//! Result sets with their pictures, as `memcontact solve` writes them and the Python
-//! module's `write` writes them too: the library's files ([`memcontact::write`]) plus
-//! the pictures of the case's `[output]` section, and for a sweep or load cases a
-//! directory per step, `sweep.csv` and the force-deflection picture `sweep.png`.
+//! Result sets with their pictures, as `memcontact solve` and the Python module's `write`
+//! write them: the files of [`super::write_result_set`] plus the pictures of the case's
+//! `[output]` section (drawn by the picture crate, `memcontact_plot`, and written here),
+//! and for a sweep or load cases a directory per step, `sweep.csv` and the
+//! force-deflection picture `sweep.png`.
 //!
 //! The picture options stored in each `summary.json` are the ones the pictures were drawn
 //! with (title included), so that `memcontact plot DIR` redraws identical files.
 
-use crate::bodies::{merge, BodyFields};
-use crate::{draw_all, line_plot, LinePlot, PlotData, PlotKind, PlotOptions, Series, Units};
-use memcontact::case::StepSpec;
-use memcontact::case::{PictureKind, VtuFormat};
-use memcontact::mesh::Mesh;
-use memcontact::outcome::fields::NodalFields;
-use memcontact::outcome::StepRow;
-use memcontact::verify::convergence::LevelResult;
-use memcontact::verify::study::{StudyOutcome, StudyResult};
-use memcontact::write::{step_label, write_result_set, SweepSet, WriteOptions};
-use memcontact::{Case, Error, Outcome, Result, Summary};
-use std::path::Path;
+use super::{step_label, write_result_set, SweepSet, WriteOptions};
+use crate::case::StepSpec;
+use crate::case::{Case, PictureKind, VtuFormat};
+use crate::error::{Error, Result};
+use crate::mesh::Mesh;
+use crate::outcome::fields::NodalFields;
+use crate::outcome::{Outcome, StepRow, Summary};
+use crate::verify::convergence::LevelResult;
+use crate::verify::study::{StudyOutcome, StudyResult};
+use memcontact_plot::bodies::{merge, BodyFields};
+use memcontact_plot::{
+    render, render_line_plot, Canvas, LinePlot, PlotData, PlotKind, PlotOptions, Series, Units,
+};
+use rayon::prelude::*;
+use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
 /// The file name of the force-deflection picture of a sweep.
@@ -56,7 +60,27 @@ pub fn plot_options(case: &Case, label: &str) -> PlotOptions {
     }
 }
 
-/// The pictures of `options` as the `extra` files of [`memcontact::write::write_files`]:
+/// Writes a picture as a PNG file, atomically.
+pub fn write_png(path: &Path, canvas: &Canvas) -> Result<()> {
+    let png = canvas.encode_png()?;
+    crate::io::write_atomic(path, |w| w.write_all(&png)).map(|_| ())
+}
+
+/// Draws the pictures `options.plots` into `dir` (`deflection.png`, `pressure.png`,
+/// `liftoff.png`, `profile.png`), each written atomically; returns the files written.
+pub fn draw_all(dir: &Path, data: &PlotData, options: &PlotOptions) -> Result<Vec<PathBuf>> {
+    let pictures = render(data, options)?;
+    pictures
+        .par_iter()
+        .map(|p| {
+            let path = dir.join(p.kind.file_name());
+            write_png(&path, &p.canvas)?;
+            Ok(path)
+        })
+        .collect()
+}
+
+/// The pictures of `options` as the `extra` files of [`super::write_files`]:
 /// drawn into the directory from the nodal fields on `mesh`; returns their names.
 pub fn pictures<'a>(
     mesh: &'a Mesh,
@@ -72,7 +96,7 @@ pub fn pictures<'a>(
             pressure: &fields.pressure,
             covered: &fields.covered,
         };
-        // With a body below, both bodies' contact is drawn ([`crate::bodies`]).
+        // With a body below, both bodies' contact is drawn ([`memcontact_plot::bodies`]).
         let merged = fields.lower.as_ref().map(|l| {
             merge(
                 upper,
@@ -115,7 +139,7 @@ pub fn pictures<'a>(
 pub const MESH_PICTURE: &str = "mesh.png";
 
 /// The pictures of an adaptive run's final step (the `extra` files of
-/// [`memcontact::write::AdaptSet::finish`]): those of `options`, and, when it draws any,
+/// [`super::AdaptSet::finish`]): those of `options`, and, when it draws any,
 /// `mesh.png`, the final mesh's edges with the outline of the contact zone.
 pub fn adapt_pictures<'a>(
     mesh: &'a Mesh,
@@ -131,14 +155,14 @@ pub fn adapt_pictures<'a>(
             .map(|v| fields.state[v] >= 0 || fields.lower.as_ref().is_some_and(|l| l.state[v] >= 0))
             .collect();
         let title = format!("Mesh: {}", options.title.as_deref().unwrap_or(""));
-        crate::mesh_plot(
-            &dir.join(MESH_PICTURE),
+        let picture = memcontact_plot::mesh_plot(
             &mesh.points,
             &mesh.triangles,
             &contact,
             &title,
             &options.units,
         )?;
+        write_png(&dir.join(MESH_PICTURE), &picture)?;
         names.push(MESH_PICTURE.to_string());
         Ok(names)
     }
@@ -258,25 +282,23 @@ impl SweepWriter {
 /// Draws the force-deflection curve of a sweep: the total contact force of each step
 /// against its largest deflection, in step order.
 pub fn sweep_picture(path: &Path, title: &str, units: &Units, rows: &[StepRow]) -> Result<()> {
-    line_plot(
-        path,
-        &LinePlot {
-            title: title.to_string(),
-            x_label: format!("max deflection{}", units.length_suffix()),
-            y_label: format!("total contact force{}", units.force_suffix()),
-            series: vec![Series {
-                name: "total contact force".into(),
-                points: rows
-                    .iter()
-                    .map(|r| (r.max_deflection, r.total_contact_force))
-                    .collect(),
-            }],
-        },
-    )
+    let picture = render_line_plot(&LinePlot {
+        title: title.to_string(),
+        x_label: format!("max deflection{}", units.length_suffix()),
+        y_label: format!("total contact force{}", units.force_suffix()),
+        series: vec![Series {
+            name: "total contact force".into(),
+            points: rows
+                .iter()
+                .map(|r| (r.max_deflection, r.total_contact_force))
+                .collect(),
+        }],
+    })?;
+    write_png(path, &picture)
 }
 
 /// The pictures of a convergence study, drawn into `dir` (the `pictures` of
-/// [`memcontact::write::write_study`]): `convergence.png` (the L² and H¹ errors of every
+/// [`super::write_study`]): `convergence.png` (the L² and H¹ errors of every
 /// variant against l_n, reference slopes 1 and 2) or, for the rigid-limit sweep,
 /// `h_sweep.png` (the distances to the rigid solution against h, reference slopes −½ and
 /// −1). `file_name` (the case file's name) titles them. Returns the names written.
@@ -305,8 +327,7 @@ pub fn study_pictures(dir: &Path, outcome: &StudyOutcome, file_name: &str) -> Re
                     pts(&|r| r.errors.map(|e| e.h1_semi)),
                 ));
             }
-            crate::loglog_plot(
-                &dir.join(CONVERGENCE_PICTURE),
+            let picture = memcontact_plot::loglog_plot(
                 &format!("Convergence: {file_name}"),
                 "mesh size lₙ",
                 if outcome.exact.is_some() {
@@ -317,6 +338,7 @@ pub fn study_pictures(dir: &Path, outcome: &StudyOutcome, file_name: &str) -> Re
                 &series,
                 &[1.0, 2.0],
             )?;
+            write_png(&dir.join(CONVERGENCE_PICTURE), &picture)?;
             Ok(vec![CONVERGENCE_PICTURE.to_string()])
         }
         StudyResult::RigidLimit {
@@ -345,14 +367,14 @@ pub fn study_pictures(dir: &Path, outcome: &StudyOutcome, file_name: &str) -> Re
                         .collect(),
                 ));
             }
-            crate::loglog_plot(
-                &dir.join(H_SWEEP_PICTURE),
+            let picture = memcontact_plot::loglog_plot(
                 &format!("Rigid limit: {file_name}"),
                 "stiffness h",
                 "distance to the rigid solution",
                 &series,
                 &[-0.5, -1.0],
             )?;
+            write_png(&dir.join(H_SWEEP_PICTURE), &picture)?;
             Ok(vec![H_SWEEP_PICTURE.to_string()])
         }
     }

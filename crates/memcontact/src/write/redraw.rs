@@ -3,9 +3,9 @@
 //! options used when it was solved), so that `memcontact plot DIR` draws the same
 //! pictures without solving again.
 
-use crate::vtu::read_vtu;
-use crate::{PlotData, PlotOptions};
-use memcontact::{Error, Result};
+use crate::error::{Error, Result};
+use crate::io::vtu::read_vtu;
+use memcontact_plot::{PlotData, PlotOptions};
 use std::path::Path;
 
 /// The fields of a result, owned.
@@ -107,14 +107,14 @@ pub fn load(dir: &Path) -> Result<Loaded> {
         (Some(p), Some(s), Some(q), Some(c)) => {
             let state_low: Vec<i8> = s.values.iter().map(|&x| x as i8).collect();
             let covered_low: Vec<bool> = c.values.iter().map(|&x| x != 0.0).collect();
-            let m = crate::bodies::merge(
-                crate::bodies::BodyFields {
+            let m = memcontact_plot::bodies::merge(
+                memcontact_plot::bodies::BodyFields {
                     phi: &phi,
                     state: &state,
                     pressure: &pressure,
                     covered: &covered,
                 },
-                crate::bodies::BodyFields {
+                memcontact_plot::bodies::BodyFields {
                     phi: &p.values,
                     state: &state_low,
                     pressure: &q.values,
@@ -141,7 +141,7 @@ pub fn load(dir: &Path) -> Result<Loaded> {
             // The pictures must be drawn from this run's solution.vtu: a directory mixing
             // the files of two runs is refused.
             if let Some(record) = json.pointer("/files/solution.vtu") {
-                let actual = memcontact::write::file_record(&vtu_path)?;
+                let actual = super::file_record(&vtu_path)?;
                 if record.get("xxh3").and_then(|h| h.as_str()) != Some(actual.xxh3.as_str()) {
                     return Err(file_err(format!(
                         "is not the solution.vtu that summary.json lists (run {}): the \

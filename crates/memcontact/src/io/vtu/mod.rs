@@ -22,6 +22,10 @@
 //!
 //! The file is written atomically ([`crate::io::write_atomic`]).
 
+mod read;
+
+pub use read::{read_vtu, Array, VtuMesh};
+
 use crate::error::{Error, Result};
 pub use crate::io::numbers::DataArray;
 use crate::io::numbers::{push_int, push_shortest};

@@ -1,13 +1,14 @@
 //! Redrawing from a result directory (`solution.vtu` + `summary.json`, as `memcontact
 //! solve` writes them) gives byte-identical pictures to the ones drawn at solve time.
 
+#[path = "pictures_common/mod.rs"]
 mod common;
 
 use memcontact::io::json::write_json;
 use memcontact::io::vtu::{write_vtu, DataArray, VtuEncoding};
 use memcontact::mesh::Mesh;
-use memcontact_plot::result::{load, ResultData};
-use memcontact_plot::{draw_all, PlotKind, PlotOptions, Units};
+use memcontact::write::{draw_all, load_result as load, ResultData};
+use memcontact_plot::{PlotKind, PlotOptions, Units};
 use std::path::Path;
 
 /// Writes a result directory the way the CLI does (plus `covered` and `plot_options`

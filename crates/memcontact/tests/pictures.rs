@@ -2,13 +2,15 @@
 //! zone drawn where the state field says contact; redrawing from a result directory gives
 //! the same bytes.
 
+#[path = "pictures_common/mod.rs"]
 mod common;
 
 use common::Solved;
+use memcontact::write::draw_all;
 use memcontact_plot::canvas::{decode_png, Rgb};
 use memcontact_plot::{
-    draw_all, hatch_color, render, MapLayout, Picture, PlotData, PlotKind, PlotOptions, Units,
-    CONTACT, MAP_HEIGHT, MAP_WIDTH, NOT_COVERED, OUTLINE, PROFILE_HEIGHT, PROFILE_WIDTH,
+    hatch_color, render, MapLayout, Picture, PlotData, PlotKind, PlotOptions, Units, CONTACT,
+    MAP_HEIGHT, MAP_WIDTH, NOT_COVERED, OUTLINE, PROFILE_HEIGHT, PROFILE_WIDTH,
 };
 use std::collections::HashSet;
 
