@@ -7,10 +7,12 @@ use crate::report;
 use crate::report::print_warnings;
 use crate::solve_flags::SolveFlags;
 use anyhow::{bail, Result};
-use memcontact::outcome::{AdaptRow, Outcome};
+use memcontact::adapt::AdaptRow;
+use memcontact::outcome::Outcome;
 use memcontact::solve::{IterationRecord, Observer};
 use memcontact::write::{adapt_pictures, pictures, plot_options};
-use memcontact::write::{AdaptHistory, AdaptSet, WriteOptions};
+use memcontact::adapt::{AdaptHistory, AdaptSet};
+use memcontact::write::WriteOptions;
 use memcontact::Case;
 use std::cell::RefCell;
 use std::time::Instant;
@@ -61,6 +63,7 @@ pub fn adapt(
         run_id: None,
         cell_data: Vec::new(),
         adapt: None,
+        unconverged: false,
     };
     // The result set begins with the first step solved: bad input found before leaves
     // nothing behind.

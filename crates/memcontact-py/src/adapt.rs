@@ -7,12 +7,13 @@ use crate::convert::{py_err, to_py};
 use crate::mesh::PyMesh;
 use crate::result::{vtu_format, PyResult_};
 use memcontact::outcome::summary::AdaptTotals;
-use memcontact::outcome::AdaptRow;
+use memcontact::adapt::AdaptRow;
 use memcontact::problem::{GivenMesh, MeshSource};
 use memcontact::run::run_adapt;
 use memcontact::solve::Silent;
 use memcontact::write::{adapt_pictures, plot_options};
-use memcontact::write::{AdaptHistory, AdaptSet, WriteOptions};
+use memcontact::adapt::{AdaptHistory, AdaptSet};
+use memcontact::write::WriteOptions;
 use memcontact::Case;
 use numpy::PyArray1;
 use pyo3::exceptions::PyValueError;
@@ -229,6 +230,7 @@ impl PyAdapt {
                 run_id: None,
                 cell_data: Vec::new(),
                 adapt: None,
+                unconverged: false,
             };
             let history = AdaptHistory {
                 rows: &self.rows,

@@ -412,6 +412,7 @@ impl PyResult_ {
                 run_id: None,
                 cell_data: Vec::new(),
                 adapt: None,
+                unconverged: false,
             };
             write_result(&directory, &outcome, &self.data.case, &options, &plots)
         })

@@ -26,12 +26,12 @@
 //!   CSV, JSON, atomic result sets), [`sparse`], [`quadrature`], [`limits`] (memory),
 //!   [`parallel`] (the worker pool and the cancellation token), [`error`].
 
+pub mod adapt;
 pub mod case;
 pub mod certificate;
 
 pub mod discretization;
 pub mod error;
-pub mod estimate;
 
 pub mod fem;
 pub mod field;

@@ -6,7 +6,8 @@
 
 use memcontact::case::Case;
 use memcontact::mesh::Mesh;
-use memcontact::outcome::{AdaptRow, Outcome};
+use memcontact::adapt::AdaptRow;
+use memcontact::outcome::Outcome;
 use memcontact::run::{run_adapt, AdaptRun, AdaptStop};
 use memcontact::solve::Silent;
 use memcontact::verify::exact::{ExactSolution, Manufactured, ManufacturedCosine};

@@ -155,6 +155,7 @@ pub fn run_case(case: &Case, scratch: &Path, pictures: bool) -> Result<CaseRun> 
         run_id: None,
         cell_data: Vec::new(),
         adapt: None,
+        unconverged: false,
     };
     let plots = memcontact::write::plot_options(&case, "bench");
     let written = memcontact::write::write_result(&dir, &outcome, &case, &options, &plots);

@@ -105,6 +105,21 @@ impl From<Case> for CaseFile {
 }
 
 impl Case {
+    /// A case of `problem` alone: the default `[solver]`, `[output]` and `[units]`, no
+    /// steps, no adaptive loop, no exact solution.
+    pub fn new(problem: Problem) -> Case {
+        Case {
+            problem,
+            settings: Settings::default(),
+            output: OutputOptions::default(),
+            exact: None,
+            units: Units::default(),
+            sweep: None,
+            load_cases: Vec::new(),
+            adapt: None,
+        }
+    }
+
     /// Whether the case has steps to solve in turn (a `[sweep]` or `[[load_case]]`
     /// entries): then it is run by [`crate::run::run_sweep`], not [`crate::run::run`].
     pub fn is_sweep(&self) -> bool {

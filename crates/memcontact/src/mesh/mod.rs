@@ -1,10 +1,8 @@
 //! Triangular meshes: the type, its checks and quality report, the boundary and the map
 //! between vertices and unknowns (SPEC §2: the unknowns are the interior vertices).
 
-pub mod bisect;
 pub mod boundary;
 pub mod generate;
-pub mod mark;
 pub mod refine;
 pub mod regions;
 pub mod reorder;

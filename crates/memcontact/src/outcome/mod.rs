@@ -2,7 +2,6 @@
 //! fields and totals in the user's numbering, `summary.json`'s values, and the checks they
 //! pass before anything is written.
 
-mod adapt;
 pub mod checks;
 pub mod fields;
 mod report;
@@ -10,7 +9,6 @@ mod solved;
 pub mod summary;
 pub mod sweep;
 
-pub use adapt::AdaptRow;
 pub use fields::{LowerFields, LowerTotals, NodalFields, Totals};
 pub use report::Report;
 pub use solved::Outcome;

@@ -13,12 +13,12 @@
 //! and its certificate. The library prints nothing: progress reaches the caller through
 //! the [`crate::solve::Observer`].
 
-mod adapt;
-mod checks;
 mod one;
 mod sweep;
 
-pub use adapt::{check_adapt_on_mesh, run_adapt, AdaptRun, AdaptStop, OnStep};
-pub use checks::{check_case_on_mesh, check_load_cases_on_mesh, check_profile_on_mesh};
-pub use one::{discretize_as_run, run, run_for_writing, run_problem};
+pub use crate::adapt::{check_adapt_on_mesh, run_adapt, AdaptRun, AdaptStop, OnStep};
+pub use crate::discretization::{
+    check_case_on_mesh, check_load_cases_on_mesh, check_profile_on_mesh,
+};
+pub use one::{check, run, run_to_files, Checked, Written};
 pub use sweep::{apply, run_sweep, run_sweep_on, step_discretization, step_model, SweepRun};

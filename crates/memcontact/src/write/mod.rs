@@ -10,7 +10,6 @@
 //! room for it (the CSV header lines are contracts), are bound to it by their hashes in
 //! the summary or manifest.
 
-mod adapt;
 mod manifest;
 mod pictures;
 mod redraw;
@@ -20,7 +19,6 @@ mod sweep;
 #[cfg(test)]
 mod tests;
 
-pub use adapt::{write_adapt_csv, AdaptHistory, AdaptSet, ADAPT_CSV};
 pub use manifest::{write_manifest, Manifest, MANIFEST};
 pub use memcontact_plot::{PlotKind, PlotOptions, Units as PlotUnits};
 pub use pictures::{

@@ -256,6 +256,7 @@ impl SweepWriter {
             run_id: None,
             cell_data: Vec::new(),
             adapt: None,
+            unconverged: false,
         };
         let mesh = outcome.mesh();
         let mut draw = pictures(&mesh, &plots);

@@ -55,6 +55,28 @@ pub struct WriteOptions {
     pub cell_data: Vec<(String, Vec<f64>)>,
     /// The adaptive loop's totals for `summary.json` (with `[adapt]`).
     pub adapt: Option<crate::outcome::summary::AdaptTotals>,
+    /// Write the files of a solve the settings did not accept (marked `"accepted": false`
+    /// in `summary.json`); otherwise [`crate::run::run_to_files`] writes nothing for it.
+    pub unconverged: bool,
+}
+
+impl WriteOptions {
+    /// The options of a result set labelled `label` (its name in `summary.json`): binary
+    /// VTU, started now, a fresh run id, an existing result replaced but no other
+    /// directory, nothing written for an outcome the settings did not accept.
+    pub fn new(label: impl Into<String>) -> WriteOptions {
+        WriteOptions {
+            label: label.into(),
+            vtu: VtuFormat::default(),
+            force: false,
+            started: Instant::now(),
+            plot_options: None,
+            run_id: None,
+            cell_data: Vec::new(),
+            adapt: None,
+            unconverged: false,
+        }
+    }
 }
 
 /// A fresh random run identifier (32 hex digits).
@@ -237,7 +259,7 @@ pub fn write_files(
     let t0 = Instant::now();
     let (fields, totals) = outcome.checked_fields()?;
     let r = &outcome.report;
-    crate::outcome::checks::check_solution(
+    crate::solve::check_solution(
         r.energy,
         r.certificate.kkt(),
         outcome.discretization.model.is_rigid(),

@@ -31,8 +31,8 @@
 //! beyond them) and keeps the classes close to the start shapes. Everything is linear in the mesh size: one edge matching (a counting sort by the smaller
 //! endpoint), a work list for the closure, one pass over the triangles.
 
-use super::refine::Refinement;
-use super::{BoundaryRegions, Circle, Mesh, Point};
+use crate::mesh::refine::Refinement;
+use crate::mesh::{BoundaryRegions, Circle, Mesh, Point};
 use crate::sparse::{first_where, group_by_key};
 use crate::{Error, Result};
 use rayon::prelude::*;
@@ -107,6 +107,7 @@ pub fn label_longest_edge(mesh: &Mesh) -> Mesh {
 /// Whether every triangle's refinement edge is its longest edge as
 /// [`longest_edge_first`] chooses it (the state [`label_longest_edge`] leaves; a mesh
 /// after [`bisect`] usually is not, and need not be).
+#[cfg(test)]
 pub fn is_longest_edge_labelled(mesh: &Mesh) -> bool {
     mesh.triangles
         .par_iter()
@@ -130,12 +131,14 @@ pub struct Bisection {
     pub refinement: Refinement,
     /// The coarse triangle of every fine triangle (nondecreasing: the children of a coarse
     /// triangle are consecutive), for moving per-triangle data to the fine mesh.
+    #[cfg_attr(not(test), allow(dead_code))]
     pub parent: Vec<u32>,
 }
 
 impl Bisection {
     /// Number of new vertices (fine vertices `coarse vertices ..` are new: the places where
     /// a local multigrid smooths).
+    #[cfg(test)]
     pub fn new_vertices(&self) -> usize {
         self.refinement
             .parents
@@ -236,7 +239,7 @@ impl HalfEdges {
 /// Whether `p` lies on the circle up to round-off (the tolerance of uniform refinement:
 /// only boundary edges with both ends on it are arcs).
 fn on_circle(c: &Circle, p: Point) -> bool {
-    (super::dist(p, c.center) - c.radius).abs() <= 1e-9 * c.radius
+    (crate::mesh::dist(p, c.center) - c.radius).abs() <= 1e-9 * c.radius
 }
 
 /// Newest-vertex bisection of `mesh` (SPEC §6): every triangle of `marked` (indices, in
@@ -370,7 +373,7 @@ pub fn bisect(mesh: &Mesh, marked: &[u32]) -> Result<Bisection> {
         .map(|&k| mesh.regions[k as usize])
         .collect();
     if any_projected {
-        if let Some(k) = first_where(&triangles, |t| super::signed_area(&points, &t) <= 0.0) {
+        if let Some(k) = first_where(&triangles, |t| crate::mesh::signed_area(&points, &t) <= 0.0) {
             return Err(Error::Mesh(format!(
                 "bisection: triangle {} turned over when a new boundary vertex was moved \
                  onto the circle; refine the start mesh of the disc",
@@ -1006,7 +1009,7 @@ mod tests {
                 let (p, q) = (m.points[x as usize], m.points[y as usize]);
                 let mid = [0.5 * (p[0] + q[0]), 0.5 * (p[1] + q[1])];
                 if fbv[v] {
-                    let d = super::super::dist(f.points[v], c);
+                    let d = crate::mesh::dist(f.points[v], c);
                     assert!((d - r).abs() < 1e-14 * r, "vertex {v} at r = {d}");
                     moved += 1;
                 } else {

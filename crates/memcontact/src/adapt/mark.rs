@@ -4,7 +4,7 @@
 //! [`super::bisect::bisect`]. Nothing here knows the solver: indicators and contact flags
 //! are plain slices.
 
-use super::Mesh;
+use crate::mesh::Mesh;
 use crate::sparse::first_where;
 use crate::{Error, Result};
 use rayon::prelude::*;

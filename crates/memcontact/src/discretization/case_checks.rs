@@ -3,7 +3,7 @@
 //! crossing it.
 
 use crate::case::Case;
-use crate::discretization::{assemble_model, bind_and_check};
+use super::{assemble_model, bind_and_check};
 use crate::error::{Error, Result};
 use crate::mesh::Mesh;
 

@@ -1,6 +1,6 @@
 //! What a step of the adaptive loop produced: the row of `adapt.csv`.
 
-use super::solved::Outcome;
+use crate::outcome::Outcome;
 use serde::Serialize;
 
 /// One solved step of the adaptive loop.

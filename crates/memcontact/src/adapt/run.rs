@@ -1,34 +1,15 @@
-//! The adaptive loop (SPEC §6): solve → estimate → mark → refine → solve, from the case's
-//! mesh, until the estimator meets `[adapt] tolerance`, the steps run out, or the next
-//! mesh would have more than `max_vertices` vertices.
-//!
-//! - **Estimate**: the residual indicators of [`crate::estimate`] (elastic bodies,
-//!   rigid ones and rigid regions, a body below, free edges).
-//! - **Mark**: Dörfler's bulk criterion on η_T² with fraction θ, together with the
-//!   triangles on the free boundary (those holding both contact and non-contact vertices,
-//!   of either body) and `free_boundary_rings` rings of neighbours, at most as many of
-//!   these as the Dörfler set holds (the largest first): the free boundary is refined as
-//!   fast as the bulk and no faster, so its strip never takes over the vertex budget and
-//!   the energy error keeps the rate of Dörfler marking.
-//! - **Refine**: newest-vertex bisection ([`crate::mesh::bisect`]) of the mesh in the
-//!   user's numbering (the start mesh labelled by its longest edges once): conforming,
-//!   nested and shape-regular, regions and boundary regions carried, new vertices on the
-//!   circle of a disc. Every mesh of the loop stays a level of the hierarchy, so
-//!   multigrid runs on the nested meshes (the start mesh's own levels below them).
-//! - **Solve**: each step starts from the previous answer interpolated onto the new mesh;
-//!   data given per vertex are interpolated (P1) onto the new vertices, and the run says
-//!   so ([`AdaptRun::interpolated`]).
+//! The adaptive loop itself ([`run_adapt`]), as the module's overview describes it.
 
-use super::checks::check_case_on_mesh;
 use crate::case::{AdaptSpec, Case};
-use crate::discretization::{build_mesh, BoundData, Discretization};
+use super::row::AdaptRow;
+use super::{bisect, estimate::estimate, mark};
+use crate::discretization::{build_mesh, check_case_on_mesh, BoundData, Discretization};
 use crate::error::{Error, Invalid, Result};
-use crate::estimate::estimate;
 use crate::field::{Field, Stiffness};
 use crate::mesh::boundary::FixedBoundary;
-use crate::mesh::{bisect, mark, Mesh, VertexTriangles};
+use crate::mesh::{Mesh, VertexTriangles};
 use crate::outcome::summary::AdaptTotals;
-use crate::outcome::{AdaptRow, Outcome};
+use crate::outcome::Outcome;
 use crate::problem::Problem;
 use crate::solve::{Cancellable, Observer};
 use std::time::Instant;
@@ -124,10 +105,7 @@ pub fn run_adapt(
         });
     };
     let started = Instant::now();
-    let observer = &mut Cancellable {
-        inner: observer,
-        cancel: &case.settings.cancel,
-    };
+    let observer = &mut Cancellable::new(observer, &case.settings.cancel);
     let (mut hierarchy, warnings) = build_mesh(&case.problem.mesh)?;
     // The refinement edge of every triangle: its longest (once, on the start mesh).
     let labelled = bisect::label_longest_edge(hierarchy.finest());

@@ -3,12 +3,13 @@
 //! adaptive totals in `summary.json`, and, with `[output] keep_steps`, every step's result
 //! set in `step-000/`, `step-001/`, ...
 
-use super::result::{new_run_id, write_files, WriteOptions};
+use super::row::AdaptRow;
+use crate::write::{new_run_id, write_files, WriteOptions};
 use crate::case::Case;
 use crate::error::Result;
 use crate::io::result_set::ResultSet;
 use crate::outcome::summary::AdaptTotals;
-use crate::outcome::{AdaptRow, NodalFields, Outcome, Summary};
+use crate::outcome::{NodalFields, Outcome, Summary};
 use std::path::Path;
 
 /// The name of the table of steps.
@@ -110,6 +111,7 @@ impl AdaptSet {
                 history.indicators.iter().map(|e| e.sqrt()).collect(),
             )],
             adapt: Some(history.totals.clone()),
+            unconverged: false,
             ..options.clone()
         };
         let summary = write_files(self.set.dir(), outcome, case, &options, &mut |dir, f| {
