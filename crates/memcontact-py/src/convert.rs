@@ -98,6 +98,13 @@ pub fn to_toml(obj: &Bound<'_, PyAny>, key: &str) -> PyResult<toml::Value> {
         let plain = obj.call_method0("tolist")?;
         return to_toml(&plain, key);
     }
+    // The case file's sections as dataclasses (`memcontact.Membrane`, ...): their dicts.
+    if obj.hasattr("__dataclass_fields__")? && obj.hasattr("to_dict")? {
+        let plain = obj.call_method0("to_dict")?;
+        if plain.is_instance_of::<PyDict>() {
+            return to_toml(&plain, key);
+        }
+    }
     // Paths.
     if obj.hasattr("__fspath__")? {
         let text = obj.call_method0("__fspath__")?;
@@ -200,4 +207,17 @@ pub fn interruptible<T: Send>(
             }
         }
     })
+}
+
+/// Calls `name` of the pure-Python helpers (`memcontact._notebook`: plotting, tables,
+/// meshio, pyvista, scipy), which import their optional packages when called.
+pub fn call_helper<'py>(
+    py: Python<'py>,
+    name: &str,
+    args: impl pyo3::call::PyCallArgs<'py>,
+    kwargs: Option<&Bound<'py, PyDict>>,
+) -> PyResult<Bound<'py, PyAny>> {
+    py.import("memcontact._notebook")?
+        .getattr(name)?
+        .call(args, kwargs)
 }

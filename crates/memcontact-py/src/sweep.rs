@@ -210,6 +210,17 @@ impl PySweep {
         to_py(py, &summaries)
     }
 
+    /// The rows as a `pandas.DataFrame` with the columns of the CSV file (see
+    /// `memcontact._notebook.to_pandas`).
+    fn to_pandas<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyAny>> {
+        crate::convert::call_helper(slf.py(), "to_pandas", (slf,), None)
+    }
+
+    /// The notebook's summary and table of rows (HTML).
+    fn _repr_html_<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyAny>> {
+        crate::convert::call_helper(slf.py(), "sweep_html", (slf,), None)
+    }
+
     fn __len__(&self) -> usize {
         self.results.len()
     }

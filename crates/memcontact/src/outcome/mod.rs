@@ -9,6 +9,7 @@ mod report;
 mod solved;
 pub mod summary;
 pub mod sweep;
+mod system;
 
 pub use adapt::AdaptRow;
 pub use fields::{LowerFields, LowerTotals, NodalFields, Totals};
@@ -16,3 +17,4 @@ pub use report::Report;
 pub use solved::Outcome;
 pub use summary::{FileRecord, Summary};
 pub use sweep::StepRow;
+pub use system::{SparseRows, System, SystemBody};
