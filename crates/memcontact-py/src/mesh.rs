@@ -178,6 +178,36 @@ fn regions_array<'py>(py: Python<'py>, mesh: &Mesh) -> Bound<'py, PyArray1<i64>>
     )
 }
 
+/// Names of tags given as a dict (tag → name): tags in 0..2³², names strings.
+fn tag_names(names: &Bound<'_, PyAny>, what: &str) -> PyResult<BTreeMap<u32, String>> {
+    let dict = names.cast::<PyDict>().map_err(|_| {
+        pyo3::exceptions::PyTypeError::new_err(format!(
+            "{what} must be a dict of tags to names, got a {}",
+            names
+                .get_type()
+                .name()
+                .map(|n| n.to_string())
+                .unwrap_or_default()
+        ))
+    })?;
+    let mut out = BTreeMap::new();
+    for (k, v) in dict.iter() {
+        let tag = crate::convert::count(&k, what)
+            .ok()
+            .and_then(|t| u32::try_from(t).ok())
+            .ok_or_else(|| {
+                PyValueError::new_err(format!("{what}: the tag {k} is not an integer in 0..2^32"))
+            })?;
+        let name: String = v.extract().map_err(|_| {
+            pyo3::exceptions::PyTypeError::new_err(format!(
+                "{what}: the name of tag {tag} must be a string"
+            ))
+        })?;
+        out.insert(tag, name);
+    }
+    Ok(out)
+}
+
 /// Builds and checks a mesh from arrays (see `Mesh.__new__`).
 pub fn mesh_from_arrays(
     vertices: &PyReadonlyArray2<'_, f64>,
@@ -213,11 +243,17 @@ impl PyMesh {
         vertices: &Bound<'_, PyAny>,
         triangles: &Bound<'_, PyAny>,
         regions: Option<&Bound<'_, PyAny>>,
-        region_names: Option<BTreeMap<u32, String>>,
+        region_names: Option<&Bound<'_, PyAny>>,
         boundary_edges: Option<&Bound<'_, PyAny>>,
         boundary_tags: Option<&Bound<'_, PyAny>>,
-        boundary_names: Option<BTreeMap<u32, String>>,
+        boundary_names: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<PyMesh> {
+        let region_names = region_names
+            .map(|n| tag_names(n, "region_names"))
+            .transpose()?;
+        let boundary_names = boundary_names
+            .map(|n| tag_names(n, "boundary_names"))
+            .transpose()?;
         let np = py.import("numpy")?;
         let float64 = np.getattr("float64")?;
         let v = np.call_method1("ascontiguousarray", (vertices, &float64))?;
@@ -407,8 +443,12 @@ impl PyMesh {
     /// The mesh refined uniformly `times` times (each triangle into four; new boundary
     /// vertices of a disc are moved onto its circle). The levels are kept, so a solve on
     /// the refined mesh can use multigrid.
-    #[pyo3(signature = (times=1))]
-    fn refine(&self, py: Python<'_>, times: usize) -> PyResult<PyMesh> {
+    #[pyo3(signature = (times=None), text_signature = "($self, times=1)")]
+    fn refine(&self, py: Python<'_>, times: Option<&Bound<'_, PyAny>>) -> PyResult<PyMesh> {
+        let times = match times {
+            Some(t) => crate::convert::count(t, "refine: times")?,
+            None => 1,
+        };
         if times > memcontact::problem::MAX_REFINE {
             return Err(PyValueError::new_err(format!(
                 "refine: {times} refinements is too many (at most {}: each multiplies the \

@@ -276,10 +276,10 @@ def _evaluate(f: Callable[..., Any], mesh: Mesh, key: str) -> np.ndarray:
             f"{key}: the function returned a {type(value).__name__}, not an array of "
             "numbers"
         ) from e
-    a = _real_array(a, key, "the function's values")
     if a.ndim == 0:
-        a = np.full(n, float(a))
-    elif a.shape != (n,):
+        a = np.full(n, a)
+    a = _real_array(a, key, "the function's values")
+    if a.shape != (n,):
         raise ValueError(
             f"{key}: the function returned shape {a.shape}, but one value per vertex "
             f"({n},) is needed (a vectorised f(x, y) of the vertex coordinates)"
@@ -331,8 +331,42 @@ def _refuse_functions(data: Mapping[str, Any]) -> None:
 # Meshes.
 
 
+def _int(value: Any, name: str) -> int:
+    """A count: an integer (or an integral float), not negative."""
+    if isinstance(value, (bool, np.bool_)):
+        raise TypeError(f"{name}: an integer is needed, got a bool")
+    if isinstance(value, (float, np.floating)) and float(value).is_integer():
+        value = int(value)
+    try:
+        v = int(value.__index__())
+    except (AttributeError, TypeError):
+        raise TypeError(f"{name}: an integer is needed, got {type(value).__name__}") from None
+    if v < 0:
+        raise ValueError(f"{name}: must not be negative, got {v}")
+    if v >= 2**63:
+        raise ValueError(f"{name}: {v} is too large")
+    return v
+
+
+def _float(value: Any, name: str) -> float:
+    """A real number (its checks are the library's)."""
+    if isinstance(value, (str, bytes, bool, np.bool_)) or value is None:
+        raise TypeError(f"{name}: a number is needed, got {type(value).__name__}")
+    try:
+        return float(value)
+    except OverflowError:
+        raise ValueError(f"{name}: {value} is too large") from None
+    except (TypeError, ValueError):
+        raise TypeError(f"{name}: a number is needed, got {type(value).__name__}") from None
+
+
 def _points(p: Any, name: str) -> List[Point]:
-    a = np.asarray(p, dtype=np.float64)
+    try:
+        a = np.asarray(p, dtype=np.float64)
+    except OverflowError:
+        raise ValueError(f"{name}: a coordinate is too large") from None
+    except (TypeError, ValueError) as e:
+        raise ValueError(f"{name}: expected points of shape (k, 2): {e}") from None
     if a.ndim != 2 or a.shape[1] != 2:
         raise ValueError(f"{name}: expected points of shape (k, 2), got shape {a.shape}")
     return [(float(x), float(y)) for x, y in a]
@@ -374,7 +408,12 @@ def rectangle(
     ValueError
         Bad sizes or corners.
     """
-    return _native.rectangle(x0, y0, x1, y1, int(nx), None if ny is None else int(ny), diagonal)
+    if not isinstance(diagonal, str):
+        raise TypeError(f"diagonal: a string is needed, got {type(diagonal).__name__}")
+    return _native.rectangle(
+        _float(x0, "x0"), _float(y0, "y0"), _float(x1, "x1"), _float(y1, "y1"),
+        _int(nx, "nx"), None if ny is None else _int(ny, "ny"), diagonal,
+    )
 
 
 def disk(
@@ -403,7 +442,15 @@ def disk(
     ValueError
         A radius or size that is not positive and finite, or too many triangles.
     """
-    return _native.disk((float(center[0]), float(center[1])), float(radius), size)
+    try:
+        cx, cy = center
+    except (TypeError, ValueError):
+        raise TypeError("center: a pair of numbers (x, y) is needed") from None
+    return _native.disk(
+        (_float(cx, "center"), _float(cy, "center")),
+        _float(radius, "radius"),
+        None if size is None else _float(size, "size"),
+    )
 
 
 def polygon(
@@ -441,6 +488,8 @@ def polygon(
     ValueError
         A bad polygon, size or angle.
     """
+    size = _float(size, "size")
+    min_angle = _float(min_angle, "min_angle")
     hole_list = [_points(h, "holes") for h in (holes or [])]
     if regions is None:
         region_list: List[Tuple[str, List[Point]]] = []
@@ -450,11 +499,16 @@ def polygon(
         region_list = []
         for item in regions:
             # (name, points) pairs, or the case file's {"name": ..., "polygon": ...}.
-            k, v = (item["name"], item["polygon"]) if isinstance(item, Mapping) else item
+            try:
+                k, v = (item["name"], item["polygon"]) if isinstance(item, Mapping) else item
+            except KeyError as e:
+                raise ValueError(f"regions: a region needs {e.args[0]!r}") from None
+            except (TypeError, ValueError):
+                raise TypeError(
+                    "regions: give (name, points) pairs or {'name': ..., 'polygon': ...}"
+                ) from None
             region_list.append((str(k), _points(v, f"regions[{k!r}]")))
-    return _native.polygon(
-        _points(outer, "outer"), float(size), hole_list, region_list, float(min_angle)
-    )
+    return _native.polygon(_points(outer, "outer"), size, hole_list, region_list, min_angle)
 
 
 def read_gmsh(path: PathLike) -> Mesh:
@@ -510,7 +564,9 @@ def refine(mesh: Mesh, times: int = 1) -> Mesh:
     ValueError
         Too many refinements for the memory available.
     """
-    return mesh.refine(int(times))
+    if not isinstance(mesh, Mesh):
+        raise TypeError(f"refine: a Mesh is needed, got {type(mesh).__name__}")
+    return mesh.refine(_int(times, "times"))
 
 
 # ---------------------------------------------------------------------------------------
@@ -770,12 +826,14 @@ def convergence(
     ValueError
         Bad data or options.
     """
+    if compare is not None and not isinstance(compare, str):
+        raise TypeError(f"compare: a string is needed, got {type(compare).__name__}")
     s = _native.convergence(
         _as_case(case),
-        int(levels),
+        _int(levels, "levels"),
         compare,
         bool(h_sweep),
-        None if h_values is None else [float(h) for h in h_values],
+        None if h_values is None else [_float(h, "h_values") for h in h_values],
     )
     for note in s.warnings:
         warnings.warn(note, stacklevel=2)

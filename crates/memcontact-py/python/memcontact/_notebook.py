@@ -42,8 +42,8 @@ _LABELS = {
 }
 
 #: The outline colours and names of each body's contact.
-OBSTACLE_OUTLINE = {"colors": "black", "linestyles": "solid", "label": "contact with the obstacle"}
-LOWER_OUTLINE = {"colors": "tab:red", "linestyles": "dashed", "label": "contact with the body below"}
+OBSTACLE_OUTLINE: Dict[str, Any] = {"colors": "black", "linestyles": "solid", "label": "contact with the obstacle"}
+LOWER_OUTLINE: Dict[str, Any] = {"colors": "tab:red", "linestyles": "dashed", "label": "contact with the body below"}
 
 
 def require(module: str, what: str, package: Optional[str] = None) -> Any:
@@ -112,22 +112,51 @@ def _field(r: Any, field: Any) -> Tuple[np.ndarray, str, str]:
     )
 
 
-def _outline(ax: Any, tri: Any, state: Optional[np.ndarray], style: Dict[str, str]) -> Any:
-    """Draws the outline of the vertices in contact (state ≥ 0) and returns a legend
-    handle, or None when nothing or everything is in contact."""
-    if state is None:
+def _outline(
+    ax: Any,
+    tri: Any,
+    state: Optional[np.ndarray],
+    depth: Optional[np.ndarray],
+    style: Dict[str, Any],
+) -> Any:
+    """Draws the outline of a body's contact and returns a legend handle, or None when
+    nothing or everything is in contact. An elastic body's contact is where the membrane
+    penetrates it: the zero level of the P1 interpolant of the signed penetration
+    ``depth`` (u − φ for the obstacle, φ_low − u for the body below; negative where the
+    body cannot touch); a rigid body's, the line between the touching and the clear
+    vertices."""
+    if state is None or depth is None:
         return None
-    contact = (np.asarray(state) >= 0).astype(np.float64)
+    state = np.asarray(state)
+    contact = state >= 0
     if not (0 < contact.sum() < contact.size):
         return None
     from matplotlib.lines import Line2D
 
+    if (state == 1).any():
+        d = np.asarray(depth, dtype=np.float64)
+        scale = max(float(np.max(np.abs(d))), 1e-300)
+        # A clear vertex with u above φ is one the body does not cover.
+        level = np.where(contact | (d < 0), d, -scale)
+        value = 0.0
+    else:
+        level, value = contact.astype(np.float64), 0.5
     ax.tricontour(
-        tri, contact, levels=[0.5], colors=style["colors"], linestyles=style["linestyles"],
+        tri, level, levels=[value], colors=style["colors"], linestyles=style["linestyles"],
         linewidths=1.2,
     )
     return Line2D([], [], color=style["colors"], linestyle=style["linestyles"],
                   label=style["label"])
+
+
+def _bar_size(v: np.ndarray) -> Dict[str, float]:
+    """A colour bar as tall as a map of equal aspect (matplotlib's recipe: 4.6 % of the
+    width per unit of the height-to-width ratio)."""
+    if len(v) == 0:
+        return {}
+    dx, dy = np.ptp(v[:, 0]), np.ptp(v[:, 1])
+    ratio = dy / dx if dx > 0 else 1.0
+    return {"fraction": float(np.clip(0.046 * ratio, 0.02, 0.15)), "pad": 0.04}
 
 
 def result_plot(
@@ -167,22 +196,27 @@ def result_plot(
     else:
         art = ax.tricontourf(tri, values, levels=levels, **kwargs)
     if colorbar:
-        ax.figure.colorbar(art, ax=ax, label=label)
+        ax.figure.colorbar(art, ax=ax, label=label, **_bar_size(v))
     if contact:
         handles = [
             h
             for h in (
-                _outline(ax, tri, r.state, OBSTACLE_OUTLINE),
-                _outline(ax, tri, r.state_low, LOWER_OUTLINE),
+                _outline(ax, tri, r.state, np.asarray(r.u) - r.phi, OBSTACLE_OUTLINE),
+                _outline(ax, tri, r.state_low,
+                         None if r.phi_low is None else r.phi_low - np.asarray(r.u),
+                         LOWER_OUTLINE),
             )
             if h is not None
         ]
         if handles:
-            ax.legend(handles=handles, loc="upper right", fontsize="small")
+            ax.legend(handles=handles, loc="best", fontsize="small")
     ax.set_aspect("equal")
     ax.set_xlabel("x")
     ax.set_ylabel("y")
-    ax.set_title(title if title is not None else f"{r.case.label}: {label}")
+    if title is None:
+        named = r.case.label not in ("mesh", "case")
+        title = f"{r.case.label}: {label}" if named else label
+    ax.set_title(title)
     return ax
 
 
@@ -295,11 +329,11 @@ def _number(v: Any) -> str:
 
 def _table(rows: Sequence[Dict[str, Any]], columns: Sequence[str], limit: int = 60) -> str:
     head = "".join(f"<th>{html.escape(c)}</th>" for c in columns)
-    shown = list(rows)
+    shown: List[Optional[Dict[str, Any]]] = list(rows)
     body = []
     if len(shown) > limit:
         half = limit // 2
-        shown = shown[:half] + [None] + shown[-half:]  # type: ignore[list-item]
+        shown = shown[:half] + [None] + shown[-half:]
     for row in shown:
         if row is None:
             body.append(f"<tr><td colspan='{len(columns)}'>…</td></tr>")
