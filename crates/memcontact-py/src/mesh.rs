@@ -471,8 +471,23 @@ impl PyMesh {
         Ok(PyMesh::new_from(h))
     }
 
-    /// Draws the mesh with matplotlib (see `memcontact._notebook.mesh_plot`); returns the
-    /// Axes.
+    /// Draws the mesh with matplotlib: edges, regions and named boundary regions.
+    ///
+    /// Parameters
+    /// ----------
+    /// ax : matplotlib.axes.Axes, optional
+    ///     Where to draw (default: a new figure).
+    /// **kwargs
+    ///     `regions=False`, `boundary=False`, `title`; the rest goes to `Axes.triplot`.
+    ///
+    /// Returns
+    /// -------
+    /// matplotlib.axes.Axes
+    ///
+    /// Raises
+    /// ------
+    /// ImportError
+    ///     matplotlib is not installed.
     #[pyo3(signature = (ax=None, **kwargs))]
     fn plot<'py>(
         slf: &Bound<'py, Self>,
@@ -482,7 +497,26 @@ impl PyMesh {
         crate::convert::call_helper(slf.py(), "mesh_plot", (slf, ax), kwargs)
     }
 
-    /// A mesh from a `meshio.Mesh` (see `memcontact._notebook.mesh_from_meshio`).
+    /// A mesh from a `meshio.Mesh`: its 3-node triangles (unused points dropped), Gmsh
+    /// physical surfaces as named regions and physical curves on the boundary as boundary
+    /// regions (lines inside the mesh skipped with a warning).
+    ///
+    /// Parameters
+    /// ----------
+    /// mesh : meshio.Mesh
+    /// regions : str, optional
+    ///     The cell data of the region tags (default `gmsh:physical`, else `region`).
+    ///
+    /// Returns
+    /// -------
+    /// Mesh
+    ///
+    /// Raises
+    /// ------
+    /// ValueError
+    ///     Other cells than triangles, lines and vertices, a mesh not plane or not valid.
+    /// TypeError
+    ///     Not a meshio mesh.
     #[staticmethod]
     #[pyo3(signature = (mesh, regions=None))]
     fn from_meshio<'py>(

@@ -606,9 +606,25 @@ impl PyResult_ {
         to_py(py, &summary)
     }
 
-    /// The assembled discrete problem over the unknowns (see
-    /// `memcontact._notebook.matrices`): S, L, D, φ, the unknowns' vertices, and the body
-    /// below's L and φ.
+    /// The assembled discrete problem over the unknowns (SPEC §2, §5), for scipy.
+    ///
+    /// Unknown `k` is vertex `unknowns[k]` (increasing): `U = result.u[m["unknowns"]]`.
+    /// U minimises `½ VᵀSV − VᵀD + ½ pᵀLp` (`p = (V − φ)⁺`; with a body below
+    /// `+ ½ qᵀ L_low q`, `q = (φ_low − V)⁺`).
+    ///
+    /// Returns
+    /// -------
+    /// dict
+    ///     `S` and `L` (scipy.sparse.csr_array; L the consistent foundation matrix or the
+    ///     lumped diagonal; None for a rigid obstacle, whose condition is U ≤ φ), `D`
+    ///     (the load minus the lifting of the boundary heights), `phi`, `unknowns`,
+    ///     `can_touch` (M), `rigid`, `foundation`; with a body below `L_low`, `phi_low`,
+    ///     `can_touch_low`, `rigid_low`, `foundation_low`.
+    ///
+    /// Raises
+    /// ------
+    /// ImportError
+    ///     scipy is not installed.
     fn matrices<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyAny>> {
         let py = slf.py();
         let this = slf.get();
@@ -617,8 +633,31 @@ impl PyResult_ {
         crate::convert::call_helper(py, "matrices", (parts,), None)
     }
 
-    /// Draws a field on the mesh with matplotlib (see `memcontact._notebook.result_plot`);
-    /// returns the Axes.
+    /// Draws a field on the mesh with matplotlib, each body's contact outlined (the
+    /// obstacle's solid black, the body below's dashed red), with a colour bar.
+    ///
+    /// Parameters
+    /// ----------
+    /// field : str or array_like
+    ///     `u` (default), `phi`, `penetration`, `pressure`, `contact_force`, `state`,
+    ///     `gap` (φ − u), with a body below the `_low` fields and `gap_low` (u − φ_low),
+    ///     the cell fields `region` and `estimator`; or one value per vertex or triangle.
+    /// ax : matplotlib.axes.Axes, optional
+    ///     Where to draw (default: a new figure).
+    /// **kwargs
+    ///     `kind` ("tripcolor" or "tricontourf"), `levels`, `contact`, `colorbar`,
+    ///     `title`; the rest goes to matplotlib (`cmap`, `vmin`, ...).
+    ///
+    /// Returns
+    /// -------
+    /// matplotlib.axes.Axes
+    ///
+    /// Raises
+    /// ------
+    /// ValueError, TypeError
+    ///     An unknown field or an array of the wrong size or type.
+    /// ImportError
+    ///     matplotlib is not installed.
     #[pyo3(
         signature = (field=None, ax=None, **kwargs),
         text_signature = "($self, field='u', ax=None, **kwargs)"
@@ -632,12 +671,31 @@ impl PyResult_ {
         crate::convert::call_helper(slf.py(), "result_plot", (slf, field, ax), kwargs)
     }
 
-    /// The result as a `meshio.Mesh` with every point and cell field.
+    /// The result as a `meshio.Mesh`: points (z = 0), triangles, every point field of
+    /// `nodes.csv` and the cell fields `region` (and `estimator`), as copies.
+    ///
+    /// Returns
+    /// -------
+    /// meshio.Mesh
+    ///
+    /// Raises
+    /// ------
+    /// ImportError
+    ///     meshio is not installed.
     fn to_meshio<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyAny>> {
         crate::convert::call_helper(slf.py(), "result_to_meshio", (slf,), None)
     }
 
     /// The result as a `pyvista.UnstructuredGrid` with every point and cell field.
+    ///
+    /// Returns
+    /// -------
+    /// pyvista.UnstructuredGrid
+    ///
+    /// Raises
+    /// ------
+    /// ImportError
+    ///     pyvista is not installed.
     fn to_pyvista<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyAny>> {
         crate::convert::call_helper(slf.py(), "result_to_pyvista", (slf,), None)
     }

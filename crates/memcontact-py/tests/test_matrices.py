@@ -170,3 +170,28 @@ def test_a_rigid_obstacle_has_no_L(examples):
     assert x1.min() >= -TOL * scale
     assert abs(x1 @ gap) <= TOL * scale * max(1.0, gap.sum())
     assert (gap <= 1e-12).sum() > 10, "the case must have contact"
+
+
+def test_matrices_of_steps_adaptive_results_and_unpickled_results(examples):
+    """Every kind of result can give its matrices: a sweep's step (the step's model, its
+    load scaled), the last step of an adaptive loop (its final mesh), and a result
+    unpickled (assembled again)."""
+    import pickle
+
+    s = mc.sweep(mc.load_case(examples / "disk.toml", {
+        "sweep.parameter": "load_factor", "sweep.values": [0.5, 1.5]}))
+    d = [step.matrices()["D"] for step in s.results]
+    assert relative(d[1], 3.0 * d[0]) < 1e-12
+    for step in s.results:
+        check_2f(step.matrices(), step.u)
+    a = mc.adapt({"membrane": {"tension": 1.0, "load": 8.0},
+                  "obstacle": {"shape": 1.0, "stiffness": 100.0},
+                  "adapt": {"max_vertices": 400}}, mesh=mc.disk(radius=1.0, size=0.3))
+    m = a.result.matrices()
+    assert len(m["unknowns"]) == (~a.mesh.boundary).sum()
+    check_2f(m, a.result.u)
+    r = mc.solve(mc.load_case(examples / "disk.toml"))
+    back = pickle.loads(pickle.dumps(r))
+    mine, theirs = r.matrices(), back.matrices()
+    assert (mine["S"] != theirs["S"]).nnz == 0 and np.array_equal(mine["D"], theirs["D"])
+    check_2f(theirs, back.u)
