@@ -79,10 +79,11 @@ enum Slot {
     StateLow,
     Estimator,
     Mesh,
+    Png,
 }
 
 impl Slot {
-    const COUNT: usize = 13;
+    const COUNT: usize = 14;
 }
 
 impl PyResult_ {
@@ -705,11 +706,13 @@ impl PyResult_ {
         crate::convert::call_helper(slf.py(), "result_html", (slf,), None)
     }
 
-    /// The deflection picture of the result set (`deflection.png`), drawn in memory, as
-    /// PNG bytes.
-    fn _repr_png_<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyBytes>> {
-        let png = crate::convert::detached(py, || self.deflection_png()).map_err(py_err)?;
-        Ok(PyBytes::new(py, &png))
+    /// The deflection picture of the result set (`deflection.png`), drawn in memory once,
+    /// as PNG bytes (IPython asks for it at every display of the result).
+    fn _repr_png_<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        self.cache.get(py, Slot::Png as usize, || {
+            let png = crate::convert::detached(py, || self.deflection_png()).map_err(py_err)?;
+            Ok(PyBytes::new(py, &png).into_any())
+        })
     }
 
     fn __repr__(&self) -> String {
