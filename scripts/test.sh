@@ -15,11 +15,16 @@ VENV=target/test-venv
 rm -rf "$VENV"
 "$PYTHON" -m venv "$VENV"
 "$VENV/bin/python" -m pip install --quiet --upgrade pip
-"$VENV/bin/python" -m pip install --quiet ./crates/memcontact-py pytest dask distributed meshio matplotlib
+# The optional packages of the notebook surface (plots, tables, meshes, matrices), the
+# property-based tests and the stub check.
+"$VENV/bin/python" -m pip install --quiet ./crates/memcontact-py pytest dask distributed meshio \
+    matplotlib pandas scipy pyvista hypothesis mypy
 TARGET="$(cargo metadata --format-version 1 --no-deps | "$VENV/bin/python" -c 'import json, sys; print(json.load(sys.stdin)["target_directory"])')"
 (
     cd crates/memcontact-py
     MEMCONTACT_BIN="$TARGET/release/memcontact" "../../$VENV/bin/python" -m pytest -q -p no:cacheprovider tests
+    # The type stubs against the installed module (every class, method and signature).
+    "../../$VENV/bin/python" -m mypy.stubtest memcontact --allowlist stubtest-allowlist.txt
 )
 # The documentation site (docs/, mkdocs.yml): every link and anchor must resolve, and the
 # Python API reference is rendered from the package's sources and type stubs.

@@ -254,8 +254,16 @@ fn a_run_to_files_solves_alike_writes_and_then_refuses_to_solve_again() {
         .unwrap();
         let summary = w.summary.expect("written");
         assert_eq!(summary.iterations, a.report.iterations, "{name}");
-        for file in ["solution.vtu", "nodes.csv", "summary.json", "deflection.png"] {
-            assert!(dir.path().join("out").join(file).is_file(), "{name}: {file}");
+        for file in [
+            "solution.vtu",
+            "nodes.csv",
+            "summary.json",
+            "deflection.png",
+        ] {
+            assert!(
+                dir.path().join("out").join(file).is_file(),
+                "{name}: {file}"
+            );
         }
         let b = w.outcome;
         assert_eq!(a.report.method, Method::Multigrid, "{name}");

@@ -1,8 +1,8 @@
 //! The adaptive loop itself ([`run_adapt`]), as the module's overview describes it.
 
-use crate::case::{AdaptSpec, Case};
 use super::row::AdaptRow;
 use super::{bisect, estimate::estimate, mark};
+use crate::case::{AdaptSpec, Case};
 use crate::discretization::{build_mesh, check_case_on_mesh, BoundData, Discretization};
 use crate::error::{Error, Invalid, Result};
 use crate::field::{Field, Stiffness};

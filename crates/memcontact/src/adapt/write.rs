@@ -4,12 +4,12 @@
 //! set in `step-000/`, `step-001/`, ...
 
 use super::row::AdaptRow;
-use crate::write::{new_run_id, write_files, WriteOptions};
 use crate::case::Case;
 use crate::error::Result;
 use crate::io::result_set::ResultSet;
 use crate::outcome::summary::AdaptTotals;
 use crate::outcome::{NodalFields, Outcome, Summary};
+use crate::write::{new_run_id, write_files, WriteOptions};
 use std::path::Path;
 
 /// The name of the table of steps.

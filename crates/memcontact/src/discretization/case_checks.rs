@@ -2,8 +2,8 @@
 //! load case bound to it (and assembled, when asked), and the profile line of `[output]`
 //! crossing it.
 
-use crate::case::Case;
 use super::{assemble_model, bind_and_check};
+use crate::case::Case;
 use crate::error::{Error, Result};
 use crate::mesh::Mesh;
 

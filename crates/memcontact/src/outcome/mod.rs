@@ -8,9 +8,11 @@ mod report;
 mod solved;
 pub mod summary;
 pub mod sweep;
+mod system;
 
 pub use fields::{LowerFields, LowerTotals, NodalFields, Totals};
 pub use report::Report;
 pub use solved::Outcome;
 pub use summary::{FileRecord, Summary};
 pub use sweep::StepRow;
+pub use system::{SparseRows, System, SystemBody};

@@ -8,8 +8,8 @@
 //! L, the tension S, and the obstacle offset adds to φₙ. A load case with new data
 //! assembles once on the same mesh.
 
-use crate::discretization::check_case_on_mesh;
 use crate::case::{steps, Case, StepSpec, SweepParameter};
+use crate::discretization::check_case_on_mesh;
 use crate::discretization::{assemble_model, Discretization, Phase};
 use crate::error::{Error, Result};
 use crate::mesh::refine::Hierarchy;

@@ -22,9 +22,9 @@ mod tests;
 pub use manifest::{write_manifest, Manifest, MANIFEST};
 pub use memcontact_plot::{PlotKind, PlotOptions, Units as PlotUnits};
 pub use pictures::{
-    adapt_pictures, draw_all, pictures, plot_options, steps_kind, study_pictures, sweep_picture,
-    write_png, write_result, SweepWriter, CONVERGENCE_PICTURE, H_SWEEP_PICTURE, MESH_PICTURE,
-    SWEEP_PICTURE,
+    adapt_pictures, draw_all, pictures, plot_options, render_png, steps_kind, study_pictures,
+    sweep_picture, write_png, write_result, SweepWriter, CONVERGENCE_PICTURE, H_SWEEP_PICTURE,
+    MESH_PICTURE, SWEEP_PICTURE,
 };
 pub use redraw::{load as load_result, Loaded, ResultData};
 pub use result::{

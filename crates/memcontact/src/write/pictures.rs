@@ -80,6 +80,51 @@ pub fn draw_all(dir: &Path, data: &PlotData, options: &PlotOptions) -> Result<Ve
         .collect()
 }
 
+/// Calls `draw` with the fields of `fields` on `mesh` as the picture crate takes them:
+/// with a body below, both bodies' contact is drawn ([`memcontact_plot::bodies`]). The one
+/// preparation of the data of every picture of a result.
+fn with_plot_data<T>(
+    mesh: &Mesh,
+    fields: &NodalFields,
+    draw: impl FnOnce(&PlotData) -> Result<T>,
+) -> Result<T> {
+    let upper = BodyFields {
+        phi: &fields.phi,
+        state: &fields.state,
+        pressure: &fields.pressure,
+        covered: &fields.covered,
+    };
+    let merged = fields.lower.as_ref().map(|l| {
+        merge(
+            upper,
+            BodyFields {
+                phi: &l.phi,
+                state: &l.state,
+                pressure: &l.pressure,
+                covered: &l.covered,
+            },
+        )
+    });
+    let shown = match &merged {
+        Some(m) => BodyFields {
+            phi: &m.phi,
+            state: &m.state,
+            pressure: &m.pressure,
+            covered: &m.covered,
+        },
+        None => upper,
+    };
+    draw(&PlotData {
+        points: &mesh.points,
+        triangles: &mesh.triangles,
+        u: &fields.u,
+        phi: shown.phi,
+        state: shown.state,
+        pressure: shown.pressure,
+        covered: shown.covered,
+    })
+}
+
 /// The pictures of `options` as the `extra` files of [`super::write_files`]:
 /// drawn into the directory from the nodal fields on `mesh`; returns their names.
 pub fn pictures<'a>(
@@ -90,49 +135,35 @@ pub fn pictures<'a>(
         if options.plots.is_empty() {
             return Ok(Vec::new());
         }
-        let upper = BodyFields {
-            phi: &fields.phi,
-            state: &fields.state,
-            pressure: &fields.pressure,
-            covered: &fields.covered,
-        };
-        // With a body below, both bodies' contact is drawn ([`memcontact_plot::bodies`]).
-        let merged = fields.lower.as_ref().map(|l| {
-            merge(
-                upper,
-                BodyFields {
-                    phi: &l.phi,
-                    state: &l.state,
-                    pressure: &l.pressure,
-                    covered: &l.covered,
-                },
-            )
-        });
-        let shown = match &merged {
-            Some(m) => BodyFields {
-                phi: &m.phi,
-                state: &m.state,
-                pressure: &m.pressure,
-                covered: &m.covered,
-            },
-            None => upper,
-        };
-        let data = PlotData {
-            points: &mesh.points,
-            triangles: &mesh.triangles,
-            u: &fields.u,
-            phi: shown.phi,
-            state: shown.state,
-            pressure: shown.pressure,
-            covered: shown.covered,
-        };
-        let files =
-            draw_all(dir, &data, options).map_err(|e| Error::Data(format!("pictures: {e}")))?;
+        let files = with_plot_data(mesh, fields, |data| {
+            draw_all(dir, data, options).map_err(|e| Error::Data(format!("pictures: {e}")))
+        })?;
         Ok(files
             .iter()
             .filter_map(|f| f.file_name().map(|n| n.to_string_lossy().into_owned()))
             .collect())
     }
+}
+
+/// One picture of the fields of a result on `mesh`, drawn in memory as PNG bytes (the same
+/// bytes as the file of a result set drawn with `options`): for a notebook's display.
+pub fn render_png(
+    mesh: &Mesh,
+    fields: &NodalFields,
+    options: &PlotOptions,
+    kind: PlotKind,
+) -> Result<Vec<u8>> {
+    let options = PlotOptions {
+        plots: vec![kind],
+        ..options.clone()
+    };
+    with_plot_data(mesh, fields, |data| {
+        let pictures = render(data, &options)?;
+        let picture = pictures
+            .first()
+            .ok_or_else(|| Error::Data("no picture was drawn".into()))?;
+        Ok(picture.canvas.encode_png()?)
+    })
 }
 
 /// The file name of the mesh picture of an adaptive run.
