@@ -93,15 +93,7 @@ fn solve_on(
 /// case file without `[mesh]` solved on a mesh given as data.
 #[pyfunction]
 fn _case_table<'py>(py: Python<'py>, path: std::path::PathBuf) -> PyResult<Bound<'py, PyAny>> {
-    let bytes = memcontact::io::input::read_input(&path, memcontact::io::input::CASE_FILE)
-        .map_err(convert::py_err)?;
-    let text = String::from_utf8(bytes).map_err(|e| {
-        PyValueError::new_err(format!(
-            "{}: is not UTF-8 text (invalid byte at offset {})",
-            path.display(),
-            e.utf8_error().valid_up_to()
-        ))
-    })?;
+    let text = memcontact::case::read_case_text(&path).map_err(convert::py_err)?;
     let table: toml::Table = toml::from_str(&text).map_err(|e| {
         PyValueError::new_err(format!(
             "{}: malformed TOML: {}",

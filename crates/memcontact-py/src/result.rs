@@ -6,11 +6,11 @@ use crate::convert::{py_err, to_py};
 use crate::mesh::{hierarchy_from_state, mesh_state, PyMesh};
 use crate::views::{self, Cache};
 use memcontact::case::VtuFormat;
-use memcontact::certificate::Certificate;
 use memcontact::discretization::Phase;
 use memcontact::outcome::fields::{LowerFields, NodalFields};
 use memcontact::outcome::{SparseRows, System, SystemBody};
 use memcontact::run::step_discretization;
+use memcontact::solve::Certificate;
 use memcontact::solve::{Choice, Fallback, IterationRecord, Multipliers, Silent};
 use memcontact::write::PlotKind;
 use memcontact::write::{input_hash, new_run_id, WriteOptions};
@@ -304,7 +304,7 @@ struct ReportState {
     requested: Method,
     method: Method,
     #[serde(default)]
-    coarsening: Option<memcontact::solve::multigrid::Kind>,
+    coarsening: Option<memcontact::solve::HierarchyKind>,
     choice: Choice,
     fallback: Option<Fallback>,
     message: Option<String>,

@@ -4,7 +4,6 @@
 #[path = "pictures_common/mod.rs"]
 mod common;
 
-use memcontact::io::json::write_json;
 use memcontact::io::vtu::{write_vtu, DataArray, VtuEncoding};
 use memcontact::mesh::Mesh;
 use memcontact::write::{draw_all, load_result as load, ResultData};
@@ -55,7 +54,11 @@ fn write_result(
     if let Some(o) = opts {
         summary["plot_options"] = serde_json::to_value(o).unwrap();
     }
-    write_json(&dir.join("summary.json"), &summary).unwrap();
+    std::fs::write(
+        dir.join("summary.json"),
+        serde_json::to_vec(&summary).unwrap(),
+    )
+    .unwrap();
 }
 
 #[test]
@@ -112,7 +115,11 @@ fn missing_optional_fields_are_assumed_and_said() {
     assert_eq!(loaded.data.state, d.state);
     // A broken plot_options is an error naming the key.
     let summary = serde_json::json!({ "case": "x", "plot_options": { "plots": ["contour"] } });
-    write_json(&dir.path().join("summary.json"), &summary).unwrap();
+    std::fs::write(
+        dir.path().join("summary.json"),
+        serde_json::to_vec(&summary).unwrap(),
+    )
+    .unwrap();
     let e = load(dir.path()).unwrap_err().to_string();
     assert!(
         e.contains("summary.json") && e.contains("plot_options"),

@@ -12,7 +12,7 @@ pub mod standard;
 
 use anyhow::{bail, Context, Result};
 use memcontact::problem::MeshSource;
-use memcontact::solve::multigrid::Kind;
+use memcontact::solve::HierarchyKind as Kind;
 use memcontact::solve::{HierarchyChoice, Method, Silent};
 use memcontact::write::WriteOptions;
 use memcontact::Case;

@@ -291,8 +291,9 @@ impl Case {
     }
 }
 
-/// Reads a case file: a regular file, at most [`crate::io::input::CASE_FILE_CAP`] bytes, UTF-8.
-fn read_case_text(path: &Path) -> Result<String> {
+/// Reads a case file's text: a regular file, at most [`CASE_FILE_CAP`](super::CASE_FILE_CAP)
+/// bytes, UTF-8 (errors name the file).
+pub fn read_case_text(path: &Path) -> Result<String> {
     let bytes = crate::io::input::read_input(path, crate::io::input::CASE_FILE)?;
     String::from_utf8(bytes).map_err(|e| Error::File {
         path: path.to_path_buf(),

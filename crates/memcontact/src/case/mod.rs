@@ -19,7 +19,7 @@ mod tests;
 pub use crate::io::input::CASE_FILE_CAP;
 pub use adapt::AdaptSpec;
 pub use exact::{BenchmarkBody, ExactSpec, ManufacturedDomain, ManufacturedForm};
-pub use file::{steps, Case};
+pub use file::{read_case_text, steps, Case};
 pub use output::{OutputOptions, PictureKind, Units, VtuFormat};
 pub use overrides::apply_overrides;
 pub use sweep::{

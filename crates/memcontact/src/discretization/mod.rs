@@ -3,11 +3,13 @@
 //! sweeps reuse it.
 
 mod binding;
-mod case_checks;
+pub(crate) mod case_checks;
 mod discrete;
 mod meshing;
+#[cfg(test)]
+mod ordering_tests;
 
-pub use binding::{assemble_model, bind_and_check, BoundBody, BoundData};
-pub use case_checks::{check_case_on_mesh, check_load_cases_on_mesh, check_profile_on_mesh};
+pub(crate) use binding::{assemble_model, bind_and_check, BoundData};
+pub(crate) use case_checks::check_case_on_mesh;
 pub use discrete::{Discretization, Phase};
-pub use meshing::build_mesh;
+pub(crate) use meshing::build_mesh;

@@ -187,11 +187,6 @@ impl NodalP1 {
             + l[1] * self.values[t[1] as usize]
             + l[2] * self.values[t[2] as usize]
     }
-
-    /// The values at the vertices.
-    pub fn values(&self) -> &[f64] {
-        &self.values
-    }
 }
 
 #[cfg(test)]

@@ -2,7 +2,7 @@
 //! fields and totals in the user's numbering, `summary.json`'s values, and the checks they
 //! pass before anything is written.
 
-pub mod checks;
+pub(crate) mod checks;
 pub mod fields;
 mod report;
 mod solved;

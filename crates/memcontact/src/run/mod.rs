@@ -17,8 +17,6 @@ mod one;
 mod sweep;
 
 pub use crate::adapt::{check_adapt_on_mesh, run_adapt, AdaptRun, AdaptStop, OnStep};
-pub use crate::discretization::{
-    check_case_on_mesh, check_load_cases_on_mesh, check_profile_on_mesh,
-};
+pub use crate::verify::study::{run_study, StudyOptions, StudyOutcome};
 pub use one::{check, run, run_to_files, Checked, Written};
 pub use sweep::{apply, run_sweep, run_sweep_on, step_discretization, step_model, SweepRun};

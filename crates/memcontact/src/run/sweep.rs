@@ -348,9 +348,13 @@ stiffness = 300
         .unwrap();
         let d = Discretization::new(&c.problem, &mut Silent).unwrap();
         for assemble in [false, true] {
-            let e = crate::discretization::check_load_cases_on_mesh(&c, d.mesh(), assemble)
-                .unwrap_err()
-                .to_string();
+            let e = crate::discretization::case_checks::check_load_cases_on_mesh(
+                &c,
+                d.mesh(),
+                assemble,
+            )
+            .unwrap_err()
+            .to_string();
             assert!(e.contains("load_case.1.shape") && e.contains("clay"), "{e}");
         }
         let mut solved = 0;

@@ -12,19 +12,20 @@
 //! Every solve ends with the certificates of 2e and 2f; not reaching the tolerance is an
 //! error, never a silently returned iterate.
 
-pub mod active_set;
-pub mod coordinate;
-pub mod line_search;
-pub mod linear;
-pub mod multigrid;
-pub mod newton;
-pub mod qp;
-pub mod relax;
+pub(crate) mod active_set;
+pub(crate) mod coordinate;
+pub(crate) mod line_search;
+pub(crate) mod linear;
+pub(crate) mod multigrid;
+pub(crate) mod newton;
+pub(crate) mod qp;
+pub(crate) mod relax;
 
-use crate::certificate::Certificate;
+pub use crate::certificate::Certificate;
 use crate::error::{Error, Result};
 use crate::mesh::refine::Hierarchy;
 use crate::model::Model;
+pub use multigrid::Kind as HierarchyKind;
 use std::time::Instant;
 
 /// The solution methods.

@@ -2,11 +2,11 @@
 //! Gmsh writes it) is solved in a renumbered order, and every output comes back in the
 //! user's numbering, equal to the answer computed without renumbering up to rounding.
 
-use memcontact::discretization::BoundData;
-use memcontact::field::Field;
-use memcontact::model::Model;
-use memcontact::solve::{self, Method, Silent};
-use memcontact::{run, Case};
+use super::BoundData;
+use crate::field::Field;
+use crate::model::Model;
+use crate::solve::{self, Method, Silent};
+use crate::{run, Case};
 use std::path::Path;
 
 fn site_case(method: &str, load: Option<Field>) -> Case {
@@ -35,13 +35,13 @@ tolerance = 1e-12
 
 #[test]
 fn renumbered_solve_answers_in_the_users_numbering() {
-    let user = memcontact::io::gmsh::read_msh(
+    let user = crate::io::gmsh::read_msh(
         &Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/site.msh"),
     )
     .unwrap()
     .0;
     assert!(
-        memcontact::mesh::reorder::edge_span(&user) > 4.0,
+        crate::mesh::reorder::edge_span(&user) > 4.0,
         "a scattered numbering"
     );
     // The load as nodal values in the file's vertex order: 20 + 3x is linear, so its P1
