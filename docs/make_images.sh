@@ -4,6 +4,8 @@
 #     (getting-started.md);
 #   - adapt-mesh.png: the final mesh of `examples/roof-corner.toml`'s adaptive loop
 #     (adaptivity.md);
+#   - geomembrane-deflection.png, geomembrane-liftoff.png: the pictures of a membrane
+#     between two bodies, `examples/geomembrane.toml` (outputs.md, "Pictures");
 #   - python-deflection.png: the matplotlib picture of the Python guide (python.md), when
 #     the `memcontact` package and matplotlib can be imported by $PYTHON.
 # Usage: docs/make_images.sh   (MEMCONTACT: the binary; default: a release build made with
@@ -27,6 +29,12 @@ done
 "$MEMCONTACT" solve examples/roof-corner.toml -o "$TMP/roof-corner" -q \
     --set 'output.plots=["profile"]' >/dev/null
 cp "$TMP/roof-corner/mesh.png" "$IMAGES/adapt-mesh.png"
+
+"$MEMCONTACT" solve examples/geomembrane.toml -o "$TMP/geomembrane" -q \
+    --set 'output.plots=["deflection", "liftoff"]' >/dev/null
+for p in deflection liftoff; do
+    cp "$TMP/geomembrane/$p.png" "$IMAGES/geomembrane-$p.png"
+done
 
 
 PYTHON="${PYTHON:-python3}"

@@ -84,6 +84,7 @@ fn main() {
         state: &state,
         pressure: &pressure,
         covered: &covered,
+        lower: None,
     };
     let options = PlotOptions {
         title: Some(format!("synthetic square N = {n}")),

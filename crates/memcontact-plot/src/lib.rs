@@ -12,6 +12,11 @@
 //!   with the gap φ − u there;
 //! * `profile.png`: u and φ along a line against arc length, contact stretches shaded.
 //!
+//! With a body below the membrane ([`PlotData::lower`]), every picture tells the two
+//! bodies apart: each body's contact zone outlined (the obstacle's solid, the body
+//! below's dashed) and named, on the lift-off map each body's contact and each body's gap
+//! in its own colours, in the profile both surfaces and each body's contact stretches.
+//!
 //! Maps are rasterised here (every pixel centre interpolates the nodal field in the
 //! triangle that covers it, see [`raster`]), in parallel and deterministically, so that a
 //! mesh of a million vertices is drawn in a fraction of a second. Also here: the log-log
@@ -23,7 +28,6 @@
 //! them from a result directory. It prints nothing: errors are returned.
 
 pub mod axes;
-pub mod bodies;
 pub mod canvas;
 pub mod colormap;
 pub mod lines;
@@ -40,7 +44,8 @@ pub use canvas::{Canvas, PixelRect};
 pub use lines::{render_line_plot, LinePlot, Series};
 pub use loglog::loglog_plot;
 pub use maps::{
-    field_plot, mesh_plot, MapLayout, Picture, CONTACT, NOT_COVERED, OUTLINE, PRESSURE_OUTLINE,
+    field_plot, mesh_plot, MapLayout, Picture, CONTACT, LOWER_CONTACT, LOWER_OUTLINE,
+    LOWER_PRESSURE_OUTLINE, NOT_COVERED, OUTLINE, PRESSURE_OUTLINE,
 };
 pub use raster::MapTransform;
 
@@ -249,6 +254,23 @@ pub struct PlotData<'a> {
     pub pressure: &'a [f64],
     /// Where the body can touch the membrane (the set M of the paper's problem 2b).
     pub covered: &'a [bool],
+    /// The body below the membrane's fields, when there is one (the membrane between two
+    /// bodies): then each picture draws each body's contact separately.
+    pub lower: Option<BodyData<'a>>,
+}
+
+/// The fields of the body below the membrane (surface φ_low, reaction pushing up where
+/// the membrane sinks into it), borrowed, one value per mesh vertex.
+#[derive(Debug, Clone, Copy)]
+pub struct BodyData<'a> {
+    /// Its surface φ_low (sampled at the vertices).
+    pub phi: &'a [f64],
+    /// Vertex state: −1 clear (u > φ_low), 0 touching (u = φ_low), 1 sunk in (u < φ_low).
+    pub state: &'a [i8],
+    /// Its contact pressure (≥ 0, pushing up).
+    pub pressure: &'a [f64],
+    /// Where it lies under the membrane and can touch it.
+    pub covered: &'a [bool],
 }
 
 impl PlotData<'_> {
@@ -258,13 +280,22 @@ impl PlotData<'_> {
         if n == 0 || self.triangles.is_empty() {
             return Err(Error::Data("plot: the mesh has no triangle to draw".into()));
         }
-        for (name, len) in [
+        let mut lengths = vec![
             ("u", self.u.len()),
             ("phi", self.phi.len()),
             ("state", self.state.len()),
             ("pressure", self.pressure.len()),
             ("covered", self.covered.len()),
-        ] {
+        ];
+        if let Some(l) = &self.lower {
+            lengths.extend([
+                ("phi_low", l.phi.len()),
+                ("state_low", l.state.len()),
+                ("pressure_low", l.pressure.len()),
+                ("covered_low", l.covered.len()),
+            ]);
+        }
+        for (name, len) in lengths {
             if len != n {
                 return Err(Error::Data(format!(
                     "plot: field `{name}` has {len} values, the mesh has {n} vertices"
@@ -296,10 +327,28 @@ impl PlotData<'_> {
                 self.state[i]
             )));
         }
+        if let Some(l) = &self.lower {
+            if let Some(i) = l.state.iter().position(|s| !(-1..=1).contains(s)) {
+                return Err(Error::Data(format!(
+                    "plot: vertex {i} has state_low {} (expected -1, 0 or 1)",
+                    l.state[i]
+                )));
+            }
+        }
         if let Some(i) = self.u.iter().position(|v| !v.is_finite()) {
             return Err(Error::Data(format!("plot: u is not finite at vertex {i}")));
         }
         Ok(())
+    }
+
+    /// True when vertex `i` is in contact with a body (touching or penetrating either).
+    pub fn in_contact(&self, i: usize) -> bool {
+        self.state[i] >= 0 || self.lower.is_some_and(|l| l.state[i] >= 0)
+    }
+
+    /// True when vertex `i` penetrates a body (u > φ, or u < φ_low).
+    pub fn penetrating(&self, i: usize) -> bool {
+        self.state[i] == 1 || self.lower.is_some_and(|l| l.state[i] == 1)
     }
 
     /// The bounding box `[xmin, xmax, ymin, ymax]` of the triangles' vertices.

@@ -10,7 +10,8 @@ use memcontact::write::draw_all;
 use memcontact_plot::canvas::{decode_png, Rgb};
 use memcontact_plot::{
     hatch_color, render, MapLayout, Picture, PlotData, PlotKind, PlotOptions, Units, CONTACT,
-    MAP_HEIGHT, MAP_WIDTH, NOT_COVERED, OUTLINE, PROFILE_HEIGHT, PROFILE_WIDTH,
+    LOWER_CONTACT, LOWER_OUTLINE, LOWER_PRESSURE_OUTLINE, MAP_HEIGHT, MAP_WIDTH, NOT_COVERED,
+    OUTLINE, PRESSURE_OUTLINE, PROFILE_HEIGHT, PROFILE_WIDTH,
 };
 use std::collections::HashSet;
 
@@ -470,4 +471,337 @@ fn allowable_pressure_outlines_the_area_above_one() {
         outlined as f64 >= 0.95 * edges as f64,
         "{outlined} of {edges} crossings outlined"
     );
+}
+
+/// The picture options of the two-body liner: its units, and a profile line across the
+/// gas bubble (contact with the obstacle) and the stone (squeezed between the bodies).
+fn liner_options(s: &Solved) -> PlotOptions {
+    PlotOptions {
+        units: Units {
+            length: Some("m".into()),
+            force: Some("kN".into()),
+        },
+        profile: Some([[0.0, 14.0], [20.0, 14.0]]),
+        ..options(s)
+    }
+}
+
+/// Pixels of `color` in the frame of map `p` lie only in triangles with a vertex where
+/// `mine` holds, and fill at least 85 % of the pixels of the triangles whose vertices all
+/// have `mine` and none `other` (outlines drawn over the fill take the rest). Returns the
+/// pixels of `color` in the triangles whose vertices all have both.
+fn check_fill(
+    name: &str,
+    p: &Picture,
+    layout: &MapLayout,
+    d: &PlotData,
+    color: Rgb,
+    mine: &dyn Fn(usize) -> bool,
+    other: &dyn Fn(usize) -> bool,
+) -> usize {
+    let (_, frame) = p.map.unwrap();
+    let (mut inside, mut hit, mut both) = (0usize, 0usize, 0usize);
+    for y in frame.y0..frame.y1 {
+        for x in frame.x0..frame.x1 {
+            let Some(t) = layout.triangle_at(x, y) else {
+                continue;
+            };
+            let c = p.canvas.get(x as u32, y as u32);
+            let tri = d.triangles[t as usize].map(|v| v as usize);
+            let k = tri.iter().filter(|&&v| mine(v)).count();
+            let o = tri.iter().filter(|&&v| other(v)).count();
+            assert!(
+                c != color || k > 0,
+                "{name}: its colour at ({x}, {y}), in a triangle without a vertex in contact"
+            );
+            if k == 3 && o == 0 {
+                inside += 1;
+                hit += (c == color) as usize;
+            }
+            if k == 3 && o == 3 {
+                both += (c == color) as usize;
+            }
+        }
+    }
+    assert!(inside > 500, "{name}: {inside} pixels of contact alone");
+    assert!(
+        hit as f64 >= 0.85 * inside as f64,
+        "{name}: {hit} of {inside} pixels in its colour"
+    );
+    both
+}
+
+/// Pixels of `color` (an outline) lie within 3 pixels of a triangle whose vertices are
+/// partly in the set `inside`; there are more than 20 of them.
+fn check_outline(
+    name: &str,
+    p: &Picture,
+    layout: &MapLayout,
+    d: &PlotData,
+    color: Rgb,
+    inside: &dyn Fn(usize) -> bool,
+) {
+    let (_, frame) = p.map.unwrap();
+    let mut mixed = HashSet::new();
+    let mut line = Vec::new();
+    for y in frame.y0..frame.y1 {
+        for x in frame.x0..frame.x1 {
+            if p.canvas.get(x as u32, y as u32) == color {
+                line.push((x, y));
+            }
+            if let Some(t) = layout.triangle_at(x, y) {
+                let k = d.triangles[t as usize]
+                    .iter()
+                    .filter(|&&v| inside(v as usize))
+                    .count();
+                if k > 0 && k < 3 {
+                    mixed.insert((x, y));
+                }
+            }
+        }
+    }
+    let near =
+        |x: i32, y: i32| (-3..=3).any(|dy| (-3..=3).any(|dx| mixed.contains(&(x + dx, y + dy))));
+    let far: Vec<_> = line.iter().filter(|&&(x, y)| !near(x, y)).collect();
+    assert!(
+        far.is_empty(),
+        "{name}: outline pixels away from its contact edge: {:?}",
+        &far[..far.len().min(5)]
+    );
+    assert!(line.len() > 20, "{name}: {} outline pixels", line.len());
+}
+
+/// A membrane between two bodies (a small geomembrane liner, with a stone in the subsoil
+/// that squeezes it into the cover): every picture draws each body's contact in its own
+/// colour, where and only where the membrane touches that body, and names both bodies;
+/// the files are the pictures.
+#[test]
+fn liner_pictures_tell_the_two_bodies_apart() {
+    let s = common::liner();
+    let d = s.data.view();
+    let low = d.lower.expect("the liner lies on a body below");
+    let n = d.points.len();
+    let up = |i: usize| d.state[i] >= 0;
+    let down = |i: usize| low.state[i] >= 0;
+    // The case has every kind of vertex.
+    assert!(
+        (0..n).any(|i| up(i) && !down(i)),
+        "contact with the obstacle alone"
+    );
+    assert!(
+        (0..n).any(|i| down(i) && !up(i)),
+        "contact with the body below alone"
+    );
+    assert!((0..n).any(|i| up(i) && down(i)), "squeezed between both");
+    assert!((0..n).any(|i| !up(i) && !down(i)), "clear of both");
+    let opts = liner_options(&s);
+    let pics = render(&d, &opts).unwrap();
+    assert_eq!(pics.len(), 4);
+    let dir = tempfile::tempdir().unwrap();
+    let files = draw_all(dir.path(), &d, &opts).unwrap();
+    for (f, p) in files.iter().zip(&pics) {
+        common::keep(f, s.name);
+        let back = decode_png(&std::fs::read(f).unwrap()).unwrap();
+        assert!(back == p.canvas, "{} differs from the picture", f.display());
+    }
+    // Texts on the canvas, none over another.
+    for p in &pics {
+        let (w, h) = (p.canvas.width as i32, p.canvas.height as i32);
+        for (i, a) in p.text_boxes.iter().enumerate() {
+            assert!(
+                a.x0 >= 0 && a.y0 >= 0 && a.x1 <= w && a.y1 <= h,
+                "{:?}: text box {a:?} leaves the canvas",
+                p.kind
+            );
+            for b in &p.text_boxes[..i] {
+                assert!(
+                    !a.overlaps(b),
+                    "{:?}: texts {a:?} and {b:?} overlap",
+                    p.kind
+                );
+            }
+        }
+    }
+    // The legends name both bodies.
+    let legend = |k: usize| pics[k].legend.join(" | ");
+    for (k, want) in [
+        (
+            0,
+            &["contact with the obstacle", "contact with the body below"][..],
+        ),
+        (
+            1,
+            &["contact with the obstacle", "contact with the body below"][..],
+        ),
+        (
+            2,
+            &[
+                "obstacle: contact",
+                "body below: contact",
+                "both: squeezed",
+                "obstacle: gap",
+                "body below: gap",
+            ][..],
+        ),
+        (
+            3,
+            &[
+                "obstacle φ",
+                "body below φ_low",
+                "contact with the obstacle",
+                "contact with the body below",
+            ][..],
+        ),
+    ] {
+        for w in want {
+            assert!(
+                legend(k).contains(w),
+                "{:?}: {w:?} in {}",
+                pics[k].kind,
+                legend(k)
+            );
+        }
+    }
+    let layout = MapLayout::new(&d);
+
+    // Deflection: each body's outline along its own contact edge; hatching over the
+    // contact with either body, none over triangles clear of both.
+    check_outline("deflection, obstacle", &pics[0], &layout, &d, OUTLINE, &up);
+    check_outline(
+        "deflection, body below",
+        &pics[0],
+        &layout,
+        &d,
+        LOWER_OUTLINE,
+        &down,
+    );
+    let (_, frame) = pics[0].map.unwrap();
+    let (mut lattice, mut hit) = (0usize, 0usize);
+    for y in frame.y0..frame.y1 {
+        for x in frame.x0..frame.x1 {
+            let Some(t) = layout.triangle_at(x, y) else {
+                continue;
+            };
+            let c = pics[0].canvas.get(x as u32, y as u32);
+            let tri = d.triangles[t as usize].map(|v| v as usize);
+            let touching = tri.iter().filter(|&&v| up(v) || down(v)).count();
+            let hatch = c == [255, 255, 255] || c == [0, 0, 0];
+            if touching == 0 {
+                assert!(!hatch, "deflection: hatching at ({x}, {y}) clear of both");
+            } else if touching == 3 && tri.iter().all(|&v| !up(v) && low.state[v] == 1) {
+                // Sunk into the body below only: the penetrating pattern.
+                if let Some(want) = hatch_color(x, y, true) {
+                    lattice += 1;
+                    hit += (c == want) as usize;
+                }
+            }
+        }
+    }
+    assert!(
+        lattice > 50 && hit as f64 >= 0.75 * lattice as f64,
+        "{hit}/{lattice}"
+    );
+
+    // Pressure: each body's outline along its own contact edge.
+    check_outline(
+        "pressure, obstacle",
+        &pics[1],
+        &layout,
+        &d,
+        PRESSURE_OUTLINE,
+        &up,
+    );
+    check_outline(
+        "pressure, body below",
+        &pics[1],
+        &layout,
+        &d,
+        LOWER_PRESSURE_OUTLINE,
+        &down,
+    );
+
+    // Lift-off: each body's contact colour where, and only where, it touches; both, in
+    // stripes, where the membrane is squeezed; elsewhere neither.
+    let squeezed_up = check_fill(
+        "lift-off, obstacle",
+        &pics[2],
+        &layout,
+        &d,
+        CONTACT,
+        &up,
+        &down,
+    );
+    let squeezed_low = check_fill(
+        "lift-off, body below",
+        &pics[2],
+        &layout,
+        &d,
+        LOWER_CONTACT,
+        &down,
+        &up,
+    );
+    assert!(
+        squeezed_up > 20 && squeezed_low > 20,
+        "stripes of both where squeezed: {squeezed_up}, {squeezed_low}"
+    );
+    // Clear of both: a gap colour (not grey: both bodies cover everything).
+    let (_, frame) = pics[2].map.unwrap();
+    for y in frame.y0..frame.y1 {
+        for x in frame.x0..frame.x1 {
+            if let Some(t) = layout.triangle_at(x, y) {
+                let tri = d.triangles[t as usize].map(|v| v as usize);
+                if tri.iter().all(|&v| !up(v) && !down(v)) {
+                    let c = pics[2].canvas.get(x as u32, y as u32);
+                    assert!(
+                        c != NOT_COVERED && c != CONTACT && c != LOWER_CONTACT,
+                        "lift-off: {c:?} at ({x}, {y}), clear of both"
+                    );
+                }
+            }
+        }
+    }
+    // The gaps' range: both gaps shown, from the contact edges (about 0) up.
+    let (glo, ghi) = pics[2].range.expect("a gap is shown");
+    assert!(glo >= 0.0 && glo < 1e-2 && ghi > 0.05, "{glo} {ghi}");
+
+    // Profile: each body's contact stretches in its own shade.
+    let ax = pics[3].axes.unwrap();
+    let p = &pics[3];
+    let column = |x: i32, shade: Rgb| {
+        (ax.rect.y0..ax.rect.y1)
+            .filter(|&y| p.canvas.get(x as u32, y as u32) == shade)
+            .count() as f64
+            / ax.rect.height() as f64
+    };
+    let upper = memcontact_plot::profile::contact_along(&d, &opts);
+    let lower = memcontact_plot::profile::lower_contact_along(&d, &opts);
+    assert!(
+        !upper.is_empty() && !lower.is_empty(),
+        "{upper:?} {lower:?}"
+    );
+    for (stretches, shade, min) in [
+        (&upper, memcontact_plot::profile::CONTACT_SHADE, 0.35),
+        (&lower, memcontact_plot::profile::LOWER_SHADE, 0.35),
+    ] {
+        for &(a, b) in stretches {
+            let (xa, xb) = (ax.px(a), ax.px(b));
+            if xb - xa > 6.0 {
+                let m = ((xa + xb) / 2.0) as i32;
+                let f = (m - 3..=m + 3)
+                    .map(|x| column(x, shade))
+                    .fold(0.0, f64::max);
+                assert!(f > min, "stretch [{a}, {b}] shaded on {f}");
+            }
+        }
+        for x in ax.rect.x0 + 2..ax.rect.x1 - 2 {
+            let s_mid = (x as f64 + 0.5 - ax.rect.x0 as f64) / ax.rect.width() as f64 * ax.x.1;
+            let margin = 3.0 / ax.rect.width() as f64 * ax.x.1;
+            if stretches
+                .iter()
+                .all(|&(a, b)| s_mid < a - margin || s_mid > b + margin)
+            {
+                assert_eq!(column(x, shade), 0.0, "column {x} shaded outside contact");
+            }
+        }
+    }
 }

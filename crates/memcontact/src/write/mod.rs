@@ -26,7 +26,7 @@ pub use pictures::{
     sweep_picture, write_png, write_result, SweepWriter, CONVERGENCE_PICTURE, H_SWEEP_PICTURE,
     MESH_PICTURE, SWEEP_PICTURE,
 };
-pub use redraw::{load as load_result, Loaded, ResultData};
+pub use redraw::{load as load_result, Loaded, LowerData, ResultData};
 pub use result::{
     file_record, input_hash, new_run_id, write_fields, write_files, write_result_set, WriteOptions,
     LOWER_FIELDS, NODAL_FIELDS,

@@ -16,9 +16,9 @@ use crate::outcome::fields::NodalFields;
 use crate::outcome::{Outcome, StepRow, Summary};
 use crate::verify::convergence::LevelResult;
 use crate::verify::study::{StudyOutcome, StudyResult};
-use memcontact_plot::bodies::{merge, BodyFields};
 use memcontact_plot::{
-    render, render_line_plot, Canvas, LinePlot, PlotData, PlotKind, PlotOptions, Series, Units,
+    render, render_line_plot, BodyData, Canvas, LinePlot, PlotData, PlotKind, PlotOptions, Series,
+    Units,
 };
 use rayon::prelude::*;
 use std::path::{Path, PathBuf};
@@ -81,47 +81,28 @@ pub fn draw_all(dir: &Path, data: &PlotData, options: &PlotOptions) -> Result<Ve
 }
 
 /// Calls `draw` with the fields of `fields` on `mesh` as the picture crate takes them:
-/// with a body below, both bodies' contact is drawn ([`memcontact_plot::bodies`]). The one
-/// preparation of the data of every picture of a result.
+/// with a body below, its fields beside the obstacle's, so that each picture draws each
+/// body's contact separately. The one preparation of the data of every picture of a
+/// result.
 fn with_plot_data<T>(
     mesh: &Mesh,
     fields: &NodalFields,
     draw: impl FnOnce(&PlotData) -> Result<T>,
 ) -> Result<T> {
-    let upper = BodyFields {
-        phi: &fields.phi,
-        state: &fields.state,
-        pressure: &fields.pressure,
-        covered: &fields.covered,
-    };
-    let merged = fields.lower.as_ref().map(|l| {
-        merge(
-            upper,
-            BodyFields {
-                phi: &l.phi,
-                state: &l.state,
-                pressure: &l.pressure,
-                covered: &l.covered,
-            },
-        )
-    });
-    let shown = match &merged {
-        Some(m) => BodyFields {
-            phi: &m.phi,
-            state: &m.state,
-            pressure: &m.pressure,
-            covered: &m.covered,
-        },
-        None => upper,
-    };
     draw(&PlotData {
         points: &mesh.points,
         triangles: &mesh.triangles,
         u: &fields.u,
-        phi: shown.phi,
-        state: shown.state,
-        pressure: shown.pressure,
-        covered: shown.covered,
+        phi: &fields.phi,
+        state: &fields.state,
+        pressure: &fields.pressure,
+        covered: &fields.covered,
+        lower: fields.lower.as_ref().map(|l| BodyData {
+            phi: &l.phi,
+            state: &l.state,
+            pressure: &l.pressure,
+            covered: &l.covered,
+        }),
     })
 }
 
@@ -171,7 +152,8 @@ pub const MESH_PICTURE: &str = "mesh.png";
 
 /// The pictures of an adaptive run's final step (the `extra` files of
 /// [`super::AdaptSet::finish`]): those of `options`, and, when it draws any,
-/// `mesh.png`, the final mesh's edges with the outline of the contact zone.
+/// `mesh.png`, the final mesh's edges with the outline of the contact zone (of each
+/// body's, with a body below).
 pub fn adapt_pictures<'a>(
     mesh: &'a Mesh,
     options: &'a PlotOptions,
@@ -182,14 +164,17 @@ pub fn adapt_pictures<'a>(
         if options.plots.is_empty() {
             return Ok(names);
         }
-        let contact: Vec<bool> = (0..fields.state.len())
-            .map(|v| fields.state[v] >= 0 || fields.lower.as_ref().is_some_and(|l| l.state[v] >= 0))
-            .collect();
+        let contact: Vec<bool> = fields.state.iter().map(|&s| s >= 0).collect();
+        let contact_low: Option<Vec<bool>> = fields
+            .lower
+            .as_ref()
+            .map(|l| l.state.iter().map(|&s| s >= 0).collect());
         let title = format!("Mesh: {}", options.title.as_deref().unwrap_or(""));
         let picture = memcontact_plot::mesh_plot(
             &mesh.points,
             &mesh.triangles,
             &contact,
+            contact_low.as_deref(),
             &title,
             &options.units,
         )?;

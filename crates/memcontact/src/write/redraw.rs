@@ -1,11 +1,12 @@
 //! A result directory read back for redrawing: `solution.vtu` (point fields u, phi, state,
-//! pressure, and `covered` when present) and `summary.json` (the case's name and the plot
+//! pressure, and `covered` when present; with a body below, `phi_low`, `state_low`,
+//! `pressure_low` and `covered_low`) and `summary.json` (the case's name and the plot
 //! options used when it was solved), so that `memcontact plot DIR` draws the same
 //! pictures without solving again.
 
 use crate::error::{Error, Result};
 use crate::io::vtu::read_vtu;
-use memcontact_plot::{PlotData, PlotOptions};
+use memcontact_plot::{BodyData, PlotData, PlotOptions};
 use std::path::Path;
 
 /// The fields of a result, owned.
@@ -25,6 +26,21 @@ pub struct ResultData {
     pub pressure: Vec<f64>,
     /// Where the body can touch.
     pub covered: Vec<bool>,
+    /// The body below's fields, when there is one.
+    pub lower: Option<LowerData>,
+}
+
+/// The fields of the body below, owned.
+#[derive(Debug, Clone, Default)]
+pub struct LowerData {
+    /// Its surface φ_low.
+    pub phi: Vec<f64>,
+    /// −1 clear (u > φ_low), 0 touching, 1 sunk in (u < φ_low).
+    pub state: Vec<i8>,
+    /// Its contact pressure.
+    pub pressure: Vec<f64>,
+    /// Where it lies under the membrane.
+    pub covered: Vec<bool>,
 }
 
 impl ResultData {
@@ -38,6 +54,12 @@ impl ResultData {
             state: &self.state,
             pressure: &self.pressure,
             covered: &self.covered,
+            lower: self.lower.as_ref().map(|l| BodyData {
+                phi: &l.phi,
+                state: &l.state,
+                pressure: &l.pressure,
+                covered: &l.covered,
+            }),
         }
     }
 }
@@ -74,18 +96,21 @@ pub fn load(dir: &Path) -> Result<Loaded> {
     let u = field("u")?;
     let phi = field("phi")?;
     let pressure = field("pressure")?;
-    let state: Vec<i8> = field("state")?
-        .iter()
-        .enumerate()
-        .map(|(i, &s)| match s {
-            -1.0 => Ok(-1),
-            0.0 => Ok(0),
-            1.0 => Ok(1),
-            _ => Err(file_err(format!(
-                "point field `state` is {s} at vertex {i} (expected -1, 0 or 1)"
-            ))),
-        })
-        .collect::<Result<_>>()?;
+    let states = |name: &str, values: &[f64]| -> Result<Vec<i8>> {
+        values
+            .iter()
+            .enumerate()
+            .map(|(i, &s)| match s {
+                -1.0 => Ok(-1),
+                0.0 => Ok(0),
+                1.0 => Ok(1),
+                _ => Err(file_err(format!(
+                    "point field `{name}` is {s} at vertex {i} (expected -1, 0 or 1)"
+                ))),
+            })
+            .collect()
+    };
+    let state = states("state", &field("state")?)?;
     let covered: Vec<bool> = match mesh.point_array("covered") {
         Some(a) => a.values.iter().map(|&c| c != 0.0).collect(),
         None => {
@@ -97,33 +122,27 @@ pub fn load(dir: &Path) -> Result<Loaded> {
             phi.iter().map(|p| p.is_finite()).collect()
         }
     };
-    // A body below: its fields are drawn with the obstacle's, as when solving.
-    let (phi, state, pressure, covered) = match (
-        mesh.point_array("phi_low"),
-        mesh.point_array("state_low"),
-        mesh.point_array("pressure_low"),
-        mesh.point_array("covered_low"),
-    ) {
-        (Some(p), Some(s), Some(q), Some(c)) => {
-            let state_low: Vec<i8> = s.values.iter().map(|&x| x as i8).collect();
-            let covered_low: Vec<bool> = c.values.iter().map(|&x| x != 0.0).collect();
-            let m = memcontact_plot::bodies::merge(
-                memcontact_plot::bodies::BodyFields {
-                    phi: &phi,
-                    state: &state,
-                    pressure: &pressure,
-                    covered: &covered,
-                },
-                memcontact_plot::bodies::BodyFields {
-                    phi: &p.values,
-                    state: &state_low,
-                    pressure: &q.values,
-                    covered: &covered_low,
-                },
-            );
-            (m.phi, m.state, m.pressure, m.covered)
+    // A body below: its four fields, all or none.
+    let lower_names = ["phi_low", "state_low", "pressure_low", "covered_low"];
+    let present: Vec<&str> = lower_names
+        .into_iter()
+        .filter(|n| mesh.point_array(n).is_some())
+        .collect();
+    let lower = match present.len() {
+        0 => None,
+        4 => Some(LowerData {
+            phi: field("phi_low")?,
+            state: states("state_low", &field("state_low")?)?,
+            pressure: field("pressure_low")?,
+            covered: field("covered_low")?.iter().map(|&c| c != 0.0).collect(),
+        }),
+        _ => {
+            return Err(file_err(format!(
+                "has the body below's point fields {} but not all of {}",
+                present.join(", "),
+                lower_names.join(", ")
+            )))
         }
-        _ => (phi, state, pressure, covered),
     };
     let summary_path = dir.join("summary.json");
     let mut options = PlotOptions::default();
@@ -181,6 +200,7 @@ pub fn load(dir: &Path) -> Result<Loaded> {
         state,
         pressure,
         covered,
+        lower,
     };
     data.view().validate()?;
     options.validate()?;

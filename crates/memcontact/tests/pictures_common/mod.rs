@@ -4,7 +4,7 @@
 #![allow(dead_code)]
 
 use memcontact::solve::Silent;
-use memcontact::write::ResultData;
+use memcontact::write::{LowerData, ResultData};
 use memcontact::Case;
 use std::path::{Path, PathBuf};
 
@@ -41,6 +41,12 @@ pub fn solve_case(name: &'static str, toml: &str) -> Solved {
             state: fields.state,
             pressure: fields.pressure,
             covered: fields.covered,
+            lower: fields.lower.map(|l| LowerData {
+                phi: l.phi,
+                state: l.state,
+                pressure: l.pressure,
+                covered: l.covered,
+            }),
         },
         regions: mesh.regions,
     }
@@ -200,6 +206,38 @@ shape = "0.55 + 0.3*(x - 0.5)^2 + 0.1*y"
 stiffness = "50*(1 + y)"
 "#,
     )
+}
+
+/// `examples/geomembrane.toml` at a small size (32 × 32): a liner between a cover layer
+/// above and the subsoil below, with a stone in the subsoil that squeezes it into the
+/// cover, so that it touches the obstacle, the body below, both at once, and neither.
+pub const LINER: &str = r#"
+[mesh]
+generator = "rectangle"
+x1 = 20.0
+y1 = 20.0
+nx = 32
+ny = 32
+[membrane]
+tension = 15.0
+load = "1.6*exp(-((x - 6)^2 + (y - 13)^2)/12) - 0.5"
+[obstacle]
+shape = 0.05
+stiffness = 800.0
+[lower]
+shape = "-0.25*exp(-((x - 13)^2 + (y - 7)^2)/10) + 0.2*exp(-((x - 15)^2 + (y - 15)^2)/3)"
+stiffness = 2000.0
+foundation = "consistent"
+[boundary]
+height = 0.0
+[units]
+length = "m"
+force = "kN"
+"#;
+
+/// [`LINER`], solved.
+pub fn liner() -> Solved {
+    solve_case("liner", LINER)
 }
 
 /// The repository's `examples/` folder.
