@@ -84,12 +84,14 @@ impl Certificate {
         self.residual_2f.max(self.residual_2e)
     }
 
-    /// The residual is within [`AT_FLOOR`] times the rounding floor.
+    /// The residual is within twice the rounding floor (`AT_FLOOR`): iterating further only
+    /// moves the rounding errors around.
     pub fn at_floor(&self) -> bool {
         self.kkt() <= AT_FLOOR * self.rounding_floor
     }
 
-    /// Within [`NEAR_FLOOR`] times the rounding floor.
+    /// Within eight times the rounding floor (`NEAR_FLOOR`): a solve whose residual stops
+    /// decreasing there has reached what the arithmetic allows.
     pub fn near_floor(&self) -> bool {
         self.kkt() <= NEAR_FLOOR * self.rounding_floor
     }
@@ -574,7 +576,8 @@ fn evaluate_with<const EXT: bool>(
 
 impl Model {
     /// The optimality certificates of a candidate U (Problems 2e and 2f, scaled by the
-    /// forces of U): see [`evaluate`].
+    /// forces of U, with the energy and the rounding floor): see the theory page,
+    /// `docs/theory.md#certificates`.
     pub fn certificate(&self, u: &[f64]) -> Certificate {
         evaluate(self, u).certificate
     }

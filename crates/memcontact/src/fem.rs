@@ -57,6 +57,7 @@ impl Element {
 
     /// `∫_T c λ_a λ_b` (exact for constant c on the region, degree-5 quadrature otherwise):
     /// entry (a, b) of [`Element::weighted_mass_matrix`].
+    #[cfg(any(test, feature = "bench"))]
     #[inline]
     pub fn weighted_mass(&self, c: &dyn Coefficient, region: u32, a: usize, b: usize) -> f64 {
         self.weighted_mass_matrix(c, region)[sym_index(a, b)]
@@ -113,6 +114,7 @@ impl Element {
     }
 
     /// `∫_T c λ_a`: corner a of [`Element::weighted_load_row`].
+    #[cfg(any(test, feature = "bench"))]
     #[inline]
     pub fn weighted_load(&self, c: &dyn Coefficient, region: u32, a: usize) -> f64 {
         self.weighted_load_row(c, region)[a]
@@ -529,6 +531,7 @@ impl<'a> Loads<'a> {
 
 /// Fills a vector over unknowns: entry `i` sums `local(element, region, a)` over the
 /// triangles around `a_i` (`a` the local index of `a_i`).
+#[cfg(any(test, feature = "bench"))]
 pub fn assemble_vector(
     mesh: &Mesh,
     dofs: &DofMap,

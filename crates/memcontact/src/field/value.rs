@@ -41,8 +41,9 @@ impl Field {
         Field::Constant(value)
     }
 
-    /// Parses a number or an expression of `x, y` (see [`crate::field::expr`]); an expression that
-    /// does not depend on the position becomes a [`Field::Constant`] (`"2*pi"`, `"-3"`).
+    /// Parses a number or an expression of `x, y` (an [`Expr`], in the grammar of the case
+    /// file: `docs/case-file/index.md#expressions`); an expression that does not depend on
+    /// the position becomes a [`Field::Constant`] (`"2*pi"`, `"-3"`).
     pub fn parse(text: &str) -> Result<Field> {
         let e = Expr::parse(text)?;
         Ok(match e.constant_value() {

@@ -402,7 +402,7 @@ impl Mesh {
     /// so an edge `v → b` is shared exactly when `b → v` exists: v is interior when the
     /// vertices following it in its triangles are the vertices preceding it (its fan
     /// closes). One parallel pass over the vertices, without branches on the mesh's data
-    /// for the usual fans of up to [`SMALL_FAN`] triangles.
+    /// for the usual fans of up to 16 triangles.
     pub fn boundary_vertices_with(&self, adj: &VertexTriangles) -> Vec<bool> {
         use rayon::prelude::*;
         const NEXT: [usize; 3] = [1, 2, 0];

@@ -203,8 +203,8 @@ fn matrix_finite(l: &FoundationMatrix) -> bool {
     }
 }
 
-/// What overflowed, in terms of the data, for the messages of [`crate::outcome::checks::check_solution`] and
-/// [`crate::outcome::checks::check_results`].
+/// What overflowed, in terms of the data, for the messages of
+/// [`crate::solve::check_solution`] and of the checks of a run's fields and totals.
 pub const OVERFLOW_HINT: &str = "the data's scales (tension t, load f, stiffness h, shape φ, \
                              mesh size) overflow double precision; rescale the problem \
                              (units)";

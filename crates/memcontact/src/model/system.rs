@@ -266,7 +266,7 @@ impl Model {
     /// A force scale of the data, `max(‖D‖∞, ‖Sφ‖∞, ‖L|φ|‖∞)` (and the same of the body
     /// below): the size of the forces the problem can involve, for scaling a formulation
     /// (the QP). Certificates are scaled by the forces of the iterate instead
-    /// ([`crate::certificate`]).
+    /// (`docs/theory.md#certificates`).
     pub fn force_scale(&self) -> f64 {
         let body_scale = |l: &FoundationMatrix, phi: &[f64]| {
             let sphi = norm_inf(&self.s.mul(phi));

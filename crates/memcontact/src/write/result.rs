@@ -310,8 +310,9 @@ pub fn write_files(
     Ok(summary)
 }
 
-/// Writes the result set of `outcome` into `target` atomically ([`ResultSet`]): the files
-/// of [`write_files`], moved into place together. Returns the summary written.
+/// Writes the result set of `outcome` into `target` atomically: the files
+/// of [`write_files`], written into a staging directory beside it and moved into place
+/// together (the target holds the complete previous result or the complete new one). Returns the summary written.
 pub fn write_result_set(
     target: &Path,
     outcome: &Outcome,

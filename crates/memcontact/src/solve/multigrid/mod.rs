@@ -36,6 +36,8 @@ pub mod cycle;
 mod kernels;
 pub mod levels;
 pub mod operator;
+// The linear multigrid solve, the yardstick of the benchmark.
+#[cfg(any(test, feature = "bench"))]
 pub mod poisson;
 pub mod smoother;
 pub mod tnnmg;
@@ -49,5 +51,8 @@ pub(crate) mod tests;
 #[cfg(feature = "kernel-timings")]
 pub use kernels::kernel_timings;
 pub use levels::{Kind, Levels};
+#[cfg(any(test, feature = "bench"))]
 pub use poisson::poisson_solve;
-pub use tnnmg::{solve, solve_with, Coarsening, TnnmgOptions};
+pub use tnnmg::{solve, Coarsening};
+#[cfg(feature = "bench")]
+pub use tnnmg::{solve_with, TnnmgOptions};
