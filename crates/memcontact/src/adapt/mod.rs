@@ -1,6 +1,7 @@
-//! Adaptive refinement (the theory page, `docs/theory.md#adaptivity`). The loop: solve → estimate → mark → refine → solve, from the case's
-//! mesh, until the estimator meets `[adapt] tolerance`, the steps run out, or the next
-//! mesh would have more than `max_vertices` vertices.
+//! Adaptive refinement (docs/theory.md#adaptivity; the guide: docs/adaptivity.md). The
+//! loop: solve → estimate → mark → refine → solve, from the case's mesh, until the
+//! estimator meets `[adapt] tolerance`, the steps run out, or the next mesh would have more
+//! than `max_vertices` vertices.
 //!
 //! - **Estimate**: the residual indicators (elastic bodies,
 //!   rigid ones and rigid regions, a body below, free edges).

@@ -370,10 +370,11 @@ impl FixedBoundary {
 }
 
 impl DofMap {
-    /// Numbers the vertices that are not fixed, in vertex order (SPEC §5: the unknowns
-    /// are all vertices not on Γ_D, free-boundary vertices included). Blocks of vertices
-    /// are counted, then numbered, on all threads (the arrays are mostly fresh memory,
-    /// whose first writes are page faults).
+    /// Numbers the vertices that are not fixed, in vertex order
+    /// (docs/theory.md#boundary-data: the unknowns are all vertices not on Γ_D,
+    /// free-boundary vertices included). Blocks of vertices are counted, then numbered, on
+    /// all threads (the arrays are mostly fresh memory, whose first writes are page
+    /// faults).
     pub fn from_fixed(fixed: &[bool]) -> DofMap {
         use rayon::prelude::*;
         const BLOCK: usize = 1 << 14;

@@ -185,7 +185,8 @@ pub fn write_fields(
         ("contact_force", DataArray::F64(&fields.contact_force)),
         ("state", DataArray::I32(&state)),
     ];
-    // The body below's fields follow the paper's (SPEC §5), when there is one.
+    // The body below's fields follow the paper's (docs/theory.md#second-body), when there
+    // is one.
     let lower = fields.lower.as_ref();
     let state_low: Vec<i32> =
         lower.map_or(Vec::new(), |l| l.state.iter().map(|&s| s as i32).collect());

@@ -131,7 +131,8 @@ fn galerkin_operator_is_the_coarse_stiffness() {
             assert!((c.get(i, j) - mid.s.get(i, j)).abs() < 1e-12, "({i}, {j})");
         }
     }
-    // The same for the consistent L, and the lumped l (SPEC §3: l_i = ∫ h g_i).
+    // The same for the consistent L, and the lumped l (l_i = ∫ h g_i,
+    // docs/theory.md#lumped).
     let FoundationMatrix::Consistent(lf) = &fine.l else {
         panic!()
     };
