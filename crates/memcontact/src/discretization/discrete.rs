@@ -79,8 +79,8 @@ impl Discretization {
 
     /// Assembles the problem's data on a given mesh hierarchy (the finest level is solved
     /// on; its coarser levels serve multigrid). `problem.mesh` is not used. Levels whose
-    /// numbering is scattered are first renumbered for locality
-    /// ([`crate::mesh::reorder`]); outputs come back in the user's numbering.
+    /// numbering is scattered are first renumbered for locality (vertices along a
+    /// Hilbert curve); outputs come back in the user's numbering.
     pub fn assemble(
         problem: &Problem,
         hierarchy: Hierarchy,
@@ -405,7 +405,8 @@ fn geometry_hash(mesh: &Mesh) -> u64 {
 
 impl Discretization {
     /// The estimated memory of the run on this mesh besides a solver's factorisation
-    /// (bytes): [`super::meshing::bytes_per_vertex`] of its problem and kind of run.
+    /// (bytes): the vertices of the finest mesh times the bytes per vertex of its problem
+    /// and kind of run (the constants of [`crate::limits`]).
     pub fn run_bytes(&self) -> f64 {
         self.per_vertex * self.mesh().n_vertices() as f64
     }
