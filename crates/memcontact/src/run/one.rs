@@ -64,7 +64,7 @@ impl Discretization {
     /// ([`Discretization::release_mesh`]): the mesh is built again after the solver is done
     /// and before the fields are derived on it (its seconds count in the `mesh` phase, not
     /// in `solve`).
-    pub fn solve_once(
+    pub(crate) fn solve_once(
         &mut self,
         settings: &Settings,
         observer: &mut dyn Observer,
