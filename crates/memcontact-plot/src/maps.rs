@@ -815,8 +815,8 @@ fn two_body_deflection_entries(data: &PlotData, low: &BodyData) -> Vec<(Swatch, 
         _ => b.to_string(),
     };
     let n = data.points.len();
-    let pen_up = data.state.iter().any(|&s| s == 1);
-    let pen_low = low.state.iter().any(|&s| s == 1);
+    let pen_up = data.state.contains(&1);
+    let pen_low = low.state.contains(&1);
     let touch_up = (0..n).any(|i| data.state[i] == 0 && !data.penetrating(i));
     let touch_low = (0..n).any(|i| low.state[i] == 0 && !data.penetrating(i));
     entries.push((

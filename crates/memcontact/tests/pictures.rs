@@ -762,7 +762,7 @@ fn liner_pictures_tell_the_two_bodies_apart() {
     }
     // The gaps' range: both gaps shown, from the contact edges (about 0) up.
     let (glo, ghi) = pics[2].range.expect("a gap is shown");
-    assert!(glo >= 0.0 && glo < 1e-2 && ghi > 0.05, "{glo} {ghi}");
+    assert!((0.0..1e-2).contains(&glo) && ghi > 0.05, "{glo} {ghi}");
 
     // Profile: each body's contact stretches in its own shade.
     let ax = pics[3].axes.unwrap();
