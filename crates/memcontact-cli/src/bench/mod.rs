@@ -126,7 +126,7 @@ pub struct CaseRun {
     pub stolen: Option<f64>,
     /// With `write_parts`: the seconds of each part of writing alone, one after the other
     /// after the run (`memcontact::bench::write_parts_seconds`).
-    pub write_parts: Vec<(String, f64)>,
+    pub write_parts: Vec<(String, f64, f64)>,
 }
 
 /// The names of [`CaseRun::seconds`].
@@ -261,12 +261,17 @@ pub fn case_row(r: &CaseRun) -> String {
     s
 }
 
-/// The line after a row with the seconds of each part of writing alone.
-pub fn write_parts_row(parts: &[(String, f64)]) -> String {
-    let total: f64 = parts.iter().map(|(_, s)| s).sum();
-    let each: Vec<String> = parts.iter().map(|(n, s)| format!("{n} {s:.3}")).collect();
+/// The line after a row with the seconds of each part of writing alone (and the processor
+/// seconds of all threads meanwhile).
+pub fn write_parts_row(parts: &[(String, f64, f64)]) -> String {
+    let total: f64 = parts.iter().map(|(_, s, _)| s).sum();
+    let cpu: f64 = parts.iter().map(|(_, _, c)| c).sum();
+    let each: Vec<String> = parts
+        .iter()
+        .map(|(n, s, c)| format!("{n} {s:.3} (CPU {c:.2})"))
+        .collect();
     format!(
-        "    writing part by part: {} (sum {total:.3} s)",
+        "    writing part by part, seconds: {}; sum {total:.3} (CPU {cpu:.2})",
         each.join(", ")
     )
 }

@@ -131,22 +131,25 @@ pub fn pictures<'a>(
 /// [`write_result`] writes, without `summary.json`): seconds of `solution.vtu`,
 /// `nodes.csv` (when the case writes it), the input's hash, the pictures' shared layout,
 /// each picture (drawn, encoded and written) and the pictures' records (read back and
-/// hashed). For the benchmark: where the time of writing goes.
+/// hashed), each with the processor seconds of all threads the process spent meanwhile
+/// (NaN where unknown): `(part, seconds, CPU seconds)`. For the benchmark: where the time
+/// of writing goes, and how much of it waits for the disk.
 #[cfg(feature = "bench")]
 pub fn write_parts_seconds(
     dir: &Path,
     outcome: &Outcome,
     case: &Case,
     plots: &PlotOptions,
-) -> Result<Vec<(String, f64)>> {
+) -> Result<Vec<(String, f64, f64)>> {
     use super::result::{file_record, input_hash, write_nodes_csv, write_solution_vtu};
     let (fields, _) = outcome.checked_fields()?;
     let mesh = outcome.mesh();
     let mut parts = Vec::new();
     let mut timed = |name: &str, part: &mut dyn FnMut() -> Result<()>| -> Result<()> {
-        let t = Instant::now();
+        let (t, cpu) = (Instant::now(), crate::io::numbers::cpu_seconds());
         part()?;
-        parts.push((name.to_string(), t.elapsed().as_secs_f64()));
+        let cpu = crate::io::numbers::cpu_seconds() - cpu;
+        parts.push((name.to_string(), t.elapsed().as_secs_f64(), cpu));
         Ok(())
     };
     timed("solution.vtu", &mut || {
