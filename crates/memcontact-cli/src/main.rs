@@ -140,6 +140,11 @@ enum Command {
         /// Also draw the pictures when writing.
         #[arg(long)]
         pictures: bool,
+        /// After each run, write its files again one part at a time (solution.vtu,
+        /// nodes.csv, the input's hash, with --pictures each picture) and print the
+        /// seconds of each part alone: where the time of writing goes.
+        #[arg(long)]
+        write_parts: bool,
     },
     /// Redraw the pictures of a result directory (deflection.png, pressure.png,
     /// liftoff.png, profile.png) from its solution.vtu and summary.json, without solving
@@ -227,6 +232,7 @@ fn main() -> ExitCode {
             hierarchy,
             repeat,
             pictures,
+            write_parts,
         } => {
             if case.is_some() || mesh.is_some() {
                 memcontact_cli::bench::run_case_bench(&memcontact_cli::bench::CaseBench {
@@ -236,6 +242,7 @@ fn main() -> ExitCode {
                     hierarchy,
                     repeat,
                     pictures,
+                    write_parts,
                 })
             } else {
                 bench_cmd::run(&sizes, &foundation, phases)

@@ -11,3 +11,4 @@ pub use crate::model::{BodyStiffness, Model, ProblemData};
 pub use crate::solve::multigrid::{
     kernel_timings, poisson_solve, solve_with, Coarsening, TnnmgOptions,
 };
+pub use crate::write::write_parts_seconds;

@@ -124,6 +124,9 @@ pub struct CaseRun {
     pub accepted: bool,
     /// CPU seconds the host of a virtual machine took during the run (`None` where unknown).
     pub stolen: Option<f64>,
+    /// With `write_parts`: the seconds of each part of writing alone, one after the other
+    /// after the run (`memcontact::bench::write_parts_seconds`).
+    pub write_parts: Vec<(String, f64, f64)>,
 }
 
 /// The names of [`CaseRun::seconds`].
@@ -133,8 +136,9 @@ pub const CASE_PHASES: [&str; 7] = [
 
 /// Runs `case` as `memcontact solve` does (mesh, renumbering, assembly, solve, the result
 /// set written into a scratch directory under `scratch`, removed afterwards; pictures only
-/// with `pictures`), timing each phase.
-pub fn run_case(case: &Case, scratch: &Path, pictures: bool) -> Result<CaseRun> {
+/// with `pictures`), timing each phase; with `write_parts`, then each part of writing
+/// alone.
+pub fn run_case(case: &Case, scratch: &Path, pictures: bool, write_parts: bool) -> Result<CaseRun> {
     let mut case = case.clone();
     if !pictures {
         case.output.plots = Some(Vec::new());
@@ -198,6 +202,18 @@ pub fn run_case(case: &Case, scratch: &Path, pictures: bool) -> Result<CaseRun> 
         certificate: r.certificate.kkt(),
         accepted: r.accepted,
         stolen,
+        write_parts: Vec::new(),
+    };
+    let run = if write_parts {
+        std::fs::create_dir_all(&dir)?;
+        let parts = memcontact::bench::write_parts_seconds(&dir, &outcome, &case, &plots);
+        let _ = std::fs::remove_dir_all(&dir);
+        CaseRun {
+            write_parts: parts.context("writing the result set part by part")?,
+            ..run
+        }
+    } else {
+        run
     };
     // The teardown is not part of any phase; the freed memory goes back to the system, so
     // that a repeated run starts as the first did and its peak memory is its own.
@@ -245,6 +261,21 @@ pub fn case_row(r: &CaseRun) -> String {
     s
 }
 
+/// The line after a row with the seconds of each part of writing alone (and the processor
+/// seconds of all threads meanwhile).
+pub fn write_parts_row(parts: &[(String, f64, f64)]) -> String {
+    let total: f64 = parts.iter().map(|(_, s, _)| s).sum();
+    let cpu: f64 = parts.iter().map(|(_, _, c)| c).sum();
+    let each: Vec<String> = parts
+        .iter()
+        .map(|(n, s, c)| format!("{n} {s:.3} (CPU {c:.2})"))
+        .collect();
+    format!(
+        "    writing part by part, seconds: {}; sum {total:.3} (CPU {cpu:.2})",
+        each.join(", ")
+    )
+}
+
 /// The note after a row whose run lost CPU time to the host of a virtual machine (more
 /// than a clock tick or two): its times are longer than the code's by up to that much.
 pub fn stolen_note(stolen: Option<f64>) -> String {
@@ -268,6 +299,8 @@ pub struct CaseBench {
     pub repeat: usize,
     /// Draw the pictures too.
     pub pictures: bool,
+    /// Time each part of writing alone after each run.
+    pub write_parts: bool,
 }
 
 /// Runs the case benchmark, printing the table as rows are measured.
@@ -310,8 +343,11 @@ pub fn run_case_bench(b: &CaseBench) -> Result<()> {
         let mut c = case.clone();
         c.settings.hierarchy = choice;
         for _ in 0..b.repeat {
-            let run = run_case(&c, &scratch, b.pictures)?;
+            let run = run_case(&c, &scratch, b.pictures, b.write_parts)?;
             println!("{}", case_row(&run));
+            if !run.write_parts.is_empty() {
+                println!("{}", write_parts_row(&run.write_parts));
+            }
         }
     }
     Ok(())

@@ -78,7 +78,7 @@ pub fn push_int(buf: &mut Vec<u8>, x: i64) {
     buf.extend_from_slice(&digits[k..]);
 }
 
-#[cfg(test)]
+#[cfg(any(test, feature = "bench"))]
 /// CPU time of this process (user + system, all threads) from /proc, NaN elsewhere: wall
 /// times are unreliable on a loaded machine.
 pub(crate) fn cpu_seconds() -> f64 {

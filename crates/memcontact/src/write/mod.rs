@@ -22,6 +22,8 @@ mod tests;
 
 pub use manifest::{write_manifest, Manifest, MANIFEST};
 pub use memcontact_plot::{PlotKind, PlotOptions, Units as PlotUnits};
+#[cfg(feature = "bench")]
+pub use pictures::write_parts_seconds;
 pub use pictures::{
     adapt_pictures, draw_all, pictures, plot_options, render_png, steps_kind, study_pictures,
     sweep_picture, write_png, write_result, SweepWriter, CONVERGENCE_PICTURE, H_SWEEP_PICTURE,

@@ -126,6 +126,80 @@ pub fn pictures<'a>(
     }
 }
 
+/// The parts of writing the result set of `outcome` with the pictures of `plots`, each
+/// alone and one after the other into the existing directory `dir` (the same files as
+/// [`write_result`] writes, without `summary.json`): seconds of `solution.vtu`,
+/// `nodes.csv` (when the case writes it), the input's hash, the pictures' shared layout,
+/// each picture (drawn, encoded and written) and the pictures' records (read back and
+/// hashed), each with the processor seconds of all threads the process spent meanwhile
+/// (NaN where unknown): `(part, seconds, CPU seconds)`. For the benchmark: where the time
+/// of writing goes, and how much of it waits for the disk.
+#[cfg(feature = "bench")]
+pub fn write_parts_seconds(
+    dir: &Path,
+    outcome: &Outcome,
+    case: &Case,
+    plots: &PlotOptions,
+) -> Result<Vec<(String, f64, f64)>> {
+    use super::result::{file_record, input_hash, write_nodes_csv, write_solution_vtu};
+    let (fields, _) = outcome.checked_fields()?;
+    let mesh = outcome.mesh();
+    let mut parts = Vec::new();
+    let mut timed = |name: &str, part: &mut dyn FnMut() -> Result<()>| -> Result<()> {
+        let (t, cpu) = (Instant::now(), crate::io::numbers::cpu_seconds());
+        part()?;
+        let cpu = crate::io::numbers::cpu_seconds() - cpu;
+        parts.push((name.to_string(), t.elapsed().as_secs_f64(), cpu));
+        Ok(())
+    };
+    timed("solution.vtu", &mut || {
+        write_solution_vtu(dir, &mesh, &fields, case.output.vtu, "0", &[]).map(|_| ())
+    })?;
+    if case.output.writes_csv() {
+        timed("nodes.csv", &mut || {
+            write_nodes_csv(dir, &mesh, &fields).map(|_| ())
+        })?;
+    }
+    timed("input hash", &mut || {
+        input_hash(case);
+        Ok(())
+    })?;
+    with_plot_data(&mesh, &fields, |data| {
+        let maps = plots.plots.iter().any(|k| *k != PlotKind::Profile);
+        let mut layout = None;
+        if maps {
+            timed("picture layout", &mut || {
+                layout = Some(memcontact_plot::MapLayout::new(data));
+                Ok(())
+            })?;
+        }
+        for &kind in &plots.plots {
+            timed(&kind.file_name(), &mut || {
+                let picture = match &layout {
+                    Some(l) if kind != PlotKind::Profile => {
+                        memcontact_plot::render_kind(kind, l, data, plots)?
+                    }
+                    _ => {
+                        let one = PlotOptions {
+                            plots: vec![kind],
+                            ..plots.clone()
+                        };
+                        render(data, &one)?.pop().expect("one picture")
+                    }
+                };
+                write_png(&dir.join(kind.file_name()), &picture.canvas)
+            })?;
+        }
+        timed("picture records", &mut || {
+            for kind in &plots.plots {
+                file_record(&dir.join(kind.file_name()))?;
+            }
+            Ok(())
+        })
+    })?;
+    Ok(parts)
+}
+
 /// One picture of the fields of a result on `mesh`, drawn in memory as PNG bytes (the same
 /// bytes as the file of a result set drawn with `options`): for a notebook's display.
 pub fn render_png(

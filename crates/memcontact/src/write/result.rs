@@ -7,6 +7,7 @@ use crate::io::csv::write_columns_csv;
 use crate::io::json::write_json;
 use crate::io::result_set::ResultSet;
 use crate::io::vtu::{write_vtu_with_field_data, DataArray, VtuEncoding};
+use crate::mesh::Mesh;
 use crate::outcome::fields::NodalFields;
 use crate::outcome::summary::{FileRecord, Summary};
 use crate::outcome::Outcome;
@@ -174,76 +175,116 @@ pub fn write_fields(
     cell_data: &[(String, Vec<f64>)],
 ) -> Result<Vec<(String, FileRecord)>> {
     let mesh = outcome.mesh();
-    let region: Vec<i32> = mesh.regions.iter().map(|&r| r as i32).collect();
-    let state: Vec<i32> = fields.state.iter().map(|&s| s as i32).collect();
-    let covered: Vec<i32> = fields.covered.iter().map(|&c| c as i32).collect();
-    let point_data = [
+    // The two files are written side by side: one thread's formatting overlaps the other's
+    // writes.
+    let (vtu_written, csv_written) = rayon::join(
+        || write_solution_vtu(dir, &mesh, fields, vtu, run_id, cell_data),
+        || csv.then(|| write_nodes_csv(dir, &mesh, fields)),
+    );
+    let mut files = vec![vtu_written?];
+    if let Some(written) = csv_written {
+        files.push(written?);
+    }
+    Ok(files)
+}
+
+/// The point fields of `solution.vtu` and the columns of `nodes.csv` after `x`, `y`
+/// ([`NODAL_FIELDS`], then [`LOWER_FIELDS`] with a body below), as one call's integer
+/// copies of the state fields let them be borrowed.
+fn nodal_arrays<'a>(
+    fields: &'a NodalFields,
+    state: &'a [i32],
+    state_low: &'a [i32],
+) -> Vec<(&'static str, DataArray<'a>)> {
+    let mut arrays = vec![
         ("u", DataArray::F64(&fields.u)),
         ("phi", DataArray::F64(&fields.phi)),
         ("penetration", DataArray::F64(&fields.penetration)),
         ("pressure", DataArray::F64(&fields.pressure)),
         ("contact_force", DataArray::F64(&fields.contact_force)),
-        ("state", DataArray::I32(&state)),
+        ("state", DataArray::I32(state)),
     ];
     // The body below's fields follow the paper's (docs/theory.md#second-body), when there
     // is one.
-    let lower = fields.lower.as_ref();
-    let state_low: Vec<i32> =
-        lower.map_or(Vec::new(), |l| l.state.iter().map(|&s| s as i32).collect());
-    let covered_low: Vec<i32> = lower.map_or(Vec::new(), |l| {
-        l.covered.iter().map(|&c| c as i32).collect()
-    });
-    let lower_data: Vec<(&str, DataArray)> = match lower {
-        Some(l) => vec![
+    if let Some(l) = &fields.lower {
+        arrays.extend([
             ("phi_low", DataArray::F64(&l.phi)),
             ("penetration_low", DataArray::F64(&l.penetration)),
             ("pressure_low", DataArray::F64(&l.pressure)),
             ("contact_force_low", DataArray::F64(&l.contact_force)),
-            ("state_low", DataArray::I32(&state_low)),
-        ],
-        None => Vec::new(),
-    };
-    let mut vtu_points = point_data.to_vec();
-    vtu_points.push(("covered", DataArray::I32(&covered)));
-    vtu_points.extend(lower_data.iter().cloned());
-    if lower.is_some() {
-        vtu_points.push(("covered_low", DataArray::I32(&covered_low)));
+            ("state_low", DataArray::I32(state_low)),
+        ]);
     }
+    arrays
+}
+
+/// `values` as `i32`s (the VTU and CSV integer columns).
+fn as_i32<T: Copy + Into<i32>>(values: &[T]) -> Vec<i32> {
+    values.iter().map(|&v| v.into()).collect()
+}
+
+/// Writes `solution.vtu` of `fields` on `mesh` into `dir` (`run_id` in its field data,
+/// `cell_data` after the regions), hashed as written; returns its name and record.
+pub(super) fn write_solution_vtu(
+    dir: &Path,
+    mesh: &Mesh,
+    fields: &NodalFields,
+    vtu: VtuFormat,
+    run_id: &str,
+    cell_data: &[(String, Vec<f64>)],
+) -> Result<(String, FileRecord)> {
+    let region: Vec<i32> = mesh.regions.iter().map(|&r| r as i32).collect();
+    let state = as_i32(&fields.state);
+    let covered = as_i32(&fields.covered);
+    let lower = fields.lower.as_ref();
+    let state_low = lower.map_or(Vec::new(), |l| as_i32(&l.state));
+    let covered_low = lower.map_or(Vec::new(), |l| as_i32(&l.covered));
+    // The obstacle's fields, `covered`, the body below's, `covered_low`.
+    let mut points = nodal_arrays(fields, &state, &state_low);
+    points.insert(NODAL_FIELDS.len(), ("covered", DataArray::I32(&covered)));
+    if lower.is_some() {
+        points.push(("covered_low", DataArray::I32(&covered_low)));
+    }
+    let cells: Vec<(&str, DataArray)> = std::iter::once(("region", DataArray::I32(&region)))
+        .chain(
+            cell_data
+                .iter()
+                .map(|(n, v)| (n.as_str(), DataArray::F64(v))),
+        )
+        .collect();
+    let written = write_vtu_with_field_data(
+        &dir.join("solution.vtu"),
+        mesh,
+        &points,
+        &cells,
+        match vtu {
+            VtuFormat::Binary => VtuEncoding::Binary,
+            VtuFormat::Ascii => VtuEncoding::Ascii,
+            VtuFormat::Compressed => VtuEncoding::Compressed,
+        },
+        &[("run_id", run_id)],
+    )?;
+    Ok(("solution.vtu".to_string(), written.into()))
+}
+
+/// Writes `nodes.csv` of `fields` on `mesh` into `dir` (`x`, `y`, then the nodal
+/// columns), hashed as written; returns its name and record.
+pub(super) fn write_nodes_csv(
+    dir: &Path,
+    mesh: &Mesh,
+    fields: &NodalFields,
+) -> Result<(String, FileRecord)> {
+    let state = as_i32(&fields.state);
+    let state_low = fields
+        .lower
+        .as_ref()
+        .map_or(Vec::new(), |l| as_i32(&l.state));
     let x: Vec<f64> = mesh.points.iter().map(|p| p[0]).collect();
     let y: Vec<f64> = mesh.points.iter().map(|p| p[1]).collect();
     let mut columns = vec![("x", DataArray::F64(&x)), ("y", DataArray::F64(&y))];
-    columns.extend(point_data);
-    columns.extend(lower_data);
-    // The two files are written side by side: one thread's formatting overlaps the other's
-    // writes.
-    let (vtu_written, csv_written) = rayon::join(
-        || {
-            write_vtu_with_field_data(
-                &dir.join("solution.vtu"),
-                &mesh,
-                &vtu_points,
-                &std::iter::once(("region", DataArray::I32(&region)))
-                    .chain(
-                        cell_data
-                            .iter()
-                            .map(|(n, v)| (n.as_str(), DataArray::F64(v))),
-                    )
-                    .collect::<Vec<_>>(),
-                match vtu {
-                    VtuFormat::Binary => VtuEncoding::Binary,
-                    VtuFormat::Ascii => VtuEncoding::Ascii,
-                    VtuFormat::Compressed => VtuEncoding::Compressed,
-                },
-                &[("run_id", run_id)],
-            )
-        },
-        || csv.then(|| write_columns_csv(&dir.join("nodes.csv"), &columns)),
-    );
-    let mut files = vec![("solution.vtu".to_string(), vtu_written?.into())];
-    if let Some(written) = csv_written {
-        files.push(("nodes.csv".to_string(), written?.into()));
-    }
-    Ok(files)
+    columns.extend(nodal_arrays(fields, &state, &state_low));
+    let written = write_columns_csv(&dir.join("nodes.csv"), &columns)?;
+    Ok(("nodes.csv".to_string(), written.into()))
 }
 
 /// Writes the files of `outcome` into the directory `dir` (which must exist and is not
@@ -266,24 +307,45 @@ pub fn write_files(
         outcome.discretization.model.is_rigid(),
     )?;
     let run_id = options.run_id.clone().unwrap_or_else(new_run_id);
-    // The input's hash reads the mesh file again: alongside the writing, not after it.
-    let (written, hash) = rayon::join(
-        || {
-            write_fields(
+    let mesh = outcome.mesh();
+    let csv = case.output.writes_csv();
+    // Everything at once: `solution.vtu`, `nodes.csv` and the input's hash (which reads
+    // the mesh file again) on the pool's threads, the extra files (pictures, drawn on the
+    // pool too) from this one, which need not be `Send`, then read back for their records.
+    // No file's bytes depend on another's. The errors come in the order of a sequential
+    // write: the fields' files first.
+    let mut vtu_written = None;
+    let mut csv_written = None;
+    let mut hash = String::new();
+    let extra_written = rayon::in_place_scope(|s| {
+        s.spawn(|_| {
+            vtu_written = Some(write_solution_vtu(
                 dir,
-                outcome,
+                &mesh,
                 &fields,
                 options.vtu,
-                case.output.writes_csv(),
                 &run_id,
                 &options.cell_data,
-            )
-        },
-        || input_hash(case),
-    );
-    let written = written?;
+            ))
+        });
+        if csv {
+            s.spawn(|_| csv_written = Some(write_nodes_csv(dir, &mesh, &fields)));
+        }
+        s.spawn(|_| hash = input_hash(case));
+        extra(dir, &fields).and_then(|names| {
+            let records = names
+                .iter()
+                .map(|name| file_record(&dir.join(name)))
+                .collect::<Result<Vec<FileRecord>>>()?;
+            Ok(names.into_iter().zip(records))
+        })
+    });
+    let mut written = vec![vtu_written.expect("the VTU task ran")?];
+    if let Some(w) = csv_written {
+        written.push(w?);
+    }
     case.settings.cancel.check()?;
-    let names = extra(dir, &fields)?;
+    let extra_written = extra_written?;
     let mut summary = Summary::new(
         &options.label,
         outcome,
@@ -294,17 +356,8 @@ pub fn write_files(
     summary.input_hash = hash;
     summary.plot_options = options.plot_options.clone();
     summary.adapt = options.adapt.clone();
-    // The fields' files were hashed as they were written; the extra files (pictures) are
-    // read back, side by side.
-    let records: Vec<FileRecord> = {
-        use rayon::prelude::*;
-        names
-            .par_iter()
-            .map(|name| file_record(&dir.join(name)))
-            .collect::<Result<_>>()?
-    };
     summary.files.extend(written);
-    summary.files.extend(names.into_iter().zip(records));
+    summary.files.extend(extra_written);
     summary.time_write_s = t0.elapsed().as_secs_f64();
     summary.time_total_s = options.started.elapsed().as_secs_f64();
     write_json(&dir.join("summary.json"), &summary)?;
