@@ -7,7 +7,9 @@ The expected digests (data/example_outputs.json) were made with that release's b
 and made again once since, when TNNMG went from two to three multigrid cycles per Newton
 correction while the vertex states change (a deliberate change of the iterates: every
 example's u then agreed with that release's to 1.7e-11 of its maximum, with the same
-vertex states, and no iteration count grew except roof-frame's, 9 to 10):
+vertex states, and no iteration count grew except roof-frame's, 9 to 10), and again
+when the pictures learned to tell two bodies apart (the four pictures of the six
+examples with a body below, and their summaries' file hashes; nothing else changed):
 
     python crates/memcontact-py/tests/test_example_outputs.py PATH/TO/memcontact
 
