@@ -34,6 +34,16 @@ CASE FILE (TOML; paths relative to the case file; unknown keys are errors)
 [[load_case]] name = \"...\"               one entry per combination (its output directory)
               load, load_factor (1),     override the base case's data
               shape, stiffness
+[[sensor]]    name = \"A\", at = [x, y]     u there (P1); measured = u_m, sigma = σ (1) for [fit]
+[sensitivity] outputs = [\"energy\"]         max_deflection, total_contact_force(_low), contact_area,
+                                         sensors, sensor:NAME, contact_force:REGION
+              parameters = [\"key\", ...]    membrane.tension, membrane.load, obstacle.shape,
+                                         obstacle.stiffness(.REGION), lower.*, boundary.height
+              influence = true           dJ_dh, dsensor_NAME_dh in solution.vtu; writes
+                                         sensitivity.csv (output,parameter,value,derivative,...)
+[fit]         parameters = { \"key\" = [min, max] }  start: the case's value; ln p if min > 0
+              measurements = \"points.csv\"  name,x,y,u[,sigma] (default: sensors' measured)
+              max_iterations = 30, tolerance = 1e-8, prior = α   writes fit.json, fit.csv, fit.png
 
 Units: any consistent system (e.g. m, kN: t in kN/m, f in kN/m², h in kN/m³).
 Expressions: x, y, r, pi, e; + - * / ^; < <= > >= == != && || !; sin cos tan asin acos atan

@@ -12,6 +12,7 @@ mod help;
 mod plot_cmd;
 mod progress;
 mod report;
+mod sensitivity_cmd;
 mod signals;
 mod solve_flags;
 

@@ -26,6 +26,7 @@ pub mod axes;
 pub mod bodies;
 pub mod canvas;
 pub mod colormap;
+pub mod fit_plot;
 pub mod lines;
 pub mod loglog;
 mod maps;
@@ -39,6 +40,7 @@ pub mod write;
 
 pub use axes::{hatch_color, HATCH_SPACING};
 pub use canvas::{Canvas, PixelRect};
+pub use fit_plot::{fit_plot, FIT_PICTURE};
 pub use lines::{line_plot, LinePlot, Series};
 pub use loglog::loglog_plot;
 pub use maps::{

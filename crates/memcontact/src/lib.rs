@@ -35,6 +35,7 @@ pub mod estimate;
 
 pub mod fem;
 pub mod field;
+pub mod fit;
 pub mod io;
 pub mod limits;
 pub mod mesh;
@@ -44,6 +45,7 @@ pub mod parallel;
 pub mod problem;
 pub mod quadrature;
 pub mod run;
+pub mod sensitivity;
 pub mod solve;
 pub mod sparse;
 pub mod verify;

@@ -4,13 +4,15 @@
 //!
 //! A [`Case`] is a [`crate::problem::Problem`], the solver [`crate::solve::Settings`], the
 //! [`OutputOptions`], the [`ExactSpec`] of a closed-form solution for convergence studies,
-//! and the steps of a load sweep or of load combinations.
+//! the steps of a load sweep or of load combinations, and the sensors, sensitivities and
+//! fit of [`sensitivity`].
 
 mod adapt;
 mod exact;
 mod file;
 mod output;
 mod overrides;
+pub mod sensitivity;
 mod sweep;
 #[cfg(test)]
 mod tests;
@@ -21,6 +23,9 @@ pub use exact::{BenchmarkBody, ExactSpec, ManufacturedDomain, ManufacturedForm};
 pub use file::{steps, Case};
 pub use output::{OutputOptions, PictureKind, Units, VtuFormat};
 pub use overrides::apply_overrides;
+pub use sensitivity::{
+    FitParameters, FitSpec, ParameterKey, ParameterKind, ParameterTarget, SensitivitySpec, Sensor,
+};
 pub use sweep::{
     step_list, validate_steps, LoadCase, StepSpec, SweepParameter, SweepSpec, MAX_STEPS,
 };

@@ -6,6 +6,7 @@ mod binding;
 mod discrete;
 mod meshing;
 
+pub(crate) use binding::bind_height;
 pub use binding::{assemble_model, bind_and_check, BoundBody, BoundData};
 pub use discrete::{Discretization, Phase};
 pub use meshing::build_mesh;

@@ -15,10 +15,14 @@
 
 mod adapt;
 mod checks;
+mod fit;
 mod one;
+mod sensitivity;
 mod sweep;
 
 pub use adapt::{check_adapt_on_mesh, run_adapt, AdaptRun, AdaptStop, OnStep};
 pub use checks::{check_case_on_mesh, check_load_cases_on_mesh, check_profile_on_mesh};
+pub use fit::{run_fit, FitProblem, FitRun};
 pub use one::{discretize_as_run, run, run_for_writing, run_problem};
+pub use sensitivity::{check_sensitivity_on_mesh, run_request, run_sensitivity, SensitivityRun};
 pub use sweep::{apply, run_sweep, run_sweep_on, step_discretization, step_model, SweepRun};

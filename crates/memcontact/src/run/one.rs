@@ -215,10 +215,10 @@ pub fn run_for_writing(case: &Case, observer: &mut dyn Observer) -> Result<Outco
 
 /// The discretisation `memcontact solve` of `case` solves on, built as that run builds it
 /// (not solved): the lean one of [`run_for_writing`] for one solve, everything kept for a
-/// sweep, load cases or the adaptive loop. `memcontact check` reports on it, so that its
+/// sweep, load cases, the adaptive loop, sensitivities or a fit. `memcontact check` reports on it, so that its
 /// memory estimate is the one the run checks.
 pub fn discretize_as_run(case: &Case, observer: &mut dyn Observer) -> Result<Discretization> {
-    if case.is_sweep() || case.adapt.is_some() {
+    if case.is_sweep() || case.adapt.is_some() || case.sensitivity.is_some() || case.fit.is_some() {
         Discretization::new(&case.problem, observer)
     } else {
         Discretization::for_one_solve(&case.problem, &case.settings, observer)

@@ -13,6 +13,7 @@
 mod adapt;
 mod manifest;
 mod result;
+mod sensitivity;
 mod study;
 mod sweep;
 #[cfg(test)]
@@ -21,8 +22,13 @@ mod tests;
 pub use adapt::{write_adapt_csv, AdaptHistory, AdaptSet, ADAPT_CSV};
 pub use manifest::{write_manifest, Manifest, MANIFEST};
 pub use result::{
-    file_record, input_hash, new_run_id, write_fields, write_files, write_result_set, WriteOptions,
-    LOWER_FIELDS, NODAL_FIELDS,
+    file_record, input_hash, new_run_id, write_fields, write_fields_with, write_files,
+    write_files_with, write_result_set, write_result_set_with, Extras, WriteOptions, LOWER_FIELDS,
+    NODAL_FIELDS,
+};
+pub use sensitivity::{
+    write_fit_csv, write_fit_json, write_sensitivity_csv, FIT_CSV, FIT_JSON, SENSITIVITY_COLUMNS,
+    SENSITIVITY_CSV,
 };
 pub use study::{
     convergence_columns, h_sweep_columns, write_study, write_study_csv, StudyColumn,

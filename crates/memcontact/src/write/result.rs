@@ -151,6 +151,22 @@ pub fn write_fields(
     run_id: &str,
     cell_data: &[(String, Vec<f64>)],
 ) -> Result<Vec<(String, FileRecord)>> {
+    write_fields_with(dir, outcome, fields, vtu, csv, run_id, cell_data, &[])
+}
+
+/// [`write_fields`] with further point fields of `solution.vtu` (`extra_points`, one value
+/// per vertex in the user's order: the sensitivity run's influence maps).
+#[allow(clippy::too_many_arguments)]
+pub fn write_fields_with(
+    dir: &Path,
+    outcome: &Outcome,
+    fields: &NodalFields,
+    vtu: VtuFormat,
+    csv: bool,
+    run_id: &str,
+    cell_data: &[(String, Vec<f64>)],
+    extra_points: &[(String, Vec<f64>)],
+) -> Result<Vec<(String, FileRecord)>> {
     let mesh = outcome.mesh();
     let region: Vec<i32> = mesh.regions.iter().map(|&r| r as i32).collect();
     let state: Vec<i32> = fields.state.iter().map(|&s| s as i32).collect();
@@ -186,6 +202,11 @@ pub fn write_fields(
     if lower.is_some() {
         vtu_points.push(("covered_low", DataArray::I32(&covered_low)));
     }
+    vtu_points.extend(
+        extra_points
+            .iter()
+            .map(|(n, v)| (n.as_str(), DataArray::F64(v))),
+    );
     let x: Vec<f64> = mesh.points.iter().map(|p| p[0]).collect();
     let y: Vec<f64> = mesh.points.iter().map(|p| p[1]).collect();
     let mut columns = vec![("x", DataArray::F64(&x)), ("y", DataArray::F64(&y))];
@@ -234,6 +255,28 @@ pub fn write_files(
     options: &WriteOptions,
     extra: &mut dyn FnMut(&Path, &NodalFields) -> Result<Vec<String>>,
 ) -> Result<Summary> {
+    write_files_with(dir, outcome, case, options, extra, &Extras::default())
+}
+
+/// What a run adds to the files of its solve: point fields of `solution.vtu` and keys of
+/// `summary.json` (a sensitivity run's influence maps and totals).
+#[derive(Debug, Clone, Default)]
+pub struct Extras {
+    /// Further point fields of `solution.vtu`, one value per vertex in the user's order.
+    pub point_data: Vec<(String, Vec<f64>)>,
+    /// The sensitivity totals of `summary.json`.
+    pub sensitivity: Option<crate::outcome::SensitivityTotals>,
+}
+
+/// [`write_files`] with the [`Extras`] of a run.
+pub fn write_files_with(
+    dir: &Path,
+    outcome: &Outcome,
+    case: &Case,
+    options: &WriteOptions,
+    extra: &mut dyn FnMut(&Path, &NodalFields) -> Result<Vec<String>>,
+    extras: &Extras,
+) -> Result<Summary> {
     let t0 = Instant::now();
     let (fields, totals) = outcome.checked_fields()?;
     let r = &outcome.report;
@@ -246,7 +289,7 @@ pub fn write_files(
     // The input's hash reads the mesh file again: alongside the writing, not after it.
     let (written, hash) = rayon::join(
         || {
-            write_fields(
+            write_fields_with(
                 dir,
                 outcome,
                 &fields,
@@ -254,6 +297,7 @@ pub fn write_files(
                 case.output.writes_csv(),
                 &run_id,
                 &options.cell_data,
+                &extras.point_data,
             )
         },
         || input_hash(case),
@@ -271,6 +315,7 @@ pub fn write_files(
     summary.input_hash = hash;
     summary.plot_options = options.plot_options.clone();
     summary.adapt = options.adapt.clone();
+    summary.sensitivity = extras.sensitivity.clone();
     // The fields' files were hashed as they were written; the extra files (pictures) are
     // read back, side by side.
     let records: Vec<FileRecord> = {
@@ -297,8 +342,20 @@ pub fn write_result_set(
     options: &WriteOptions,
     extra: &mut dyn FnMut(&Path, &NodalFields) -> Result<Vec<String>>,
 ) -> Result<Summary> {
+    write_result_set_with(target, outcome, case, options, extra, &Extras::default())
+}
+
+/// [`write_result_set`] with the [`Extras`] of a run.
+pub fn write_result_set_with(
+    target: &Path,
+    outcome: &Outcome,
+    case: &Case,
+    options: &WriteOptions,
+    extra: &mut dyn FnMut(&Path, &NodalFields) -> Result<Vec<String>>,
+    extras: &Extras,
+) -> Result<Summary> {
     let set = ResultSet::begin(target, options.force)?;
-    let summary = write_files(set.dir(), outcome, case, options, extra)?;
+    let summary = write_files_with(set.dir(), outcome, case, options, extra, extras)?;
     // Stopped while writing: the staging directory goes, the previous result stays.
     case.settings.cancel.check()?;
     set.commit()?;

@@ -1,0 +1,510 @@
+//! The derivatives against central finite differences of the outputs (same mesh, same
+//! active set, solver at 1e-13), the envelope identities, Taylor remainders, and the disc's
+//! closed form.
+
+use super::*;
+use crate::case::{Case, ParameterKey};
+use crate::run::run_request;
+use crate::solve::Silent;
+
+/// A test mesh file of `tests/data`.
+fn data(name: &str) -> String {
+    format!("{}/tests/data/{name}", env!("CARGO_MANIFEST_DIR"))
+}
+
+/// The sensitivity site (`tests/data/sens.msh`): two soils and a rigid plinth in the
+/// obstacle above, an elastic body below under a downward spot load, boundary heights on
+/// three sides and the top edge free; `foundation` for both bodies.
+pub(crate) fn site(foundation: &str) -> String {
+    format!(
+        r#"
+[mesh]
+file = "{mesh}"
+[membrane]
+tension = 1.3
+load = "8 + 4*y - 60*exp(-((x - 1.5)^2 + (y - 0.5)^2)/0.03)"
+[obstacle]
+shape = "0.02 + 0.01*x"
+stiffness = {{ soft = 300, stiff = 1000, plinth = "rigid" }}
+foundation = "{foundation}"
+[lower]
+shape = -0.01
+stiffness = 200
+foundation = "{foundation}"
+[boundary]
+height = {{ left = "0.004*y", bottom = 0, right = 0.003 }}
+free = ["top"]
+[solver]
+method = "active-set"
+tolerance = 1e-13
+[[sensor]]
+name = "A"
+at = [0.3, 0.3]
+[[sensor]]
+name = "B"
+at = [1.5, 0.5]
+[[sensor]]
+name = "C"
+at = [1.2, 0.8]
+[[sensor]]
+name = "D"
+at = [0.45, 0.5]
+"#,
+        mesh = data("sens.msh")
+    )
+}
+
+const OUTPUTS: [&str; 8] = [
+    "energy",
+    "max_deflection",
+    "total_contact_force",
+    "total_contact_force_low",
+    "contact_area",
+    "sensors",
+    "contact_force:soft",
+    "contact_force:stiff",
+];
+
+const PARAMETERS: [&str; 9] = [
+    "membrane.tension",
+    "membrane.load",
+    "obstacle.shape",
+    "obstacle.stiffness.soft",
+    "obstacle.stiffness.stiff",
+    "lower.stiffness",
+    "lower.shape",
+    "boundary.height.right",
+    "boundary.height.left",
+];
+
+fn request(outputs: &[&str], parameters: &[&str]) -> Request {
+    Request {
+        outputs: outputs.iter().map(|s| s.to_string()).collect(),
+        parameters: parameters.iter().map(|s| s.to_string()).collect(),
+        influence: true,
+    }
+}
+
+/// The outputs' values and the vertex states (both bodies) of a case.
+fn values(case: &Case, req: &Request) -> (Sensitivities, Vec<i8>) {
+    let run = run_request(case, req, &mut Silent).expect("a run");
+    let d = &run.outcome.discretization;
+    let u = &run.outcome.report.u;
+    let mut st = d.model.states(u);
+    st.extend(d.model.lower_states(u));
+    (run.sensitivities.expect("accepted"), st)
+}
+
+/// `case` with parameter `key` at `value`.
+fn moved(case: &Case, key: &ParameterKey, value: f64) -> Case {
+    let mut c = case.clone();
+    key.apply(&mut c.problem, value).expect("applied");
+    c
+}
+
+/// Central differences of every output in parameter `p` at the step `h` and at `h/4`, with
+/// the same vertex states at every end (the step is quartered until they are); the step.
+fn central(case: &Case, req: &Request, key: &ParameterKey, states: &[i8]) -> ([Vec<f64>; 2], f64) {
+    let mut h = reference(key) * 1e-4;
+    let only_values = Request {
+        influence: false,
+        parameters: vec![req.parameters[0].clone()],
+        ..req.clone()
+    };
+    'steps: for _ in 0..6 {
+        let mut out: [Vec<f64>; 2] = Default::default();
+        for (k, step) in [h, 0.25 * h].into_iter().enumerate() {
+            let (a, sa) = values(&moved(case, key, key.value + step), &only_values);
+            let (b, sb) = values(&moved(case, key, key.value - step), &only_values);
+            if sa != states || sb != states {
+                h *= 0.25;
+                continue 'steps;
+            }
+            out[k] = a
+                .values
+                .iter()
+                .zip(&b.values)
+                .map(|(x, y)| (x - y) / (2.0 * step))
+                .collect();
+        }
+        return (out, h);
+    }
+    panic!("{}: the vertex states change at every step", key.key);
+}
+
+/// The size of a parameter: its value, 1 for a factor, 0.01 (a length) for an offset.
+fn reference(key: &ParameterKey) -> f64 {
+    match key.kind {
+        ParameterKind::Value => key.value.abs().max(1e-2),
+        ParameterKind::Factor => 1.0,
+        ParameterKind::Offset => 1e-2,
+    }
+}
+
+/// How far a derivative `d` is from a central difference `fd` taken with the step `h` on
+/// an output of size `q`: relative to the larger of the two, or, where that difference is
+/// within the differences' rounding noise (`1e-13 |q| / h`, some hundred ulps of q over
+/// the step), zero.
+fn difference(d: f64, fd: f64, q: f64, h: f64) -> f64 {
+    let diff = (d - fd).abs();
+    if diff <= 1e-13 * q.abs() / h {
+        return 0.0;
+    }
+    diff / d.abs().max(fd.abs()).max(f64::MIN_POSITIVE)
+}
+
+/// Every output in every parameter kind against central differences, to 1e-6 relative,
+/// on the site (two soils, a rigid region, the body below, a free edge, boundary heights)
+/// with `foundation`.
+fn finite_differences(foundation: &str) {
+    let case = Case::from_toml_str(&site(foundation), None).unwrap();
+    let req = request(&OUTPUTS, &PARAMETERS);
+    let (s, states) = values(&case, &req);
+    assert_eq!(
+        s.biactive(),
+        0,
+        "{foundation}: the site has no biactive vertex"
+    );
+    let np = s.parameters.len();
+    let mut worst: f64 = 0.0;
+    println!("{foundation}: output, parameter, kind, derivative, central difference, rel. error");
+    for (p, key) in s.parameters.iter().enumerate() {
+        let ([fd, fd4], h) = central(&case, &req, key, &states);
+        for (o, name) in s.outputs.iter().enumerate() {
+            let d = s.derivative[o * np + p];
+            let q = s.values[o];
+            // The better of the two steps: where a vertex's gap is within a step of zero
+            // the contact area is C¹ but not C² and the larger step's difference is first
+            // order.
+            let (rel, fd) = [
+                (difference(d, fd[o], q, h), fd[o]),
+                (difference(d, fd4[o], q, 0.25 * h), fd4[o]),
+            ]
+            .into_iter()
+            .fold((f64::INFINITY, 0.0), |a, b| if b.0 < a.0 { b } else { a });
+            worst = worst.max(rel);
+            println!(
+                "  {name:>22} {:>26} {:>6} {d:>14.6e} {fd:>14.6e} {rel:9.1e} (h {h:.1e})",
+                key.key,
+                key.kind.name()
+            );
+            assert!(
+                rel <= 1e-6,
+                "{foundation}: d {name} / d {}: {d:e} against {fd:e} (relative {rel:e})",
+                key.key
+            );
+        }
+    }
+    println!("{foundation}: worst relative difference {worst:.1e}");
+}
+
+#[test]
+fn every_output_in_every_parameter_kind_consistent() {
+    finite_differences("consistent");
+}
+
+#[test]
+fn every_output_in_every_parameter_kind_lumped() {
+    finite_differences("lumped");
+}
+
+/// The solution of a case, its states, and the derivative data of `parameters`.
+struct Solved {
+    discretization: crate::discretization::Discretization,
+    report: crate::outcome::Report,
+    prepared: Prepared,
+}
+
+fn solved(case: &Case, req: &Request) -> Solved {
+    let run = run_request(case, req, &mut Silent).expect("a run");
+    let d = run.outcome.discretization;
+    let prepared =
+        Prepared::new(&case.problem, &case.sensors, req, d.mesh(), &d.model).expect("prepared");
+    Solved {
+        discretization: d,
+        report: run.outcome.report,
+        prepared,
+    }
+}
+
+/// The envelope identities: dJ/dp by the envelope theorem (no solve) equals the chain rule
+/// through the tangent solve, `∂ₚJ + ∇J·δU` with ∇J from the solution itself, to 1e-10.
+fn envelope(foundation: &str) {
+    let case = Case::from_toml_str(&site(foundation), None).unwrap();
+    let req = request(&["energy"], &PARAMETERS);
+    let s = solved(&case, &req);
+    let model = &s.discretization.model;
+    let u = &s.report.u;
+    let states = States::classify(model, u, &s.report.certificate);
+    let forces = crate::certificate::contact_forces(model, u);
+    let at = At {
+        mesh: s.discretization.mesh(),
+        model,
+        u,
+        states: &states,
+        energy: s.report.energy,
+        forces: &forces,
+    };
+    let n = model.n();
+    let p = states.p_hat(model, u);
+    let q = states.q_hat(model, u);
+    // ∇J of the piece at U: r + E_P L p̂ − E_Q L_low q̂ (r alone on held rows).
+    let lp = states::restricted_mul(&model.l, &states.pen_up, &p);
+    let lq = match &model.lower {
+        Some(low) => states::restricted_mul(&low.l, &states.pen_low, &q),
+        None => vec![0.0; n],
+    };
+    let grad: Vec<f64> = (0..n).map(|i| states.r[i] + lp[i] - lq[i]).collect();
+    println!("{foundation}: parameter, dJ/dp (envelope), chain rule, relative difference");
+    for d in &s.prepared.parameters {
+        let dr = at.dr(d);
+        let env = at.envelope(d, &dr);
+        let (du, _) = lcp::directional(&at, &states, None, d, &dr, 1.0).unwrap();
+        // ∂ₚJ of the piece at fixed U.
+        let mut partial = crate::sparse::dot(u, &dr);
+        if d.tension {
+            partial -= 0.5 / model.tension * model.s.quad_form(u);
+        }
+        if let Some(dl) = &d.up.dl {
+            partial += 0.5 * outputs_quad(dl, &p);
+        }
+        if let Some(dphi) = &d.up.dphi {
+            partial -= crate::sparse::dot(&lp, dphi);
+        }
+        if let Some(dl) = &d.low.dl {
+            partial += 0.5 * outputs_quad(dl, &q);
+        }
+        if let Some(dphi) = &d.low.dphi {
+            partial += crate::sparse::dot(&lq, dphi);
+        }
+        let chain = partial + crate::sparse::dot(&grad, &du);
+        let scale = env
+            .abs()
+            .max(chain.abs())
+            .max(1e-12 * s.report.energy.abs() / reference(&d.key));
+        let rel = (env - chain).abs() / scale;
+        println!("  {:>26} {env:>16.9e} {chain:>16.9e} {rel:9.1e}", d.key.key);
+        assert!(
+            rel <= 1e-10,
+            "{foundation} {}: {env:e} against {chain:e}",
+            d.key.key
+        );
+    }
+}
+
+fn outputs_quad(l: &crate::model::FoundationMatrix, x: &[f64]) -> f64 {
+    match l {
+        crate::model::FoundationMatrix::Consistent(a) => a.quad_form(x),
+        crate::model::FoundationMatrix::Lumped(d) => d.iter().zip(x).map(|(d, x)| d * x * x).sum(),
+        crate::model::FoundationMatrix::Rigid => 0.0,
+    }
+}
+
+#[test]
+fn envelope_identities_consistent() {
+    envelope("consistent");
+}
+
+#[test]
+fn envelope_identities_lumped() {
+    envelope("lumped");
+}
+
+/// Taylor remainders `|Q(p + ε) − Q(p) − ε dQ/dp|` fall like ε² while the vertex states
+/// stay (rates printed and checked above 1.8).
+#[test]
+fn taylor_remainders_fall_at_rate_two() {
+    let case = Case::from_toml_str(&site("consistent"), None).unwrap();
+    let outputs = [
+        "energy",
+        "sensor:B",
+        "total_contact_force",
+        "contact_force:stiff",
+    ];
+    let params = [
+        "obstacle.stiffness.stiff",
+        "membrane.tension",
+        "lower.shape",
+    ];
+    let req = request(&outputs, &params);
+    let (s, states) = values(&case, &req);
+    let only = Request {
+        influence: false,
+        ..req.clone()
+    };
+    for (p, key) in s.parameters.iter().enumerate() {
+        let eps: Vec<f64> = (0..4)
+            .map(|k| 2e-3 * reference(key) / f64::powi(2.0, k))
+            .collect();
+        let mut rem = vec![vec![0.0; eps.len()]; outputs.len()];
+        for (k, &e) in eps.iter().enumerate() {
+            let (a, sa) = values(&moved(&case, key, key.value + e), &only);
+            assert_eq!(sa, states, "{}: the states change at ε = {e:e}", key.key);
+            for o in 0..outputs.len() {
+                rem[o][k] = (a.values[o] - s.values[o] - e * s.get(o, p)).abs();
+            }
+        }
+        for (o, name) in outputs.iter().enumerate() {
+            let rates: Vec<f64> = rem[o].windows(2).map(|w| (w[0] / w[1]).log2()).collect();
+            println!(
+                "  {name:>20} in {:>26}: remainders {:.2e} .. {:.2e}, rates {rates:.3?}",
+                key.key, rem[o][0], rem[o][3]
+            );
+            // A remainder at rounding level has no rate to show.
+            if rem[o][0] > 1e-13 * s.values[o].abs() {
+                assert!(
+                    rates.iter().all(|&r| r > 1.8 && r < 2.2),
+                    "{name} in {}: {rates:?}",
+                    key.key
+                );
+            }
+        }
+    }
+}
+
+/// A rigid obstacle that the free membrane just touches at one vertex (φ = max u₀ there):
+/// the vertex is biactive (zero contact force), and the one-sided derivatives in φ are
+/// those of one-sided differences: raising the obstacle frees the membrane (0), lowering it
+/// pushes the vertex down with it.
+#[test]
+fn a_biactive_vertex_gives_both_one_sided_derivatives() {
+    for stiffness in ["\"rigid\"", "400"] {
+        let base = |phi: f64, h: &str| {
+            format!(
+                r#"
+[mesh]
+generator = "rectangle"
+nx = 8
+[membrane]
+tension = 1
+load = 8
+[obstacle]
+shape = {phi:e}
+stiffness = {h}
+foundation = "lumped"
+[solver]
+method = "active-set"
+tolerance = 1e-13
+[[sensor]]
+name = "mid"
+at = [0.5, 0.5]
+[[sensor]]
+name = "side"
+at = [0.25, 0.5]
+"#
+            )
+        };
+        let req = request(
+            &["sensors", "energy", "total_contact_force"],
+            &["obstacle.shape"],
+        );
+        // The free membrane's deflection at the centre.
+        let free = Case::from_toml_str(&base(10.0, "0"), None).unwrap();
+        let (f, _) = values(&free, &req);
+        let top = f.values[0];
+        let case = Case::from_toml_str(&base(top, stiffness), None).unwrap();
+        let (s, _) = values(&case, &req);
+        assert!(s.biactive() >= 1, "{stiffness}: {} biactive", s.biactive());
+        assert_eq!(s.mode, Mode::OneSided);
+        let key = &s.parameters[0];
+        let at = |c: f64| values(&moved(&case, key, c), &req).0.values;
+        // One-sided differences, Richardson-extrapolated (the response is piecewise
+        // quadratic in φ: the extrapolation removes the O(h) term).
+        let h = 1e-6 * top;
+        let (u1, u2, d1, d2) = (
+            at(top + h),
+            at(top + 0.5 * h),
+            at(top - h),
+            at(top - 0.5 * h),
+        );
+        for o in 0..s.outputs.len() {
+            let q = s.values[o];
+            let right = 2.0 * (u2[o] - q) / (0.5 * h) - (u1[o] - q) / h;
+            let left = 2.0 * (q - d2[o]) / (0.5 * h) - (q - d1[o]) / h;
+            let (plus, minus) = (s.derivative_plus[o], s.derivative_minus[o]);
+            println!(
+                "  {stiffness:>8} {:>20}: plus {plus:.9e} (right difference {right:.9e}), minus {minus:.9e} (left {left:.9e}), derivative {:.6e}, flagged {}",
+                s.outputs[o], s.derivative[o], s.nonsmooth[o]
+            );
+            let close = |a: f64, b: f64| difference(a, b, q, 0.5 * h) <= 1e-6;
+            assert!(
+                close(plus, right),
+                "{}: plus {plus:e} right {right:e}",
+                s.outputs[o]
+            );
+            assert!(
+                close(minus, left),
+                "{}: minus {minus:e} left {left:e}",
+                s.outputs[o]
+            );
+            assert!(
+                (s.derivative[o] - 0.5 * (plus + minus)).abs()
+                    <= 1e-15 * plus.abs().max(minus.abs())
+            );
+        }
+        // The centre's deflection follows the obstacle down, not up.
+        assert!(s.nonsmooth[0] && s.derivative_plus[0].abs() < 1e-9 && s.derivative_minus[0] > 0.1);
+    }
+}
+
+/// The axisymmetric disc (t = f = R = 1, φ = 0.1, h = 100): dJ/dh and du(0)/dh converge
+/// under refinement to the values of the Bessel solution differentiated in h.
+#[test]
+fn disc_derivatives_converge_to_the_bessel_solution() {
+    let exact =
+        crate::verify::exact::DiskSolution::new([0.0, 0.0], 1.0, 1.0, 1.0, Some(100.0), 0.1)
+            .unwrap();
+    let (dj, du0) = exact.h_derivatives().unwrap();
+    // The derivative of the closed form's u(0) by Richardson-extrapolated differences.
+    let u0 = |h: f64| {
+        crate::verify::exact::DiskSolution::new([0.0, 0.0], 1.0, 1.0, 1.0, Some(h), 0.1)
+            .unwrap()
+            .radial(0.0)[0]
+    };
+    let fd = |d: f64| (u0(100.0 + d) - u0(100.0 - d)) / (2.0 * d);
+    let richardson = (4.0 * fd(0.05) - fd(0.1)) / 3.0;
+    println!("exact: dJ/dh = {dj:.12e}, du(0)/dh = {du0:.12e} (differences of the closed form {richardson:.12e})");
+    assert!((richardson - du0).abs() <= 1e-8 * du0.abs());
+    let mut errors = Vec::new();
+    for refine in 0..4 {
+        let text = format!(
+            r#"
+[mesh]
+generator = "disk"
+radius = 1
+size = 0.2
+refine = {refine}
+[membrane]
+tension = 1
+load = 1
+[obstacle]
+shape = 0.1
+stiffness = 100
+[solver]
+method = "active-set"
+tolerance = 1e-12
+[[sensor]]
+name = "centre"
+at = [0, 0]
+"#
+        );
+        let case = Case::from_toml_str(&text, None).unwrap();
+        let req = request(&["energy", "sensor:centre"], &["obstacle.stiffness"]);
+        let run = run_request(&case, &req, &mut Silent).unwrap();
+        let s = run.sensitivities.unwrap();
+        let n = run.outcome.discretization.mesh().n_vertices();
+        let (ej, eu) = (
+            (s.get(0, 0) - dj).abs() / dj.abs(),
+            (s.get(1, 0) - du0).abs() / du0.abs(),
+        );
+        println!(
+            "  refine {refine}: {n:>6} vertices, dJ/dh {:.10e} (rel. error {ej:.2e}), du(0)/dh {:.10e} (rel. error {eu:.2e})",
+            s.get(0, 0),
+            s.get(1, 0)
+        );
+        errors.push((ej, eu));
+    }
+    for w in errors.windows(2) {
+        assert!(w[1].0 < 0.5 * w[0].0 && w[1].1 < 0.5 * w[0].1, "{errors:?}");
+    }
+}
