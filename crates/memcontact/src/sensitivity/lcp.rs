@@ -40,7 +40,7 @@ pub fn directional(
         d.key.key
     );
     let max_steps = 4 * nb + 10;
-    for step in 0..max_steps {
+    for _ in 0..max_steps {
         let ps = states.piece(&pieces);
         let mut jac = Jacobian::new(model, &ps, levels)?;
         let dres = at.residual_derivative(&ps, d, dr);
@@ -83,7 +83,7 @@ pub fn directional(
             .collect();
         let p_hat = states.p_hat(model, at.u);
         let (w_low, q_hat) = match &model.lower {
-            Some(low) => (
+            Some(_) => (
                 (0..n)
                     .map(|i| {
                         if ps.pen_low[i] && ps.held[i].is_none() {
@@ -93,10 +93,7 @@ pub fn directional(
                         }
                     })
                     .collect::<Vec<f64>>(),
-                {
-                    let _ = low;
-                    states.q_hat(model, at.u)
-                },
+                states.q_hat(model, at.u),
             ),
             None => (Vec::new(), Vec::new()),
         };
@@ -149,7 +146,6 @@ pub fn directional(
         } else {
             pieces = next;
         }
-        let _ = step;
     }
     Err(Error::Solver {
         solver: "sensitivity".into(),

@@ -165,6 +165,10 @@ pub struct Prepared {
     rigid: (Vec<u32>, Vec<u32>),
     /// The sensors' names by output.
     sensor_names: Vec<Option<String>>,
+    /// The multigrid levels of the linear solves, built on first use and kept for the
+    /// next solutions of the same mesh (a fit's iterates): `None` inside when the systems
+    /// are factorised.
+    levels: std::sync::OnceLock<Option<std::sync::Arc<crate::solve::multigrid::Levels>>>,
 }
 
 impl Prepared {
@@ -205,7 +209,21 @@ impl Prepared {
                     .unwrap_or_default(),
             ),
             sensor_names,
+            levels: std::sync::OnceLock::new(),
         })
+    }
+
+    /// The multigrid levels for `model` (built on the first call, see [`Prepared`]).
+    fn levels(
+        &self,
+        model: &Model,
+        hierarchy: Option<&crate::mesh::refine::Hierarchy>,
+    ) -> Result<Option<&crate::solve::multigrid::Levels>> {
+        if self.levels.get().is_none() {
+            let built = linear::levels_for(model, hierarchy)?.map(std::sync::Arc::new);
+            let _ = self.levels.set(built);
+        }
+        Ok(self.levels.get().and_then(|l| l.as_deref()))
     }
 
     /// The outputs' values alone at the solution `u` of `model` on `mesh`.
@@ -285,7 +303,7 @@ impl Prepared {
         let levels = if others.is_empty() || np == 0 {
             None
         } else {
-            linear::levels_for(model, hierarchy)?
+            self.levels(model, hierarchy)?
         };
         let base = states.piece(&vec![Piece::Held; states.biactive.len()]);
         let gradients: Vec<Option<Vec<f64>>> = self
@@ -321,7 +339,7 @@ impl Prepared {
                 .collect();
             match mode {
                 Mode::Adjoint | Mode::Tangent => {
-                    let mut jac = linear::Jacobian::new(model, &base, levels.as_ref())?;
+                    let mut jac = linear::Jacobian::new(model, &base, levels)?;
                     if mode == Mode::Adjoint {
                         for &o in &others {
                             let (lambda, rec) = adjoint(
@@ -389,7 +407,7 @@ impl Prepared {
                         let d = &self.parameters[p];
                         for (sign, target) in [(1.0, &mut plus), (-1.0, &mut minus)] {
                             let (du, recs) =
-                                lcp::directional(&at, &states, levels.as_ref(), d, &drs[p], sign)?;
+                                lcp::directional(&at, &states, levels, d, &drs[p], sign)?;
                             solves.extend(recs);
                             for &o in &others {
                                 let g = gradients[o].as_ref().expect("a gradient");
@@ -401,7 +419,7 @@ impl Prepared {
                         }
                     }
                     if !sensors_for_maps.is_empty() {
-                        let mut jac = linear::Jacobian::new(model, &base, levels.as_ref())?;
+                        let mut jac = linear::Jacobian::new(model, &base, levels)?;
                         for &o in &sensors_for_maps {
                             let (lambda, rec) = adjoint(
                                 &mut jac,

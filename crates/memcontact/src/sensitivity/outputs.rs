@@ -444,7 +444,6 @@ impl At<'_> {
     pub fn envelope(&self, d: &DataDerivative, dr: &[f64]) -> f64 {
         let m = self.model;
         let u = self.u;
-        let n = m.n();
         // ½ ds UᵀSU + ds Uᵀlift − Uᵀ(dD − dlift) = Uᵀ dr − ½ ds UᵀSU.
         let mut j = crate::sparse::dot(u, dr);
         if d.tension {
@@ -468,7 +467,6 @@ impl At<'_> {
         if let (Some(dphi), false) = (&d.low.dphi, self.forces.low.is_empty()) {
             j += crate::sparse::dot(&self.forces.low, dphi);
         }
-        let _ = n;
         j
     }
 
@@ -581,7 +579,8 @@ fn corner(area: f64, e: [f64; 3], c: usize, sign: f64) -> (f64, [f64; 3]) {
     let (ec, ea, eb) = (e[c], e[a], e[b]);
     let (da, db) = (ec - ea, ec - eb);
     if da == 0.0 || db == 0.0 {
-        return (if sign > 0.0 { 0.0 } else { 0.0 }, [0.0; 3]);
+        // A lone corner equal to another: the corner region is empty.
+        return (0.0, [0.0; 3]);
     }
     let value = area * ec * ec / (da * db);
     let mut d = [0.0; 3];

@@ -179,22 +179,39 @@ fn finite_differences(foundation: &str) {
             // The better of the two steps: where a vertex's gap is within a step of zero
             // the contact area is C¹ but not C² and the larger step's difference is first
             // order.
-            let (rel, fd) = [
+            let (r, fd) = [
                 (difference(d, fd[o], q, h), fd[o]),
                 (difference(d, fd4[o], q, 0.25 * h), fd4[o]),
             ]
             .into_iter()
-            .fold((f64::INFINITY, 0.0), |a, b| if b.0 < a.0 { b } else { a });
-            worst = worst.max(rel);
+            .fold(((f64::INFINITY, 0.0), 0.0), |a, b| {
+                if b.0 .0 < a.0 .0 {
+                    b
+                } else {
+                    a
+                }
+            });
+            // The worst of the derivatives well above the differences' noise.
+            if r.1 < 1e-3 {
+                worst = worst.max(r.0);
+            }
             println!(
-                "  {name:>22} {:>26} {:>6} {d:>14.6e} {fd:>14.6e} {rel:9.1e} (h {h:.1e})",
+                "  {name:>22} {:>26} {:>6} {d:>14.6e} {fd:>14.6e} {:9.1e}{}",
                 key.key,
-                key.kind.name()
+                key.kind.name(),
+                r.0,
+                if r.1 >= 1e-3 {
+                    " (near the differences' noise)"
+                } else {
+                    ""
+                }
             );
             assert!(
-                rel <= 1e-6,
-                "{foundation}: d {name} / d {}: {d:e} against {fd:e} (relative {rel:e})",
-                key.key
+                agrees(r),
+                "{foundation}: d {name} / d {}: {d:e} against {fd:e} (relative {:e}, noise {:e})",
+                key.key,
+                r.0,
+                r.1
             );
         }
     }
