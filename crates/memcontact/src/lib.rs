@@ -15,8 +15,10 @@
 //!
 //! - [`mod@run`] holds the only places that run: [`run::run`] (a case of one step),
 //!   [`run::run_sweep`] (its load steps or load cases in turn), [`run::run_adapt`] (the
-//!   adaptive loop: solve, [`estimate`], mark and bisect in [`mesh`], solve again), and,
-//!   beside the pipeline,
+//!   adaptive loop: solve, [`estimate`], mark and bisect in [`mesh`], solve again),
+//!   [`run::run_sensitivity`] and [`run::run_fit`] (derivatives of outputs in case keys
+//!   through the contact, [`sensitivity`], and the back-analysis of parameters from
+//!   measured deflections, [`fit`]), and, beside the pipeline,
 //!   [`verify::study::run_study`] (a convergence study with the exact solutions of
 //!   [`verify::exact`] and the norms of [`verify::norms`]). The command-line tool and the
 //!   Python module call these and the writers of [`mod@write`]; they run nothing themselves.

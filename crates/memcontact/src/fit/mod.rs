@@ -219,6 +219,19 @@ pub struct FitIteration {
     pub solves: usize,
 }
 
+/// One forward solve of a fit.
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct FitSolve {
+    /// The parameters solved at.
+    pub parameters: Vec<f64>,
+    /// The solver's iterations.
+    pub iterations: usize,
+    /// Its seconds.
+    pub seconds: f64,
+    /// Whether its answer was accepted.
+    pub accepted: bool,
+}
+
 /// The result of a fit (`fit.json`).
 #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct FitResult {
@@ -242,6 +255,12 @@ pub struct FitResult {
     pub measurements: Vec<Fitted>,
     /// The accepted iterates.
     pub history: Vec<FitIteration>,
-    /// Seconds of the fit (solves, derivatives and the optimiser).
+    /// Seconds of the fit (mesh, assembly, solves, derivatives and the optimiser).
     pub seconds: f64,
+    /// Seconds in forward solves.
+    pub seconds_solves: f64,
+    /// Seconds in the Jacobians (the tangent solves).
+    pub seconds_derivatives: f64,
+    /// Every forward solve, in order (trial steps included).
+    pub forward_solves: Vec<FitSolve>,
 }

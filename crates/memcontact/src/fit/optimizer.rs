@@ -1,7 +1,10 @@
 //! Bounded Levenberg-Marquardt on a small least-squares problem
 //! `min ½ ‖r(x)‖² + ½ α ‖x − x₀‖²` over a box (docs/theory.md#sensitivities): the exact
 //! Jacobian from the caller, a Marquardt-scaled damping updated by the gain ratio
-//! (Nielsen's rule), steps projected onto the bounds with the variables held at a bound
+//! (Nielsen's rule), steps limited to a trust radius in the variables (1 at the start: a
+//! factor e on a logarithmic variable; doubled after a step the model predicted well,
+//! quartered after a rejected one, so that a start far away is not paid for with many
+//! rejected forward solves), projected onto the bounds with the variables held at a bound
 //! (whose gradient pushes outward) left out of the step. The caller evaluates the model;
 //! the optimiser never solves anything itself, so it is tested on plain functions.
 
@@ -26,6 +29,9 @@ pub struct Options {
     pub tolerance: f64,
     /// The prior's weight α (0: none).
     pub prior: f64,
+    /// The initial trust radius: the largest change of a variable in one step (in the
+    /// variable's units, ln p for a logarithmic parameter).
+    pub radius: f64,
 }
 
 /// Why a fit stopped.
@@ -141,6 +147,7 @@ pub fn minimize(
     let mut iteration = 0;
     // Whether the model's last evaluation was at x (a rejected trial moves it away).
     let mut model_at_x = true;
+    let mut radius = options.radius;
     'outer: while iteration < options.max_iterations {
         // g = Jᵀr + α(x − x₀), A = JᵀJ + αI.
         let mut g = vec![0.0; n];
@@ -172,6 +179,9 @@ pub fn minimize(
         if pg <= options.tolerance * 1e-3 * (1.0 + cost) {
             stop = Stop::Gradient;
             break;
+        }
+        if radius <= 0.0 {
+            radius = options.radius;
         }
         if mu < 0.0 {
             mu = 1e-3 * (0..n).map(|j| a[j * n + j]).fold(0.0, f64::max).max(1e-300);
@@ -205,9 +215,16 @@ pub fn minimize(
                     continue;
                 }
             };
+            // Within the trust radius.
+            let longest = delta_free.iter().map(|v| v.abs()).fold(0.0, f64::max);
+            let shrink = if longest > radius {
+                radius / longest
+            } else {
+                1.0
+            };
             let mut trial = x.clone();
             for (p, &j) in idx.iter().enumerate() {
-                trial[j] = (x[j] + delta_free[p]).clamp(lo[j], hi[j]);
+                trial[j] = (x[j] + shrink * delta_free[p]).clamp(lo[j], hi[j]);
             }
             let step: Vec<f64> = (0..n).map(|j| trial[j] - x[j]).collect();
             let step_max = step.iter().map(|v| v.abs()).fold(0.0, f64::max);
@@ -241,6 +258,9 @@ pub fn minimize(
                 iteration += 1;
                 mu *= (1.0 / 3.0f64).max(1.0 - (2.0 * rho - 1.0).powi(3));
                 nu = 2.0;
+                if rho > 0.75 {
+                    radius = radius.max(2.0 * step_max);
+                }
                 let it = Iterate {
                     iteration,
                     x: x.clone(),
@@ -261,6 +281,7 @@ pub fn minimize(
             // Rejected: more damping, a shorter step.
             mu *= nu;
             nu *= 2.0;
+            radius = 0.25 * step_max;
             let size = 1.0 + x.iter().map(|v| v.abs()).fold(0.0, f64::max);
             if step_max <= options.tolerance * size {
                 stop = Stop::Step;
@@ -413,6 +434,7 @@ mod tests {
             max_iterations: 100,
             tolerance: 1e-12,
             prior: 0.0,
+            radius: 1.0,
         };
         let mut m = Rosenbrock { at: vec![] };
         let min = minimize(

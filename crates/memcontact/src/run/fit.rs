@@ -16,6 +16,15 @@ use crate::sensitivity::{Prepared, Request, Sensitivities};
 use crate::solve::{self, Observer};
 use std::time::Instant;
 
+/// The loosest relative residual of the tangent solves of a fit's Jacobians (far from the
+/// answer): the Jacobian is the exact derivative to this accuracy. It tightens with the
+/// misfit down to [`JACOBIAN_TOLERANCE_FINAL`] (see `Variables::jacobian`).
+pub const JACOBIAN_TOLERANCE: f64 = 1e-3;
+
+/// The tightest relative residual of a fit's tangent solves (at the answer, where the
+/// Jacobian also gives the statistics).
+pub const JACOBIAN_TOLERANCE_FINAL: f64 = 1e-10;
+
 /// A fit's model: the residuals `(Q(p) − m)/σ` of the measured deflections and their
 /// Jacobian in the parameters p (physical units), one warm-started solve per new p. The
 /// Python module hands this to `scipy.optimize.least_squares`.
@@ -35,7 +44,15 @@ pub struct FitProblem {
     current: Option<(Vec<f64>, Report)>,
     /// The last accepted answer (the warm start).
     warm: Option<Vec<f64>>,
+    /// Where the Jacobian was last computed: the parameters, the answer and its tangents
+    /// dU/dp; the next solves start from the first-order prediction
+    /// `U + Σⱼ (dU/dpⱼ) (p − p₀)ⱼ`.
+    anchor: Option<(Vec<f64>, Vec<f64>, Vec<Vec<f64>>)>,
     solves: usize,
+    /// Seconds in forward solves, and in derivatives.
+    seconds: (f64, f64),
+    /// Every forward solve.
+    log: Vec<crate::fit::FitSolve>,
 }
 
 impl FitProblem {
@@ -75,13 +92,28 @@ impl FitProblem {
             parameters: keys.iter().map(|k| k.key.clone()).collect(),
             influence: false,
         };
-        let prepared = Prepared::new(
+        let mut prepared = Prepared::new(
             &case.problem,
             &sensors,
             &request,
             discretization.mesh(),
             &discretization.model,
         )?;
+        prepared.keep_tangents = true;
+        prepared.linear_tolerance = JACOBIAN_TOLERANCE_FINAL;
+        let mut discretization = discretization;
+        // One aggregation hierarchy for every solve of the fit, forward and tangent, when
+        // the mesh has no refinement levels (built from the start's matrices: the
+        // iterates' matrices share its pattern and differ little).
+        if discretization.levels().is_none()
+            && case.settings.hierarchy == crate::solve::HierarchyChoice::Auto
+        {
+            if let Some(levels) =
+                prepared.shared_levels(&discretization.model, discretization.levels())?
+            {
+                discretization.share_levels(levels);
+            }
+        }
         let measured = sensors.iter().map(|s| s.measured.unwrap_or(0.0)).collect();
         let sigma = sensors.iter().map(|s| s.sigma.unwrap_or(1.0)).collect();
         let sigmas_given = sensors.iter().all(|s| s.sigma.is_some());
@@ -98,7 +130,10 @@ impl FitProblem {
             sigmas_given,
             current: None,
             warm: None,
+            anchor: None,
             solves: 0,
+            seconds: (0.0, 0.0),
+            log: Vec::new(),
         })
     }
 
@@ -145,10 +180,33 @@ impl FitProblem {
         }
         crate::model::check_model(self.discretization.mesh(), &model)?;
         self.discretization.model = model;
+        // The start: the first-order prediction from the last Jacobian's tangents, else
+        // the last accepted answer.
+        let predicted = self.anchor.as_ref().map(|(p0, u0, tangents)| {
+            let mut u = u0.clone();
+            for (t, (&a, &b)) in tangents.iter().zip(p.iter().zip(p0)) {
+                for (ui, ti) in u.iter_mut().zip(t) {
+                    *ui += ti * (a - b);
+                }
+            }
+            u
+        });
+        let start = predicted
+            .filter(|u| u.iter().all(|v| v.is_finite()))
+            .or_else(|| self.warm.clone());
+        let t0 = Instant::now();
         let report =
             self.discretization
-                .solve_from(&self.case.settings, self.warm.as_deref(), observer)?;
+                .solve_from(&self.case.settings, start.as_deref(), observer)?;
+        let seconds = t0.elapsed().as_secs_f64();
+        self.seconds.0 += seconds;
         self.solves += 1;
+        self.log.push(crate::fit::FitSolve {
+            parameters: p.to_vec(),
+            iterations: report.iterations,
+            seconds,
+            accepted: report.accepted,
+        });
         let accepted = report.accepted;
         if accepted {
             self.warm = Some(report.u.clone());
@@ -215,7 +273,13 @@ impl FitProblem {
                 "the fit's model has not been solved yet".into(),
             ));
         }
+        let t0 = Instant::now();
         let s = self.sensitivities_at()?;
+        self.seconds.1 += t0.elapsed().as_secs_f64();
+        if s.tangents.len() == self.keys.len() {
+            let (p, report) = self.current.as_ref().expect("solved");
+            self.anchor = Some((p.clone(), report.u.clone(), s.tangents));
+        }
         let np = self.keys.len();
         Ok((0..self.sensors.len() * np)
             .map(|k| s.derivative[k] / self.sigma[k / np])
@@ -270,23 +334,28 @@ pub(crate) fn locate_measured(
     sensors: &[Sensor],
     from_file: bool,
 ) -> Result<()> {
-    for (i, s) in sensors.iter().enumerate() {
-        let key = if from_file {
-            format!(
-                "fit.measurements (row {} of the file, sensor {})",
-                i + 1,
-                s.name
-            )
-        } else {
-            let k = case
-                .sensors
-                .iter()
-                .position(|c| c.name == s.name)
-                .unwrap_or(i);
-            format!("sensor.{k}")
-        };
-        crate::sensitivity::outputs::sensor_output(mesh, &key, s)?;
-    }
+    let keyed: Vec<(String, &Sensor)> = sensors
+        .iter()
+        .enumerate()
+        .map(|(i, s)| {
+            let key = if from_file {
+                format!(
+                    "fit.measurements (row {} of the file, sensor {})",
+                    i + 1,
+                    s.name
+                )
+            } else {
+                let k = case
+                    .sensors
+                    .iter()
+                    .position(|c| c.name == s.name)
+                    .unwrap_or(i);
+                format!("sensor.{k}")
+            };
+            (key, s)
+        })
+        .collect();
+    crate::sensitivity::outputs::sensor_outputs(mesh, &keyed)?;
     Ok(())
 }
 
@@ -295,16 +364,34 @@ pub(crate) fn locate_measured(
 struct Variables<'a> {
     problem: &'a mut FitProblem,
     log: Vec<bool>,
+    /// The start in both forms (so that the start's variables give back its parameters
+    /// exactly, not through `exp(ln p)`).
+    x0: Vec<f64>,
+    p0: Vec<f64>,
     observer: &'a mut dyn Observer,
+    /// The cost of the last residuals, and of the first.
+    cost: (f64, f64),
 }
 
 impl Variables<'_> {
     fn to_p(&self, x: &[f64]) -> Vec<f64> {
-        x.iter()
-            .zip(&self.log)
-            .map(|(&x, &l)| if l { x.exp() } else { x })
-            .collect()
+        to_parameters(x, &self.log, &self.x0, &self.p0)
     }
+}
+
+/// The parameters of the variables x (`exp x` for logarithmic ones; the start's exactly).
+fn to_parameters(x: &[f64], log: &[bool], x0: &[f64], p0: &[f64]) -> Vec<f64> {
+    (0..x.len())
+        .map(|j| {
+            if x[j] == x0[j] {
+                p0[j]
+            } else if log[j] {
+                x[j].exp()
+            } else {
+                x[j]
+            }
+        })
+        .collect()
 }
 
 impl optimizer::LeastSquares for Variables<'_> {
@@ -315,11 +402,20 @@ impl optimizer::LeastSquares for Variables<'_> {
             return Ok(vec![f64::INFINITY; self.problem.sensors.len()]);
         }
         let q = self.problem.values_now();
-        Ok(self.problem.weighted(&q))
+        let r = self.problem.weighted(&q);
+        let cost = 0.5 * r.iter().map(|v| v * v).sum::<f64>();
+        self.cost = (cost, if self.cost.1 > 0.0 { self.cost.1 } else { cost });
+        Ok(r)
     }
 
     fn jacobian(&mut self) -> Result<Vec<f64>> {
         let (p, _) = self.problem.current.clone().expect("solved");
+        // Inexact Gauss-Newton: the tangent solves of the Jacobian to a residual that
+        // tightens with the misfit (a Jacobian accurate to η contracts the error by about
+        // η besides the step's quadratic term): 1e-3 at the start, 1e-10 at the answer.
+        let (cost, first) = self.cost;
+        self.problem.prepared.linear_tolerance = (1e-3 * cost / first.max(f64::MIN_POSITIVE))
+            .clamp(JACOBIAN_TOLERANCE_FINAL, JACOBIAN_TOLERANCE);
         let j = self.problem.jacobian()?;
         let np = p.len();
         Ok(j.iter()
@@ -389,25 +485,24 @@ pub fn run_fit(case: &Case, observer: &mut dyn Observer) -> Result<FitRun> {
         max_iterations: spec.max_iterations,
         tolerance: spec.tolerance,
         prior: spec.prior.unwrap_or(0.0),
+        radius: 1.0,
     };
     let mut history = Vec::new();
     let minimum = {
         let mut vars = Variables {
             problem: &mut problem,
             log: log.clone(),
+            x0: x0.clone(),
+            p0: p0.clone(),
             observer,
+            cost: (0.0, 0.0),
         };
         let n_meas = vars.problem.sensors.len().max(1) as f64;
-        let log_c = log.clone();
+        let (log_c, x0_c, p0_c) = (log.clone(), x0.clone(), p0.clone());
         optimizer::minimize(&mut vars, &x0, &lo, &hi, &options, &mut |it| {
             history.push(FitIteration {
                 iteration: it.iteration,
-                parameters: it
-                    .x
-                    .iter()
-                    .zip(&log_c)
-                    .map(|(&x, &l)| if l { x.exp() } else { x })
-                    .collect(),
+                parameters: to_parameters(&it.x, &log_c, &x0_c, &p0_c),
                 rms: (2.0 * it.cost / n_meas).sqrt(),
                 step: it.step,
                 damping: it.damping,
@@ -415,12 +510,7 @@ pub fn run_fit(case: &Case, observer: &mut dyn Observer) -> Result<FitRun> {
             })
         })?
     };
-    let p: Vec<f64> = minimum
-        .x
-        .iter()
-        .zip(&log)
-        .map(|(&x, &l)| if l { x.exp() } else { x })
-        .collect();
+    let p = to_parameters(&minimum.x, &log, &x0, &p0);
     // The discretisation holds the model of the best point (the optimiser's last
     // evaluation).
     problem.solve_at(&p, observer)?;
@@ -470,6 +560,8 @@ pub fn run_fit(case: &Case, observer: &mut dyn Observer) -> Result<FitRun> {
         discretization,
         current,
         solves,
+        seconds: (seconds_solves, seconds_derivatives),
+        log: forward_solves,
         ..
     } = problem;
     let (_, report) = current.expect("solved");
@@ -506,6 +598,9 @@ pub fn run_fit(case: &Case, observer: &mut dyn Observer) -> Result<FitRun> {
         measurements,
         history,
         seconds: t0.elapsed().as_secs_f64(),
+        seconds_solves,
+        seconds_derivatives,
+        forward_solves,
     };
     Ok(FitRun {
         outcome: Outcome {

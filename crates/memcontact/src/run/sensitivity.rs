@@ -97,9 +97,13 @@ pub fn run_request(
 /// regions and the parameters bound to the mesh, the measurements read and located.
 pub fn check_sensitivity_on_mesh(case: &Case, discretization: &Discretization) -> Result<()> {
     let mesh = discretization.mesh();
-    for (i, s) in case.sensors.iter().enumerate() {
-        crate::sensitivity::outputs::sensor_output(mesh, &format!("sensor.{i}"), s)?;
-    }
+    let keyed: Vec<(String, &crate::case::Sensor)> = case
+        .sensors
+        .iter()
+        .enumerate()
+        .map(|(i, s)| (format!("sensor.{i}"), s))
+        .collect();
+    crate::sensitivity::outputs::sensor_outputs(mesh, &keyed)?;
     if let Some(spec) = &case.sensitivity {
         Prepared::new(
             &case.problem,

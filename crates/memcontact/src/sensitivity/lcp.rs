@@ -19,11 +19,13 @@ use crate::error::{Error, Result};
 use crate::solve::multigrid::Levels;
 
 /// The directional derivative `δU` of the solution in the direction `sign · δp` of the
-/// parameter `d` (`dr` its `∂r/∂p`), with the solves it took.
+/// parameter `d` (`dr` its `∂r/∂p`; iterative solves to the relative residual
+/// `tolerance`), with the solves it took.
 pub fn directional(
     at: &At,
     states: &States,
     levels: Option<&Levels>,
+    tolerance: f64,
     d: &DataDerivative,
     dr: &[f64],
     sign: f64,
@@ -42,7 +44,7 @@ pub fn directional(
     let max_steps = 4 * nb + 10;
     for _ in 0..max_steps {
         let ps = states.piece(&pieces);
-        let mut jac = Jacobian::new(model, &ps, levels)?;
+        let mut jac = Jacobian::new(model, &ps, levels, tolerance)?;
         let dres = at.residual_derivative(&ps, d, dr);
         let b: Vec<f64> = at.prescribed(&ps, d).iter().map(|x| sign * x).collect();
         let sb = model.s.mul(&b);

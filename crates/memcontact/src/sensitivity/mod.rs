@@ -119,6 +119,11 @@ pub struct Sensitivities {
     pub force_tolerance: f64,
     /// Wall-clock seconds of the whole analysis.
     pub seconds: f64,
+    /// The tangents δU = dU/dp over the unknowns (solver's numbering), one per parameter,
+    /// when [`Prepared::keep_tangents`] asked for them and they were computed (tangent
+    /// mode; one-sided: the mean of the two); empty otherwise. A fit predicts the next
+    /// iterate's solution with them.
+    pub tangents: Vec<Vec<f64>>,
 }
 
 impl Sensitivities {
@@ -161,6 +166,12 @@ pub struct Prepared {
     pub outputs: Vec<OutputSpec>,
     /// The influence maps wanted.
     pub influence: bool,
+    /// Keep the tangents δU in [`Sensitivities::tangents`] (and compute them by tangent
+    /// solves even where adjoint solves would be fewer).
+    pub keep_tangents: bool,
+    /// The relative residual the iterative linear solves are driven to (default
+    /// [`linear::ITERATIVE_TOLERANCE`]; factorised solves are exact to rounding).
+    pub linear_tolerance: f64,
     /// The rigid regions of the obstacle and of the body below (masked in the maps).
     rigid: (Vec<u32>, Vec<u32>),
     /// The sensors' names by output.
@@ -209,8 +220,21 @@ impl Prepared {
                     .unwrap_or_default(),
             ),
             sensor_names,
+            keep_tangents: false,
+            linear_tolerance: linear::ITERATIVE_TOLERANCE,
             levels: std::sync::OnceLock::new(),
         })
+    }
+
+    /// The multigrid levels of the linear solves, built now when they are not yet (for
+    /// `model` on its mesh `hierarchy`); `None` when the systems are factorised.
+    pub fn shared_levels(
+        &self,
+        model: &Model,
+        hierarchy: Option<&crate::mesh::refine::Hierarchy>,
+    ) -> Result<Option<std::sync::Arc<crate::solve::multigrid::Levels>>> {
+        self.levels(model, hierarchy)?;
+        Ok(self.levels.get().cloned().flatten())
     }
 
     /// The multigrid levels for `model` (built on the first call, see [`Prepared`]).
@@ -318,9 +342,10 @@ impl Prepared {
             })
             .collect();
         let mut adjoints: Vec<(usize, Vec<f64>)> = Vec::new();
+        let mut tangents: Vec<Vec<f64>> = Vec::new();
         let mode = if !states.biactive.is_empty() {
             Mode::OneSided
-        } else if others.len() <= np {
+        } else if others.len() <= np && !self.keep_tangents {
             Mode::Adjoint
         } else {
             Mode::Tangent
@@ -339,7 +364,8 @@ impl Prepared {
                 .collect();
             match mode {
                 Mode::Adjoint | Mode::Tangent => {
-                    let mut jac = linear::Jacobian::new(model, &base, levels)?;
+                    let mut jac =
+                        linear::Jacobian::new(model, &base, levels, self.linear_tolerance)?;
                     if mode == Mode::Adjoint {
                         for &o in &others {
                             let (lambda, rec) = adjoint(
@@ -389,6 +415,9 @@ impl Prepared {
                                 plus[o * np + p] = v;
                                 minus[o * np + p] = v;
                             }
+                            if self.keep_tangents {
+                                tangents.push(du);
+                            }
                         }
                         for &o in &sensors_for_maps {
                             let (lambda, rec) = adjoint(
@@ -405,10 +434,22 @@ impl Prepared {
                 Mode::OneSided => {
                     for p in 0..np {
                         let d = &self.parameters[p];
+                        let mut mean = vec![0.0; if self.keep_tangents { n } else { 0 }];
                         for (sign, target) in [(1.0, &mut plus), (-1.0, &mut minus)] {
-                            let (du, recs) =
-                                lcp::directional(&at, &states, levels, d, &drs[p], sign)?;
+                            let (du, recs) = lcp::directional(
+                                &at,
+                                &states,
+                                levels,
+                                self.linear_tolerance,
+                                d,
+                                &drs[p],
+                                sign,
+                            )?;
                             solves.extend(recs);
+                            for (m, v) in mean.iter_mut().zip(&du) {
+                                // δU toward −δp is minus the derivative's left side.
+                                *m += 0.5 * sign * v;
+                            }
                             for &o in &others {
                                 let g = gradients[o].as_ref().expect("a gradient");
                                 let v = sign * at.partial(&self.outputs[o], d, &drs[p])
@@ -417,9 +458,13 @@ impl Prepared {
                                 target[o * np + p] = sign * v;
                             }
                         }
+                        if self.keep_tangents {
+                            tangents.push(mean);
+                        }
                     }
                     if !sensors_for_maps.is_empty() {
-                        let mut jac = linear::Jacobian::new(model, &base, levels)?;
+                        let mut jac =
+                            linear::Jacobian::new(model, &base, levels, self.linear_tolerance)?;
                         for &o in &sensors_for_maps {
                             let (lambda, rec) = adjoint(
                                 &mut jac,
@@ -475,6 +520,7 @@ impl Prepared {
             mode,
             force_tolerance: states.force_tolerance,
             seconds: t0.elapsed().as_secs_f64(),
+            tangents,
         })
     }
 

@@ -70,21 +70,33 @@ pub fn locate(mesh: &Mesh, points: &[[f64; 2]]) -> Result<Vec<Option<([u32; 3], 
 /// Sensor `s` located on `mesh`, or an error naming it (`key`: `sensor.N`, or the
 /// measurements file's row).
 pub fn sensor_output(mesh: &Mesh, key: &str, s: &Sensor) -> Result<OutputSpec> {
-    match locate(mesh, &[s.at])?.pop().flatten() {
-        Some((t, w)) => Ok(OutputSpec {
-            name: format!("sensor:{}", s.name),
-            kind: OutputKind::Sensor(t, w),
-        }),
-        None => Err(Error::Case {
-            file: None,
-            line: None,
-            key: key.to_string(),
-            message: format!(
-                "sensor \"{}\" at ({}, {}) is outside the mesh",
-                s.name, s.at[0], s.at[1]
-            ),
-        }),
-    }
+    Ok(sensor_outputs(mesh, &[(key.to_string(), s)])?.remove(0))
+}
+
+/// The sensors `keyed` (each with the key that names it in errors) located on `mesh` with
+/// one point locator; the first outside the mesh is an error naming it.
+pub fn sensor_outputs(mesh: &Mesh, keyed: &[(String, &Sensor)]) -> Result<Vec<OutputSpec>> {
+    let points: Vec<[f64; 2]> = keyed.iter().map(|(_, s)| s.at).collect();
+    let found = locate(mesh, &points)?;
+    keyed
+        .iter()
+        .zip(found)
+        .map(|((key, s), f)| match f {
+            Some((t, w)) => Ok(OutputSpec {
+                name: format!("sensor:{}", s.name),
+                kind: OutputKind::Sensor(t, w),
+            }),
+            None => Err(Error::Case {
+                file: None,
+                line: None,
+                key: key.clone(),
+                message: format!(
+                    "sensor \"{}\" at ({}, {}) is outside the mesh",
+                    s.name, s.at[0], s.at[1]
+                ),
+            }),
+        })
+        .collect()
 }
 
 /// The outputs named in `names` (`sensors` expands to every sensor), resolved on `mesh`.
@@ -95,19 +107,40 @@ pub fn resolve(
     model: &Model,
     bound: &BoundData,
 ) -> Result<Vec<OutputSpec>> {
-    let mut out = Vec::new();
     let case_error = |message: String| Error::Case {
         file: None,
         line: None,
         key: "sensitivity.outputs".into(),
         message,
     };
+    // The sensors asked for, located together (one point locator).
+    let mut wanted: Vec<usize> = Vec::new();
     for name in names {
-        let sensor = |i: usize| sensor_output(mesh, &format!("sensor.{i}"), &sensors[i]);
+        if name == "sensors" {
+            wanted.extend(0..sensors.len());
+        } else if let Some(s) = name.strip_prefix("sensor:") {
+            let i = sensors
+                .iter()
+                .position(|x| x.name == s)
+                .ok_or_else(|| case_error(format!("no [[sensor]] is named \"{s}\"")))?;
+            wanted.push(i);
+        }
+    }
+    let keyed: Vec<(String, &Sensor)> = wanted
+        .iter()
+        .map(|&i| (format!("sensor.{i}"), &sensors[i]))
+        .collect();
+    let located = sensor_outputs(mesh, &keyed)?;
+    let sensor = |i: usize| -> OutputSpec {
+        let k = wanted.iter().position(|&w| w == i).expect("located");
+        located[k].clone()
+    };
+    let mut out: Vec<OutputSpec> = Vec::new();
+    for name in names {
         if name == "sensors" {
             for i in 0..sensors.len() {
-                let o = sensor(i)?;
-                if !out.iter().any(|x: &OutputSpec| x.name == o.name) {
+                let o = sensor(i);
+                if !out.iter().any(|x| x.name == o.name) {
                     out.push(o);
                 }
             }
@@ -117,9 +150,9 @@ pub fn resolve(
             let i = sensors
                 .iter()
                 .position(|x| x.name == s)
-                .ok_or_else(|| case_error(format!("no [[sensor]] is named \"{s}\"")))?;
-            let o = sensor(i)?;
-            if !out.iter().any(|x: &OutputSpec| x.name == o.name) {
+                .expect("found above");
+            let o = sensor(i);
+            if !out.iter().any(|x| x.name == o.name) {
                 out.push(o);
             }
             continue;

@@ -279,7 +279,7 @@ fn envelope(foundation: &str) {
     for d in &s.prepared.parameters {
         let dr = at.dr(d);
         let env = at.envelope(d, &dr);
-        let (du, _) = lcp::directional(&at, &states, None, d, &dr, 1.0).unwrap();
+        let (du, _) = lcp::directional(&at, &states, None, 1e-12, d, &dr, 1.0).unwrap();
         // ∂ₚJ of the piece at fixed U.
         let mut partial = crate::sparse::dot(u, &dr);
         if d.tension {

@@ -157,6 +157,14 @@ pub fn write_fit_json(path: &Path, fit: &FitResult) -> Result<()> {
         "note": if fit.converged { Value::Null } else { Value::String("the fit did not converge: these files hold its best iterate".into()) },
         "measurements": measurements,
         "seconds": number(fit.seconds),
+        "seconds_solves": number(fit.seconds_solves),
+        "seconds_derivatives": number(fit.seconds_derivatives),
+        "forward_solves": fit.forward_solves.iter().map(|f| json!({
+            "parameters": f.parameters.iter().map(|&v| number(v)).collect::<Vec<_>>(),
+            "iterations": f.iterations,
+            "seconds": number(f.seconds),
+            "accepted": f.accepted,
+        })).collect::<Vec<_>>(),
     });
     crate::io::json::write_json(path, &value)
 }
@@ -170,19 +178,22 @@ fn number(x: f64) -> serde_json::Value {
 /// largest change of a fitted variable, ln p for a logarithmic one), `damping` and
 /// `solves` (forward solves so far), one row per accepted iterate from the start.
 pub fn write_fit_csv(path: &Path, fit: &FitResult) -> Result<()> {
-    let mut header: Vec<String> = vec!["iteration".into()];
-    header.extend(fit.parameters.iter().map(|p| p.key.clone()));
-    header.extend(["rms", "step", "damping", "solves"].map(String::from));
-    let header: Vec<&str> = header.iter().map(String::as_str).collect();
-    let rows: Vec<Vec<f64>> = fit
-        .history
-        .iter()
-        .map(|h| {
-            let mut row = vec![h.iteration as f64];
-            row.extend(&h.parameters);
-            row.extend([h.rms, h.step, h.damping, h.solves as f64]);
-            row
-        })
-        .collect();
-    crate::io::csv::write_table_csv(path, &header, &rows)
+    let mut buf = Vec::new();
+    buf.extend_from_slice(b"iteration");
+    for p in &fit.parameters {
+        buf.push(b',');
+        push_text(&mut buf, &p.key);
+    }
+    buf.extend_from_slice(b",rms,step,damping,solves\n");
+    for h in &fit.history {
+        buf.extend_from_slice(h.iteration.to_string().as_bytes());
+        for &v in h.parameters.iter().chain([h.rms, h.step, h.damping].iter()) {
+            buf.push(b',');
+            push_number(&mut buf, v);
+        }
+        buf.push(b',');
+        buf.extend_from_slice(h.solves.to_string().as_bytes());
+        buf.push(b'\n');
+    }
+    crate::io::write_atomic(path, |w| w.write_all(&buf)).map(|_| ())
 }
