@@ -9,14 +9,14 @@ use memcontact_cli::bench::standard::{run_bench, BenchRow};
 /// The allocator of the `memcontact` binary, so that the kernels are timed as it runs them.
 #[global_allocator]
 static ALLOCATOR: mimalloc::MiMalloc = mimalloc::MiMalloc;
+use memcontact::bench::TnnmgOptions;
 use memcontact::model::Foundation;
-use memcontact::solve::multigrid::TnnmgOptions;
 
 /// `-- --micro N`: times the kernels of one TNNMG iteration on the N × N benchmark mesh
 /// and its geometric levels (with `--mesh FILE` instead of N: on a Gmsh mesh renumbered as
 /// a solve would, and its algebraic levels).
 fn micro(args: &[String]) {
-    use memcontact::solve::multigrid::{kernel_timings, Coarsening};
+    use memcontact::bench::{kernel_timings, Coarsening};
     let h = match args.iter().position(|a| a == "--mesh") {
         Some(k) => {
             let user = memcontact::io::gmsh::read_msh(std::path::Path::new(&args[k + 1]))
@@ -50,8 +50,9 @@ fn micro(args: &[String]) {
 /// `-- --assembly N`: times the passes of assembly on the N × N benchmark mesh (and, with
 /// `--mesh FILE` instead of N, on a Gmsh mesh renumbered as a solve would).
 fn assembly(args: &[String]) {
-    use memcontact::fem::{assemble_stiffness_and_mass, assemble_vector, unknowns_pattern};
-    use memcontact::mesh::{DofMap, VertexTriangles};
+    use memcontact::bench::{
+        assemble_stiffness_and_mass, assemble_vector, unknowns_pattern, DofMap, VertexTriangles,
+    };
     let mesh = match args.iter().position(|a| a == "--mesh") {
         Some(k) => {
             let path = std::path::Path::new(&args[k + 1]);
@@ -85,7 +86,7 @@ fn assembly(args: &[String]) {
     println!(
         "{} vertices (edge span {:.2}):   wall ms   cpu ms",
         mesh.n_vertices(),
-        memcontact::mesh::reorder::edge_span(&mesh)
+        memcontact::bench::edge_span(&mesh)
     );
     let adj = VertexTriangles::new(&mesh);
     let boundary = mesh.boundary_vertices_with(&adj);

@@ -7,11 +7,13 @@ use crate::report;
 use crate::report::print_warnings;
 use crate::solve_flags::SolveFlags;
 use anyhow::{bail, Result};
-use memcontact::outcome::{AdaptRow, Outcome};
+use memcontact::adapt::AdaptRow;
+use memcontact::adapt::{AdaptHistory, AdaptSet};
+use memcontact::outcome::Outcome;
 use memcontact::solve::{IterationRecord, Observer};
-use memcontact::write::{AdaptHistory, AdaptSet, WriteOptions};
+use memcontact::write::WriteOptions;
+use memcontact::write::{adapt_pictures, pictures, plot_options};
 use memcontact::Case;
-use memcontact_plot::write::{adapt_pictures, pictures, plot_options};
 use std::cell::RefCell;
 use std::time::Instant;
 
@@ -61,6 +63,7 @@ pub fn adapt(
         run_id: None,
         cell_data: Vec::new(),
         adapt: None,
+        unconverged: false,
     };
     // The result set begins with the first step solved: bad input found before leaves
     // nothing behind.
@@ -76,7 +79,7 @@ pub fn adapt(
             None => set.insert(AdaptSet::begin(flags.out, flags.force)?),
         };
         if keep && (outcome.report.accepted || flags.write_unconverged) {
-            let step_plots = memcontact_plot::PlotOptions {
+            let step_plots = memcontact::write::PlotOptions {
                 title: Some(format!("{label} [step {}]", row.step)),
                 ..plots.clone()
             };

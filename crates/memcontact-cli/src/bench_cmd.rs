@@ -3,8 +3,8 @@
 //! 1e-10), solved by TNNMG, with one linear Poisson multigrid solve as the yardstick.
 
 use anyhow::{bail, Result};
+use memcontact::bench::TnnmgOptions;
 use memcontact::model::Foundation;
-use memcontact::solve::multigrid::TnnmgOptions;
 use memcontact_cli::bench::proc::stolen_seconds;
 use memcontact_cli::bench::standard::{run_bench, BenchRow};
 use memcontact_cli::bench::{square_header, square_row, stolen_note};

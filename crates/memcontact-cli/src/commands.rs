@@ -5,8 +5,8 @@ use crate::report::{self, print_warnings};
 pub use crate::solve_flags::SolveFlags;
 use anyhow::{bail, Result};
 use memcontact::write::WriteOptions;
+use memcontact::write::{self, SweepWriter};
 use memcontact::{Case, Outcome};
-use memcontact_plot::write::{self, SweepWriter};
 use std::path::Path;
 use std::time::Instant;
 
@@ -26,23 +26,6 @@ pub fn solve(case_path: &Path, flags: &SolveFlags) -> Result<()> {
     if case.sensitivity.is_some() || case.fit.is_some() {
         return crate::sensitivity_cmd::solve(&label, &case, flags, progress, started);
     }
-    // Everything that needs the mesh is checked before anything is solved.
-    let outcome = memcontact::run::run_for_writing(&case, &mut progress)?;
-    progress.finish();
-    print_warnings(&outcome.discretization);
-    let accepted = outcome.report.accepted;
-    if !accepted && !flags.write_unconverged {
-        eprint!("{}", report::human(&label, &outcome, None));
-        bail!(
-            "{}; no result files were written (pass --write-unconverged to keep the \
-             iterate, marked as not accepted in summary.json){}",
-            not_converged(&outcome),
-            report::floor_note(&outcome)
-                .map(|n| format!("\n{n}"))
-                .unwrap_or_default()
-        );
-    }
-    let plots = write::plot_options(&case, &label);
     let options = WriteOptions {
         label,
         vtu: case.output.vtu,
@@ -52,30 +35,45 @@ pub fn solve(case_path: &Path, flags: &SolveFlags) -> Result<()> {
         run_id: None,
         cell_data: Vec::new(),
         adapt: None,
+        unconverged: flags.write_unconverged,
     };
-    #[cfg(feature = "alloc-trace")]
-    crate::alloc_trace::report("write started");
-    let summary = write::write_result(flags.out, &outcome, &case, &options, &plots)?;
+    // Everything that needs the mesh is checked before anything is solved.
+    let written = memcontact::run::run_to_files(&case, flags.out, &options, &mut progress)?;
+    progress.finish();
+    let outcome = &written.outcome;
+    print_warnings(&outcome.discretization);
+    let accepted = outcome.report.accepted;
+    let Some(summary) = &written.summary else {
+        eprint!("{}", report::human(&options.label, outcome, None));
+        bail!(
+            "{}; no result files were written (pass --write-unconverged to keep the \
+             iterate, marked as not accepted in summary.json){}",
+            not_converged(outcome),
+            report::floor_note(outcome)
+                .map(|n| format!("\n{n}"))
+                .unwrap_or_default()
+        );
+    };
     #[cfg(feature = "alloc-trace")]
     crate::alloc_trace::report("end of the write");
     print!(
         "{}",
-        report::human(&options.label, &outcome, Some((&summary, flags.out)))
+        report::human(&options.label, outcome, Some((summary, flags.out)))
     );
-    if let Some(note) = report::floor_note(&outcome) {
+    if let Some(note) = report::floor_note(outcome) {
         eprintln!("{note}");
     }
     if !accepted {
         bail!(
             "{}; the files in {} hold the unconverged iterate (summary.json: \"accepted\": \
              false)",
-            not_converged(&outcome),
+            not_converged(outcome),
             flags.out.display()
         );
     }
     // The process ends right after this: returning the (possibly gigabytes of) mesh
     // levels and matrices to the allocator page by page would only delay the exit.
-    std::mem::forget(outcome);
+    std::mem::forget(written);
     Ok(())
 }
 
@@ -181,22 +179,23 @@ fn not_converged(outcome: &Outcome) -> String {
         .unwrap_or_default()
 }
 
+/// `memcontact check --fragment`: a fragment of a case, checked key by key
+/// ([`Case::from_fragment_str`]).
+pub fn check_fragment(path: &Path, sets: &[String]) -> Result<()> {
+    Case::load_fragment(path, sets)?;
+    println!("fragment {}: valid", path.display());
+    Ok(())
+}
+
 /// `memcontact check`.
 pub fn check(case_path: &Path, sets: &[String]) -> Result<()> {
     let case = Case::load(case_path, sets)?;
     // Building the mesh, binding and assembling checks the data on the mesh (regions,
     // signs, NaN), everything `solve` checks before it solves; the load cases' data are
     // assembled on the mesh too, and the profile line checked against it.
-    // The memory available is read before the check's own mesh and model take theirs.
-    let (available, source) = memcontact::limits::available_memory();
-    let d = memcontact::run::discretize_as_run(&case, &mut Progress::new(Verbosity::Quiet))?;
-    memcontact::run::check_case_on_mesh(&case, d.mesh(), true)?;
-    d.check_memory(&case.settings)?;
-    if let Some(a) = &case.adapt {
-        memcontact::run::check_adapt_on_mesh(a, d.mesh())?;
-    }
-    memcontact::run::check_sensitivity_on_mesh(&case, &d)?;
-    print_warnings(&d);
+    let checked = memcontact::run::check(&case, &mut Progress::new(Verbosity::Quiet))?;
+    let d = &checked.discretization;
+    print_warnings(d);
     let mesh = d.mesh();
     println!("case {}: valid", case_path.display());
     print!(
@@ -267,7 +266,7 @@ pub fn check(case_path: &Path, sets: &[String]) -> Result<()> {
             f.max_iterations
         );
     }
-    let (method, choice) = d.auto_choice();
+    let (method, choice) = &checked.auto;
     println!(
         "  solver       {} (auto picks {}: {})",
         case.settings.method.name(),
@@ -275,9 +274,10 @@ pub fn check(case_path: &Path, sets: &[String]) -> Result<()> {
         choice.reason()
     );
     println!(
-        "  memory       about {} to solve ({} available: {source})",
-        memcontact::limits::human_bytes(d.memory_estimate(&case.settings)),
-        memcontact::limits::human_bytes(available as f64)
+        "  memory       about {} to solve ({} available: {})",
+        memcontact::limits::human_bytes(checked.memory_needed),
+        memcontact::limits::human_bytes(checked.memory_available.0 as f64),
+        checked.memory_available.1
     );
     Ok(())
 }

@@ -1,6 +1,6 @@
 //! `memcontact convergence`: arguments, progress and the tables of a convergence study
 //! (or of the rigid-limit sweep); the study itself is `memcontact::verify::study`, its
-//! files `memcontact::write::write_study` with the pictures of `memcontact_plot`.
+//! files `memcontact::write::write_study` with the pictures of `memcontact::write::study_pictures`.
 
 use crate::progress::{Progress, Verbosity};
 use anyhow::Result;
@@ -131,7 +131,7 @@ pub fn run(args: &Args) -> Result<()> {
     }
     let written =
         memcontact::write::write_study(&args.output, args.force, &case, &outcome, &mut |dir| {
-            memcontact_plot::write::study_pictures(dir, &outcome, &file_name)
+            memcontact::write::study_pictures(dir, &outcome, &file_name)
         })?;
     let mut out = String::new();
     let _ = writeln!(out, "memcontact convergence: {label}");

@@ -8,7 +8,6 @@ mod bench_cmd;
 mod commands;
 mod convergence;
 mod examples;
-mod help;
 mod plot_cmd;
 mod progress;
 mod report;
@@ -58,7 +57,7 @@ enum Command {
     /// tolerance writes nothing and exits with status 1 (see --write-unconverged). A case
     /// with [sweep] or [[load_case]] entries solves every step in turn, each from the
     /// previous answer, into a directory per step, with sweep.csv and sweep.png.
-    #[command(after_long_help = help::CASE_KEYS)]
+    #[command(after_long_help = memcontact::case::keys::reference())]
     Solve {
         /// The case file (TOML).
         case: PathBuf,
@@ -85,13 +84,18 @@ enum Command {
         write_unconverged: bool,
     },
     /// Validate a case and report its mesh, without solving.
-    #[command(after_long_help = help::CASE_KEYS)]
+    #[command(after_long_help = memcontact::case::keys::reference())]
     Check {
         /// The case file (TOML).
         case: PathBuf,
         /// Override a case key.
         #[arg(long = "set", value_name = "KEY=VALUE")]
         sets: Vec<String>,
+        /// The file is a fragment of a case (some sections or keys, as the documentation
+        /// shows them): check its keys and values on top of the fewest keys that complete
+        /// it, without a mesh.
+        #[arg(long)]
+        fragment: bool,
     },
     /// Measure the convergence of the discrete solution under uniform refinement: errors
     /// against the case's [exact] solution, rates, convergence.csv and convergence.png
@@ -202,7 +206,17 @@ fn main() -> ExitCode {
                 write_unconverged,
             },
         ),
-        Command::Check { case, sets } => commands::check(&case, &sets),
+        Command::Check {
+            case,
+            sets,
+            fragment,
+        } => {
+            if fragment {
+                commands::check_fragment(&case, &sets)
+            } else {
+                commands::check(&case, &sets)
+            }
+        }
         Command::Convergence(args) => convergence::run(&args),
         Command::Plot(args) => plot_cmd::run(&args),
         Command::Example { name, dir, force } => examples::run(name.as_deref(), &dir, force),

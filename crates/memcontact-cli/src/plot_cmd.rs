@@ -3,7 +3,7 @@
 //! (so the files are the same); on a sweep's directory, those of every step.
 
 use anyhow::{bail, Context, Result};
-use memcontact_plot::{draw_all, result, PlotKind};
+use memcontact::write::{draw_all, load_result, PlotKind};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -48,7 +48,7 @@ pub fn run(args: &Args) -> Result<()> {
 /// Redraws the pictures of one result directory.
 fn redraw(dir: &Path, args: &Args) -> Result<()> {
     let t0 = Instant::now();
-    let loaded = result::load(dir)
+    let loaded = load_result(dir)
         .with_context(|| format!("cannot read the results in {}", dir.display()))?;
     for note in &loaded.notes {
         eprintln!("note: {note}");

@@ -1,5 +1,5 @@
 //! What `memcontact solve` shows: the human summary on the terminal. The result files are
-//! the library's (`memcontact::write`), with their pictures (`memcontact_plot::write`).
+//! the library's (`memcontact::write`), with their pictures.
 
 use memcontact::mesh::{Mesh, MeshQuality};
 use memcontact::{Discretization, Outcome, Summary};
@@ -196,8 +196,8 @@ pub fn human(label: &str, outcome: &Outcome, written: Option<(&Summary, &Path)>)
         "  solver       {}{}{why}: {} iterations, J(U) = {:.12e}, {}",
         r.method.name(),
         match r.coarsening {
-            Some(memcontact::solve::multigrid::Kind::Geometric) => " on the mesh levels",
-            Some(memcontact::solve::multigrid::Kind::Algebraic) => " on algebraic levels",
+            Some(memcontact::solve::HierarchyKind::Geometric) => " on the mesh levels",
+            Some(memcontact::solve::HierarchyKind::Algebraic) => " on algebraic levels",
             None => "",
         },
         r.iterations,

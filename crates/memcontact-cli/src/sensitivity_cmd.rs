@@ -6,13 +6,9 @@ use crate::progress::Progress;
 use crate::report::{self, print_warnings};
 use crate::solve_flags::SolveFlags;
 use anyhow::{bail, Result};
-use memcontact::outcome::fields::NodalFields;
-use memcontact::outcome::SensitivityTotals;
 use memcontact::sensitivity::Sensitivities;
-use memcontact::write::{Extras, WriteOptions};
+use memcontact::write::{self, WriteOptions};
 use memcontact::{Case, Outcome};
-use memcontact_plot::write as plot_write;
-use std::path::Path;
 use std::time::Instant;
 
 /// Solves a case with `[sensitivity]` and/or `[fit]` and writes its result set.
@@ -130,7 +126,8 @@ fn fit(
     Ok(())
 }
 
-/// Writes the result set of `outcome` with the sensitivity's and the fit's files.
+/// Writes the result set of `outcome` with the sensitivity's and the fit's files
+/// ([`memcontact::write::write_sensitivity_result`]).
 fn write(
     label: &str,
     case: &Case,
@@ -140,54 +137,16 @@ fn write(
     s: Option<&Sensitivities>,
     fit: Option<&memcontact::fit::FitResult>,
 ) -> Result<memcontact::Summary> {
-    let plots = plot_write::plot_options(case, label);
+    let plots = write::plot_options(case, label);
     let options = WriteOptions {
-        label: label.to_string(),
         vtu: case.output.vtu,
         force: flags.force,
         started,
-        plot_options: serde_json::to_value(&plots).ok(),
-        run_id: None,
-        cell_data: Vec::new(),
-        adapt: None,
+        unconverged: flags.write_unconverged,
+        ..WriteOptions::new(label)
     };
-    let extras = Extras {
-        point_data: s.map(|s| s.influence.clone()).unwrap_or_default(),
-        sensitivity: s.map(SensitivityTotals::of),
-    };
-    let mesh = outcome.mesh();
-    let mut pictures = plot_write::pictures(&mesh, &plots);
-    let draw_fit = !plots.plots.is_empty();
-    let mut extra = |dir: &Path, fields: &NodalFields| -> memcontact::Result<Vec<String>> {
-        let mut names = pictures(dir, fields)?;
-        if let Some(s) = s {
-            memcontact::write::write_sensitivity_csv(
-                &dir.join(memcontact::write::SENSITIVITY_CSV),
-                s,
-            )?;
-            names.push(memcontact::write::SENSITIVITY_CSV.to_string());
-        }
-        if let Some(f) = fit {
-            memcontact::write::write_fit_json(&dir.join(memcontact::write::FIT_JSON), f)?;
-            memcontact::write::write_fit_csv(&dir.join(memcontact::write::FIT_CSV), f)?;
-            names.push(memcontact::write::FIT_JSON.to_string());
-            names.push(memcontact::write::FIT_CSV.to_string());
-            if draw_fit {
-                memcontact_plot::fit_plot(
-                    &dir.join(memcontact_plot::FIT_PICTURE),
-                    f,
-                    &mesh.points,
-                    &mesh.triangles,
-                    &format!("Fit: {label}"),
-                    &plots.units,
-                )?;
-                names.push(memcontact_plot::FIT_PICTURE.to_string());
-            }
-        }
-        Ok(names)
-    };
-    Ok(memcontact::write::write_result_set_with(
-        flags.out, outcome, case, &options, &mut extra, &extras,
+    Ok(write::write_sensitivity_result(
+        flags.out, outcome, case, &options, &plots, s, fit,
     )?)
 }
 

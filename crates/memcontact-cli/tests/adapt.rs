@@ -1,4 +1,4 @@
-//! End-to-end: `memcontact solve` on a case with `[adapt]` (the README's roof with a
+//! End-to-end: `memcontact solve` on a case with `[adapt]` (the roof with a
 //! re-entrant corner): `adapt.csv` with its exact header, the final step's result set on
 //! the final mesh with the estimator per triangle, `mesh.png`, the adaptive totals in
 //! `summary.json`, `[output] keep_steps`, and bad input refused naming the key with

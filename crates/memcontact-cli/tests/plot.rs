@@ -95,3 +95,39 @@ fn plot_redraws_a_result_directory() {
     let _ = std::fs::remove_dir_all(&dir);
     let _ = std::fs::remove_dir_all(&empty);
 }
+
+/// A membrane between two bodies: `memcontact plot` redraws the pictures `memcontact
+/// solve` drew (each body's contact drawn apart, from the body below's fields in
+/// `solution.vtu`) byte for byte.
+#[test]
+fn plot_redraws_two_bodies_byte_for_byte() {
+    let dir = tmp_in("plot", "geomembrane");
+    let case = examples().join("geomembrane.toml");
+    let o = run(&[
+        "solve",
+        case.to_str().unwrap(),
+        "-o",
+        dir.to_str().unwrap(),
+        "-q",
+        "--set",
+        "mesh.nx=24",
+        "--set",
+        "mesh.ny=24",
+    ]);
+    assert!(o.status.success(), "{}", text(&o));
+    let names = ["deflection", "pressure", "liftoff", "profile"];
+    let solved: Vec<Vec<u8>> = names
+        .iter()
+        .map(|n| std::fs::read(dir.join(format!("{n}.png"))).unwrap())
+        .collect();
+    for n in names {
+        std::fs::remove_file(dir.join(format!("{n}.png"))).unwrap();
+    }
+    let o = run(&["plot", dir.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", text(&o));
+    for (n, want) in names.iter().zip(&solved) {
+        let got = std::fs::read(dir.join(format!("{n}.png"))).unwrap();
+        assert!(&got == want, "{n}.png redrawn differs");
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}

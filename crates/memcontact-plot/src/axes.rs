@@ -252,6 +252,8 @@ pub enum Swatch {
     Hatch(bool),
     /// A disc: fill and ring colours.
     Disc(Rgb, Rgb),
+    /// Diagonal stripes of two colours (see [`stripe_color`]).
+    Stripes(Rgb, Rgb),
     /// Nothing (a line of text).
     None,
 }
@@ -297,6 +299,14 @@ pub fn legend(
                         if let Some(c) = hatch_color(px, py, slash) {
                             canvas.set(px, py, c);
                         }
+                    }
+                }
+                canvas.stroke_rect(sr, FRAME);
+            }
+            Swatch::Stripes(a, b) => {
+                for py in sr.y0..sr.y1 {
+                    for px in sr.x0..sr.x1 {
+                        canvas.set(px, py, stripe_color(px, py, a, b));
                     }
                 }
                 canvas.stroke_rect(sr, FRAME);
@@ -351,5 +361,20 @@ pub fn hatch_color(x: i32, y: i32, slash: bool) -> Option<Rgb> {
         0 => Some(HATCH_LIGHT),
         1 => Some(HATCH_DARK),
         _ => None,
+    }
+}
+
+/// Width of the stripes where the membrane is squeezed between two bodies, pixels
+/// (along x).
+pub const STRIPE_WIDTH: i32 = 6;
+
+/// The colour of pixel `(x, y)` in diagonal stripes of `a` and `b`, each
+/// [`STRIPE_WIDTH`] pixels wide along x (`a` where `⌊(x + y) / STRIPE_WIDTH⌋` is even).
+#[inline]
+pub fn stripe_color(x: i32, y: i32, a: Rgb, b: Rgb) -> Rgb {
+    if (x + y).div_euclid(STRIPE_WIDTH) % 2 == 0 {
+        a
+    } else {
+        b
     }
 }

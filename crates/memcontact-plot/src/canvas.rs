@@ -5,9 +5,8 @@
 //! segment), then composited in one colour: overlapping segments of one polyline do not
 //! darken their joints, and the result does not depend on the drawing order.
 
-use memcontact::{Error, Result};
+use crate::{Error, Result};
 use rayon::prelude::*;
-use std::path::Path;
 
 /// An RGB colour.
 pub type Rgb = [u8; 3];
@@ -179,12 +178,6 @@ impl Canvas {
             w.finish().map_err(err)?;
         }
         Ok(out)
-    }
-
-    /// Writes the canvas as a PNG file, atomically.
-    pub fn write_png(&self, path: &Path) -> Result<()> {
-        let png = self.encode_png()?;
-        memcontact::io::write_atomic(path, |w| w.write_all(&png)).map(|_| ())
     }
 }
 

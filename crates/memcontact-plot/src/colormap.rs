@@ -111,6 +111,17 @@ pub fn blues() -> &'static Colormap {
     })
 }
 
+/// A sequential green map (ColorBrewer Greens, without its near-white end): for the gap
+/// to the body below on the lift-off picture (the obstacle's gap is in [`blues`]).
+pub fn greens() -> &'static Colormap {
+    static M: OnceLock<Colormap> = OnceLock::new();
+    M.get_or_init(|| {
+        Colormap::from_knots(&hex(&[
+            "#e5f5e0", "#c7e9c0", "#a1d99b", "#74c476", "#41ab5d", "#238b45", "#006d2c", "#00441b",
+        ]))
+    })
+}
+
 /// Maps values onto `[0, 1]`: linearly over `[lo, hi]`, or, with a `center` inside, each
 /// side of the centre onto its half (`center ↦ 0.5`), so that a diverging map's middle
 /// colour marks the centre.

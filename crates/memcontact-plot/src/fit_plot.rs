@@ -1,18 +1,14 @@
-//! `fit.png`: a fit's measurements against the deflections computed at the fitted
-//! parameters (left, with the line of perfect agreement), and a map of the residuals at
-//! the sensors over the mesh's outline (right, blue below the measurement, red above,
-//! white where they agree).
+//! A fit's picture (`fit.png` of a result set): the measurements against the deflections
+//! computed at the fitted parameters (left, with the line of perfect agreement), and a map
+//! of the residuals at the sensors over the mesh's outline (right, blue below the
+//! measurement, red above, white where they agree).
 
 use crate::axes::{self, Axes, Swatch};
 use crate::canvas::{Canvas, Coverage, PixelRect, Rgb, WHITE};
 use crate::text::{self, Anchor, Style};
 use crate::Units;
-use memcontact::fit::FitResult;
-use memcontact::{Error, Result};
-use std::path::Path;
+use crate::{Error, Result};
 
-/// The file name.
-pub const FIT_PICTURE: &str = "fit.png";
 /// Width, pixels.
 pub const FIT_WIDTH: u32 = 1500;
 /// Height, pixels.
@@ -23,6 +19,34 @@ const BLUE: Rgb = [33, 102, 172];
 const RED: Rgb = [178, 24, 43];
 const MARKER: Rgb = [31, 119, 180];
 
+/// One sensor of a fit: where it is, what was measured there and what the model computes.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FitSensor {
+    /// Its position.
+    pub at: [f64; 2],
+    /// The measured deflection.
+    pub measured: f64,
+    /// The deflection computed at the fitted parameters.
+    pub computed: f64,
+}
+
+/// What a fit's picture shows, borrowed.
+#[derive(Debug, Clone, Copy)]
+pub struct FitPlot<'a> {
+    /// The title.
+    pub title: &'a str,
+    /// The last line of the legend (e.g. the fit's rms and iterations).
+    pub note: &'a str,
+    /// The mesh's vertices (its outline is drawn under the residuals).
+    pub points: &'a [[f64; 2]],
+    /// The mesh's triangles.
+    pub triangles: &'a [[u32; 3]],
+    /// The sensors.
+    pub sensors: &'a [FitSensor],
+    /// Units for the labels.
+    pub units: &'a Units,
+}
+
 /// The diverging colour of `t` in `[-1, 1]`.
 fn diverging(t: f64) -> Rgb {
     let t = t.clamp(-1.0, 1.0);
@@ -30,28 +54,27 @@ fn diverging(t: f64) -> Rgb {
     [0, 1, 2].map(|k| (WHITE[k] as f64 + s * (end[k] as f64 - WHITE[k] as f64)).round() as u8)
 }
 
-/// Draws `fit.png` into `path`: the measurements of `fit` against the computed values, and
-/// their residuals on the outline of the mesh (`points`, `triangles`), titled `title`.
-pub fn fit_plot(
-    path: &Path,
-    fit: &FitResult,
-    points: &[[f64; 2]],
-    triangles: &[[u32; 3]],
-    title: &str,
-    units: &Units,
-) -> Result<()> {
-    render_fit_plot(fit, points, triangles, title, units)?.write_png(path)
-}
-
-/// [`fit_plot`] in memory.
-pub fn render_fit_plot(
-    fit: &FitResult,
-    points: &[[f64; 2]],
-    triangles: &[[u32; 3]],
-    title: &str,
-    units: &Units,
-) -> Result<Canvas> {
-    let ms = &fit.measurements;
+/// Draws a fit's picture in memory: the measurements against the computed values, and
+/// their residuals on the outline of the mesh.
+pub fn render_fit_plot(plot: &FitPlot) -> Result<Canvas> {
+    let FitPlot {
+        title,
+        note,
+        points,
+        triangles,
+        sensors: ms,
+        units,
+    } = *plot;
+    if let Some((k, t)) = triangles
+        .iter()
+        .enumerate()
+        .find(|(_, t)| t.iter().any(|&v| v as usize >= points.len()))
+    {
+        return Err(Error::Data(format!(
+            "fit picture: triangle {k} {t:?} refers to a vertex beyond the {} vertices",
+            points.len()
+        )));
+    }
     if ms.is_empty() || triangles.is_empty() {
         return Err(Error::Data("fit picture: no measurement or no mesh".into()));
     }
@@ -114,19 +137,7 @@ pub fn render_fit_plot(
             Swatch::Dashed([120, 120, 120], 1.5),
             "computed = measured".to_string(),
         ),
-        (
-            Swatch::None,
-            format!(
-                "rms {:.3e}, {} iterations{}",
-                fit.rms,
-                fit.iterations,
-                if fit.converged {
-                    ""
-                } else {
-                    " (not converged)"
-                }
-            ),
-        ),
+        (Swatch::None, note.to_string()),
     ];
     let lw = 300;
     let box_ = PixelRect::new(ax.rect.x0 + 10, ax.rect.y0 + 10, lw, 24 * 3 + 12);
@@ -193,7 +204,7 @@ pub fn render_fit_plot(
         k = j;
     }
     canvas.composite(&outline, [80, 80, 80], 1.0);
-    let residual = |m: &memcontact::fit::Fitted| m.computed - m.measured;
+    let residual = |m: &FitSensor| m.computed - m.measured;
     let largest = ms
         .iter()
         .map(|m| residual(m).abs())

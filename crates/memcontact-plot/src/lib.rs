@@ -12,18 +12,22 @@
 //!   with the gap φ − u there;
 //! * `profile.png`: u and φ along a line against arc length, contact stretches shaded.
 //!
+//! With a body below the membrane ([`PlotData::lower`]), every picture tells the two
+//! bodies apart: each body's contact zone outlined (the obstacle's solid, the body
+//! below's dashed) and named, on the lift-off map each body's contact and each body's gap
+//! in its own colours, in the profile both surfaces and each body's contact stretches.
+//!
 //! Maps are rasterised here (every pixel centre interpolates the nodal field in the
 //! triangle that covers it, see [`raster`]), in parallel and deterministically, so that a
 //! mesh of a million vertices is drawn in a fraction of a second. Also here: the log-log
-//! convergence plot and an x-y line plot (e.g. a force-deflection curve), and a reader for
-//! the VTU files the library writes, so that pictures can be redrawn from a result
-//! directory ([`result`]), and the writers of result sets with their pictures, single
-//! solves and sweeps alike ([`write`]).
+//! convergence plot and an x-y line plot (e.g. a force-deflection curve).
 //!
-//! The crate prints nothing: errors are returned, notes are handed back to the caller.
+//! The crate only draws: it takes plain arrays (points, triangles, nodal fields) and gives
+//! back pictures in memory ([`Canvas`], PNG bytes). It knows nothing of cases, solvers or
+//! files; the `memcontact` library writes the pictures into its result sets and redraws
+//! them from a result directory. It prints nothing: errors are returned.
 
 pub mod axes;
-pub mod bodies;
 pub mod canvas;
 pub mod colormap;
 pub mod fit_plot;
@@ -32,26 +36,43 @@ pub mod loglog;
 mod maps;
 pub mod profile;
 pub mod raster;
-pub mod result;
+pub mod segment;
 pub mod text;
 pub mod ticks;
-pub mod vtu;
-pub mod write;
 
 pub use axes::{hatch_color, HATCH_SPACING};
 pub use canvas::{Canvas, PixelRect};
-pub use fit_plot::{fit_plot, FIT_PICTURE};
-pub use lines::{line_plot, LinePlot, Series};
+pub use fit_plot::{render_fit_plot, FitPlot, FitSensor, FIT_HEIGHT, FIT_WIDTH};
+pub use lines::{render_line_plot, LinePlot, Series};
 pub use loglog::loglog_plot;
 pub use maps::{
-    field_plot, mesh_plot, MapLayout, Picture, CONTACT, NOT_COVERED, OUTLINE, PRESSURE_OUTLINE,
+    field_plot, mesh_plot, MapLayout, Picture, CONTACT, LOWER_CONTACT, LOWER_OUTLINE,
+    LOWER_PRESSURE_OUTLINE, NOT_COVERED, OUTLINE, PRESSURE_OUTLINE,
 };
 pub use raster::MapTransform;
 
-use memcontact::{Error, Result};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
-use std::path::{Path, PathBuf};
+
+/// Why a picture could not be drawn: the data or options at fault, named.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Error {
+    /// Bad data or options (lengths, indices, non-finite values, an empty plot).
+    Data(String),
+}
+
+impl std::fmt::Display for Error {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Error::Data(m) => f.write_str(m),
+        }
+    }
+}
+
+impl std::error::Error for Error {}
+
+/// The result of drawing.
+pub type Result<T> = std::result::Result<T, Error>;
 
 /// Width of the map pictures (deflection, pressure, lift-off), pixels.
 pub const MAP_WIDTH: u32 = 1300;
@@ -235,6 +256,23 @@ pub struct PlotData<'a> {
     pub pressure: &'a [f64],
     /// Where the body can touch the membrane (the set M of the paper's problem 2b).
     pub covered: &'a [bool],
+    /// The body below the membrane's fields, when there is one (the membrane between two
+    /// bodies): then each picture draws each body's contact separately.
+    pub lower: Option<BodyData<'a>>,
+}
+
+/// The fields of the body below the membrane (surface φ_low, reaction pushing up where
+/// the membrane sinks into it), borrowed, one value per mesh vertex.
+#[derive(Debug, Clone, Copy)]
+pub struct BodyData<'a> {
+    /// Its surface φ_low (sampled at the vertices).
+    pub phi: &'a [f64],
+    /// Vertex state: −1 clear (u > φ_low), 0 touching (u = φ_low), 1 sunk in (u < φ_low).
+    pub state: &'a [i8],
+    /// Its contact pressure (≥ 0, pushing up).
+    pub pressure: &'a [f64],
+    /// Where it lies under the membrane and can touch it.
+    pub covered: &'a [bool],
 }
 
 impl PlotData<'_> {
@@ -244,13 +282,22 @@ impl PlotData<'_> {
         if n == 0 || self.triangles.is_empty() {
             return Err(Error::Data("plot: the mesh has no triangle to draw".into()));
         }
-        for (name, len) in [
+        let mut lengths = vec![
             ("u", self.u.len()),
             ("phi", self.phi.len()),
             ("state", self.state.len()),
             ("pressure", self.pressure.len()),
             ("covered", self.covered.len()),
-        ] {
+        ];
+        if let Some(l) = &self.lower {
+            lengths.extend([
+                ("phi_low", l.phi.len()),
+                ("state_low", l.state.len()),
+                ("pressure_low", l.pressure.len()),
+                ("covered_low", l.covered.len()),
+            ]);
+        }
+        for (name, len) in lengths {
             if len != n {
                 return Err(Error::Data(format!(
                     "plot: field `{name}` has {len} values, the mesh has {n} vertices"
@@ -282,10 +329,28 @@ impl PlotData<'_> {
                 self.state[i]
             )));
         }
+        if let Some(l) = &self.lower {
+            if let Some(i) = l.state.iter().position(|s| !(-1..=1).contains(s)) {
+                return Err(Error::Data(format!(
+                    "plot: vertex {i} has state_low {} (expected -1, 0 or 1)",
+                    l.state[i]
+                )));
+            }
+        }
         if let Some(i) = self.u.iter().position(|v| !v.is_finite()) {
             return Err(Error::Data(format!("plot: u is not finite at vertex {i}")));
         }
         Ok(())
+    }
+
+    /// True when vertex `i` is in contact with a body (touching or penetrating either).
+    pub fn in_contact(&self, i: usize) -> bool {
+        self.state[i] >= 0 || self.lower.is_some_and(|l| l.state[i] >= 0)
+    }
+
+    /// True when vertex `i` penetrates a body (u > φ, or u < φ_low).
+    pub fn penetrating(&self, i: usize) -> bool {
+        self.state[i] == 1 || self.lower.is_some_and(|l| l.state[i] == 1)
     }
 
     /// The bounding box `[xmin, xmax, ymin, ymax]` of the triangles' vertices.
@@ -346,18 +411,4 @@ pub fn render_kind(
         PlotKind::Profile => profile::render(data, options),
         k => maps::render(k, layout, data, options),
     }
-}
-
-/// Draws the pictures `options.plots` into `dir` (`deflection.png`, `pressure.png`,
-/// `liftoff.png`, `profile.png`), each written atomically; returns the files written.
-pub fn draw_all(dir: &Path, data: &PlotData, options: &PlotOptions) -> Result<Vec<PathBuf>> {
-    let pictures = render(data, options)?;
-    pictures
-        .par_iter()
-        .map(|p| {
-            let path = dir.join(p.kind.file_name());
-            p.canvas.write_png(&path)?;
-            Ok(path)
-        })
-        .collect()
 }

@@ -5,17 +5,20 @@
 //! interpolants of its fields, then draws the mesh boundary, contour lines, outlines
 //! (level ½ of the P1 interpolant of a 0/1 indicator, so that every vertex of the set lies
 //! inside its outline and every other vertex outside), labels, axes, colour bar and legend.
+//!
+//! With a body below ([`PlotData::lower`]) each body's contact zone has its own outline
+//! (the obstacle's solid, the body below's dashed), and the lift-off map shows each body's
+//! contact and gap in its own colours.
 
-use crate::axes::{self, hatch_color, Axes, Swatch};
+use crate::axes::{self, hatch_color, stripe_color, Axes, Swatch};
 use crate::canvas::{Canvas, Coverage, PixelRect, Rgb, WHITE};
 use crate::colormap::{self, Colormap, Norm};
 use crate::raster::{self, Fragments, MapTransform, EMPTY};
 use crate::text::{self, Anchor, Style};
 use crate::ticks;
-use crate::{PlotData, PlotKind, PlotOptions, Units, MAP_HEIGHT, MAP_WIDTH};
-use memcontact::{Error, Result};
+use crate::{BodyData, PlotData, PlotKind, PlotOptions, Units, MAP_HEIGHT, MAP_WIDTH};
+use crate::{Error, Result};
 use rayon::prelude::*;
-use std::path::Path;
 
 /// The area the map frame is fitted into.
 const MAP_AREA: PixelRect = PixelRect {
@@ -31,12 +34,33 @@ const BAR: PixelRect = PixelRect {
     x1: 1113,
     y1: 520,
 };
+/// The upper of two colour bars (the lift-off map's gap to the obstacle, when the gap to
+/// the body below is shown too).
+const BAR_TOP: PixelRect = PixelRect {
+    x0: 1085,
+    y0: 100,
+    x1: 1113,
+    y1: 290,
+};
+/// The lower of two colour bars (the gap to the body below).
+const BAR_BOTTOM: PixelRect = PixelRect {
+    x0: 1085,
+    y0: 350,
+    x1: 1113,
+    y1: 540,
+};
 /// Left edge and width of the right-hand column (colour bar labels, legend).
 const COLUMN: (i32, i32) = (1075, 215);
 /// Contact outline colour (deflection and lift-off maps).
 pub const OUTLINE: Rgb = [220, 20, 60];
 /// Contact outline colour on the pressure map.
 pub const PRESSURE_OUTLINE: Rgb = [0, 70, 160];
+/// Outline of the contact with the body below (deflection and lift-off maps), dashed.
+pub const LOWER_OUTLINE: Rgb = [255, 0, 255];
+/// Outline of the contact with the body below on the pressure map, dashed.
+pub const LOWER_PRESSURE_OUTLINE: Rgb = [110, 30, 160];
+/// Width of the contact outlines on the deflection map, pixels.
+const DEFLECTION_OUTLINE_WIDTH: f64 = 2.6;
 /// Fill of a penetrating vertex's marker.
 const PEN_MARK: Rgb = [255, 120, 0];
 /// Light marker colour (not the hatching's pure white).
@@ -125,11 +149,19 @@ pub struct Picture {
     pub text_boxes: Vec<PixelRect>,
     /// Vertex markers were drawn (penetrating and touching vertices of the deflection map).
     pub markers: bool,
-    /// The colour bar's range (the data range of the mapped field), if there is a bar; for
-    /// the profile, the range of u and φ along the line.
+    /// The colour bar's range (the data range of the mapped field), if there is a bar; on
+    /// the lift-off map with a body below, the range of both gaps shown (their colour bars
+    /// share it); for the profile, the range of u and the surfaces along the line.
     pub range: Option<(f64, f64)>,
     /// For the profile: its axes (arc length × value → pixels).
     pub axes: Option<Axes>,
+    /// The legend's entries, in order (as given, before any shrinking or cutting to fit).
+    pub legend: Vec<String>,
+}
+
+/// The labels of legend entries.
+pub(crate) fn legend_labels(entries: &[(Swatch, String)]) -> Vec<String> {
+    entries.iter().map(|(_, s)| s.clone()).collect()
 }
 
 /// Minimum and maximum of the finite values in `v` over the vertices where `keep` holds.
@@ -393,19 +425,47 @@ pub(crate) fn render(
         let m = level_mask(canvas, l, tris, &contact, 0.5, width, false);
         canvas.composite(&m, color, 1.0);
     };
+    // The body below's contact zone, outlined dashed.
+    let lower_contact = data.lower.map(|low| indicator(n, |i| low.state[i] >= 0));
+    let lower_outline = |canvas: &mut Canvas, color: Rgb, width: f64| {
+        if let Some(c) = &lower_contact {
+            let m = level_mask(canvas, l, tris, c, 0.5, width, true);
+            canvas.composite(&m, color, 1.0);
+        }
+    };
+    // A vertex's class for hatching and markers: 1 penetrating a body, 0 touching one,
+    // −1 clear of both.
+    let class = |i: usize| -> i8 {
+        if data.penetrating(i) {
+            1
+        } else if data.in_contact(i) {
+            0
+        } else {
+            -1
+        }
+    };
     let legend_y = BAR.y1 + 60;
     let mut markers = false;
     let bar_range;
+    let legend;
     match kind {
         PlotKind::Deflection => {
             let (lo, hi) = range(data.u, |_| true).unwrap_or((0.0, 0.0));
             bar_range = Some((lo, hi));
             let norm = Norm::linear(lo, hi);
             let map = colormap::viridis();
-            let pen = indicator(n, |i| data.state[i] == 1);
+            // Hatched: contact with either body.
+            let either_owned;
+            let either: &[f64] = if data.lower.is_some() {
+                either_owned = indicator(n, |i| data.in_contact(i));
+                &either_owned
+            } else {
+                &contact
+            };
+            let pen = indicator(n, |i| data.penetrating(i));
             fill(&mut canvas, l, |k, x, y| {
-                if f.interp(k, tris, &contact) >= 0.5 {
-                    let slash = f.interp(k, tris, &pen) >= 0.5 * f.interp(k, tris, &contact);
+                if f.interp(k, tris, either) >= 0.5 {
+                    let slash = f.interp(k, tris, &pen) >= 0.5 * f.interp(k, tris, either);
                     if let Some(c) = hatch_color(x, y, slash) {
                         return c;
                     }
@@ -414,13 +474,14 @@ pub(crate) fn render(
             });
             draw_boundary(&mut canvas, l);
             let labels = contours(&mut canvas, l, tris, data.u, (lo, hi), 8, &[]);
-            outline(&mut canvas, OUTLINE, 2.6);
+            outline(&mut canvas, OUTLINE, DEFLECTION_OUTLINE_WIDTH);
+            lower_outline(&mut canvas, LOWER_OUTLINE, DEFLECTION_OUTLINE_WIDTH);
             markers = l.markers();
             if markers {
                 for (st, fillc, ring) in [(1i8, PEN_MARK, MARK_LIGHT), (0, MARK_LIGHT, MARK_DARK)] {
                     let mut outer = Coverage::new(canvas.width, canvas.height, l.frame);
                     let mut inner = Coverage::new(canvas.width, canvas.height, l.frame);
-                    for i in (0..n).filter(|&i| data.state[i] == st) {
+                    for i in (0..n).filter(|&i| class(i) == st) {
                         outer.disc(l.pv[i], 4.4);
                         inner.disc(l.pv[i], 2.8);
                     }
@@ -438,18 +499,25 @@ pub(crate) fn render(
                 Some((map, &norm, (lo, hi), format!("u{unit}"))),
                 &mut boxes,
             );
-            let n_pen = data.state.iter().filter(|&&st| st == 1).count();
-            let n_touch = data.state.iter().filter(|&&st| st == 0).count();
-            let mut entries = vec![(
-                Swatch::Line(OUTLINE, 2.6),
-                "contact zone outline".to_string(),
-            )];
-            if n_pen > 0 {
-                entries.push((Swatch::Hatch(true), "penetrating (u > φ)".into()));
-            }
-            if n_touch > 0 {
-                entries.push((Swatch::Hatch(false), "touching (u = φ)".into()));
-            }
+            let n_pen = (0..n).filter(|&i| class(i) == 1).count();
+            let n_touch = (0..n).filter(|&i| class(i) == 0).count();
+            let mut entries = match data.lower {
+                None => vec![
+                    (
+                        Swatch::Line(OUTLINE, DEFLECTION_OUTLINE_WIDTH),
+                        "contact zone outline".to_string(),
+                    ),
+                    (Swatch::Hatch(true), "penetrating (u > φ)".into()),
+                    (Swatch::Hatch(false), "touching (u = φ)".into()),
+                ],
+                Some(low) => two_body_deflection_entries(data, &low),
+            };
+            // The hatchings that appear.
+            entries.retain(|(sw, _)| match sw {
+                Swatch::Hatch(true) => n_pen > 0,
+                Swatch::Hatch(false) => n_touch > 0,
+                _ => true,
+            });
             if markers && n_pen > 0 {
                 entries.push((
                     Swatch::Disc(PEN_MARK, MARK_LIGHT),
@@ -464,7 +532,14 @@ pub(crate) fn render(
             }
             entries.push((Swatch::Line(CONTOUR, 1.0), "contour of u".into()));
             entries.extend(range_entries("u", (lo, hi)));
-            entries.push((Swatch::None, counts(data)));
+            match data.lower {
+                None => entries.push((Swatch::None, counts(data))),
+                Some(low) => entries.extend(
+                    two_body_counts(data, &low)
+                        .into_iter()
+                        .map(|c| (Swatch::None, c)),
+                ),
+            }
             axes::legend(
                 &mut canvas,
                 COLUMN.0,
@@ -473,13 +548,28 @@ pub(crate) fn render(
                 &entries,
                 &mut boxes,
             );
+            legend = legend_labels(&entries);
         }
         PlotKind::Pressure => {
             let unit = options.units.pressure_suffix();
+            // With a body below, the pressure of whichever body presses (their sum).
+            let summed;
+            let pressure: &[f64] = match data.lower {
+                Some(low) => {
+                    summed = data
+                        .pressure
+                        .par_iter()
+                        .zip(low.pressure)
+                        .map(|(a, b)| a + b)
+                        .collect::<Vec<f64>>();
+                    &summed
+                }
+                None => data.pressure,
+            };
             let (field, map, norm, label): (Vec<f64>, &Colormap, Norm, String);
             match options.allowable_pressure {
                 Some(a) => {
-                    field = data.pressure.par_iter().map(|p| p / a).collect();
+                    field = pressure.par_iter().map(|p| p / a).collect();
                     let (lo, hi) = range(&field, |_| true).unwrap_or((0.0, 0.0));
                     // The hue changes at the allowable (ratio 1).
                     map = colormap::ratio();
@@ -487,7 +577,7 @@ pub(crate) fn render(
                     label = "pressure / allowable".into();
                 }
                 None => {
-                    field = data.pressure.to_vec();
+                    field = pressure.to_vec();
                     let (lo, hi) = range(&field, |_| true).unwrap_or((0.0, 0.0));
                     map = colormap::yellow_red();
                     norm = Norm::linear(lo, hi);
@@ -502,10 +592,19 @@ pub(crate) fn render(
             draw_boundary(&mut canvas, l);
             let labels = contours(&mut canvas, l, tris, &field, (lo, hi), 6, &[]);
             outline(&mut canvas, PRESSURE_OUTLINE, 2.0);
-            let mut entries = vec![(
-                Swatch::Line(PRESSURE_OUTLINE, 2.0),
-                "contact zone outline".to_string(),
-            )];
+            lower_outline(&mut canvas, LOWER_PRESSURE_OUTLINE, 2.0);
+            let mut entries = match data.lower {
+                None => vec![(
+                    Swatch::Line(PRESSURE_OUTLINE, 2.0),
+                    "contact zone outline".to_string(),
+                )],
+                Some(low) => body_entries(
+                    data,
+                    &low,
+                    Swatch::Line(PRESSURE_OUTLINE, 2.0),
+                    Swatch::Dashed(LOWER_PRESSURE_OUTLINE, 2.0),
+                ),
+            };
             if let Some(a) = options.allowable_pressure {
                 let m = level_mask(&canvas, l, tris, &field, 1.0, 3.0, false);
                 canvas.composite(&m, [0, 0, 0], 1.0);
@@ -518,7 +617,7 @@ pub(crate) fn render(
                         unit.replace(['[', ']'], "")
                     ),
                 ));
-                let above = data.pressure.iter().filter(|&&p| p > a).count();
+                let above = pressure.iter().filter(|&&p| p > a).count();
                 entries.push((
                     Swatch::None,
                     if above == 0 {
@@ -528,7 +627,7 @@ pub(crate) fn render(
                     },
                 ));
                 entries.extend(range_entries("ratio", (lo, hi)));
-                let (plo, phi) = range(data.pressure, |_| true).unwrap_or((0.0, 0.0));
+                let (plo, phi) = range(pressure, |_| true).unwrap_or((0.0, 0.0));
                 entries.push((
                     Swatch::None,
                     format!("pressure max {}", ticks::format_sig(phi.max(plo), 5)),
@@ -554,6 +653,12 @@ pub(crate) fn render(
                 &entries,
                 &mut boxes,
             );
+            legend = legend_labels(&entries);
+        }
+        PlotKind::Liftoff if data.lower.is_some() => {
+            let low = data.lower.expect("a body below");
+            (bar_range, legend) =
+                liftoff_two_bodies(&mut canvas, l, data, &low, options, &mut boxes);
         }
         PlotKind::Liftoff => {
             let covered = indicator(n, |i| data.covered[i]);
@@ -653,6 +758,7 @@ pub(crate) fn render(
             }
             let y = if gr.is_some() { legend_y } else { BAR.y0 };
             axes::legend(&mut canvas, COLUMN.0, y, COLUMN.1, &entries, &mut boxes);
+            legend = legend_labels(&entries);
         }
         PlotKind::Profile => unreachable!("the profile is not a map"),
     }
@@ -664,6 +770,7 @@ pub(crate) fn render(
         markers,
         range: bar_range,
         axes: None,
+        legend,
     })
 }
 
@@ -671,6 +778,317 @@ pub(crate) fn render(
 pub const CONTACT: Rgb = [244, 165, 96];
 /// Colour of the area the body cannot touch on the lift-off map.
 pub const NOT_COVERED: Rgb = [214, 214, 214];
+
+/// Colour of the contact with the body below on the lift-off map.
+pub const LOWER_CONTACT: Rgb = [180, 140, 220];
+
+/// A legend entry for the outline of each body's contact zone (of the bodies the membrane
+/// touches): `upper` for the contact with the obstacle, `lower` with the body below.
+fn body_entries(
+    data: &PlotData,
+    low: &BodyData,
+    upper: Swatch,
+    lower: Swatch,
+) -> Vec<(Swatch, String)> {
+    let mut entries = Vec::new();
+    if data.state.iter().any(|&s| s >= 0) {
+        entries.push((upper, "contact with the obstacle".to_string()));
+    }
+    if low.state.iter().any(|&s| s >= 0) {
+        entries.push((lower, "contact with the body below".to_string()));
+    }
+    entries
+}
+
+/// The deflection map's outline and hatching entries with a body below: each body's
+/// outline named, the hatchings' labels naming the conditions that occur.
+fn two_body_deflection_entries(data: &PlotData, low: &BodyData) -> Vec<(Swatch, String)> {
+    let mut entries = body_entries(
+        data,
+        low,
+        Swatch::Line(OUTLINE, DEFLECTION_OUTLINE_WIDTH),
+        Swatch::Dashed(LOWER_OUTLINE, DEFLECTION_OUTLINE_WIDTH),
+    );
+    let either = |up: bool, down: bool, a: &str, b: &str| match (up, down) {
+        (true, true) => format!("{a} or {b}"),
+        (true, false) => a.to_string(),
+        _ => b.to_string(),
+    };
+    let n = data.points.len();
+    let pen_up = data.state.contains(&1);
+    let pen_low = low.state.contains(&1);
+    let touch_up = (0..n).any(|i| data.state[i] == 0 && !data.penetrating(i));
+    let touch_low = (0..n).any(|i| low.state[i] == 0 && !data.penetrating(i));
+    entries.push((
+        Swatch::Hatch(true),
+        format!(
+            "penetrating ({})",
+            either(pen_up, pen_low, "u > φ", "u < φ_low")
+        ),
+    ));
+    entries.push((
+        Swatch::Hatch(false),
+        format!(
+            "touching ({})",
+            either(touch_up, touch_low, "u = φ", "u = φ_low")
+        ),
+    ));
+    entries
+}
+
+/// The contact counts of each body that can touch the membrane, and of the vertices
+/// squeezed between the two.
+fn two_body_counts(data: &PlotData, low: &BodyData) -> Vec<String> {
+    let count = |state: &[i8], s: i8| state.iter().filter(|&&x| x == s).count();
+    let mut lines = Vec::new();
+    if data.covered.iter().any(|&c| c) {
+        lines.push(format!(
+            "obstacle: {} penetrating, {} touching",
+            count(data.state, 1),
+            count(data.state, 0)
+        ));
+    }
+    if low.covered.iter().any(|&c| c) {
+        lines.push(format!(
+            "body below: {} penetrating, {} touching",
+            count(low.state, 1),
+            count(low.state, 0)
+        ));
+    }
+    let squeezed = (0..data.points.len())
+        .filter(|&i| data.state[i] >= 0 && low.state[i] >= 0)
+        .count();
+    if squeezed > 0 {
+        lines.push(format!("squeezed between both: {squeezed}"));
+    }
+    lines
+}
+
+/// Nodal areas |Qᵢ|/3 (as the library's contact area).
+fn nodal_areas(data: &PlotData) -> Vec<f64> {
+    let mut nodal = vec![0.0; data.points.len()];
+    for t in data.triangles {
+        let [a, b, c] = t.map(|v| data.points[v as usize]);
+        let area = 0.5 * ((b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0])).abs();
+        for &v in t {
+            nodal[v as usize] += area / 3.0;
+        }
+    }
+    nodal
+}
+
+/// The lift-off map of a membrane between two bodies: the contact with the obstacle and
+/// the contact with the body below in their own colours (stripes of both where the
+/// membrane is squeezed between them), and where the membrane is clear, the gap to the
+/// nearer of the bodies that cover the vertex (φ − u to the obstacle in blues, u − φ_low
+/// to the body below in greens, over one range, so that equal gaps are equally dark),
+/// each with its colour bar. Returns the range of the gaps shown and the legend's labels.
+fn liftoff_two_bodies(
+    canvas: &mut Canvas,
+    l: &MapLayout,
+    data: &PlotData,
+    low: &BodyData,
+    options: &PlotOptions,
+    boxes: &mut Vec<PixelRect>,
+) -> (Option<(f64, f64)>, Vec<String>) {
+    let n = data.points.len();
+    let tris = data.triangles;
+    let f = &l.frags;
+    let covered = indicator(n, |i| data.covered[i] || low.covered[i]);
+    let up = indicator(n, |i| data.state[i] >= 0);
+    let down = indicator(n, |i| low.state[i] >= 0);
+    let gap = |cov: &[bool], g: &(dyn Fn(usize) -> f64 + Sync)| -> Vec<f64> {
+        (0..n)
+            .into_par_iter()
+            .map(|i| if cov[i] { g(i) } else { f64::NAN })
+            .collect()
+    };
+    let gap_up = gap(data.covered, &|i| data.phi[i] - data.u[i]);
+    let gap_low = gap(low.covered, &|i| data.u[i] - low.phi[i]);
+    // The body whose gap a vertex shows: the nearer of those that cover it (the obstacle
+    // on a tie).
+    let nearer_low = |i: usize| low.covered[i] && (!data.covered[i] || gap_low[i] < gap_up[i]);
+    let shows_low = indicator(n, nearer_low);
+    let clear = |i: usize| data.state[i] < 0 && low.state[i] < 0;
+    let clamp = |r: Option<(f64, f64)>| r.map(|(a, b)| (a.max(0.0), b.max(0.0)));
+    let gr_up = clamp(range(&gap_up, |i| {
+        clear(i) && data.covered[i] && !nearer_low(i)
+    }));
+    let gr_low = clamp(range(&gap_low, |i| clear(i) && nearer_low(i)));
+    let shown = gr_up
+        .into_iter()
+        .chain(gr_low)
+        .reduce(|a, b| (a.0.min(b.0), a.1.max(b.1)));
+    let (glo, ghi) = shown.unwrap_or((0.0, 0.0));
+    let norm = Norm::linear(glo, ghi);
+    let (map_up, map_low) = (colormap::blues(), colormap::greens());
+    fill(canvas, l, |k, x, y| {
+        if f.interp(k, tris, &covered) < 0.5 {
+            return NOT_COVERED;
+        }
+        match (
+            f.interp(k, tris, &up) >= 0.5,
+            f.interp(k, tris, &down) >= 0.5,
+        ) {
+            (true, true) => stripe_color(x, y, CONTACT, LOWER_CONTACT),
+            (true, false) => CONTACT,
+            (false, true) => LOWER_CONTACT,
+            (false, false) => {
+                let above = || {
+                    let g = f.interp(k, tris, &gap_up);
+                    g.is_finite().then(|| map_up.at(norm.t(g)))
+                };
+                let below = || {
+                    let g = f.interp(k, tris, &gap_low);
+                    g.is_finite().then(|| map_low.at(norm.t(g)))
+                };
+                if f.interp(k, tris, &shows_low) >= 0.5 {
+                    below().or_else(above)
+                } else {
+                    above().or_else(below)
+                }
+                .unwrap_or(NOT_COVERED)
+            }
+        }
+    });
+    draw_boundary(canvas, l);
+    let some_uncovered = (0..n).any(|i| !(data.covered[i] || low.covered[i]));
+    let m = level_mask(canvas, l, tris, &covered, 0.5, 1.6, true);
+    canvas.composite(&m, [60, 60, 60], 1.0);
+    let m = level_mask(canvas, l, tris, &up, 0.5, 2.4, false);
+    canvas.composite(&m, OUTLINE, 1.0);
+    let m = level_mask(canvas, l, tris, &down, 0.5, 2.4, true);
+    canvas.composite(&m, LOWER_OUTLINE, 1.0);
+    furniture(
+        canvas,
+        l,
+        &options.units,
+        &titled("Lift-off", options),
+        None,
+        boxes,
+    );
+    let unit = options.units.length_suffix();
+    let label_up = format!("gap φ − u{unit}");
+    let label_low = format!("gap u − φ_low{unit}");
+    let bars: Vec<(PixelRect, &Colormap, &String)> = match (gr_up, gr_low) {
+        (Some(_), Some(_)) => vec![
+            (BAR_TOP, map_up, &label_up),
+            (BAR_BOTTOM, map_low, &label_low),
+        ],
+        (Some(_), None) => vec![(BAR, map_up, &label_up)],
+        (None, Some(_)) => vec![(BAR, map_low, &label_low)],
+        (None, None) => Vec::new(),
+    };
+    for &(rect, map, label) in &bars {
+        axes::colorbar(canvas, rect, map, &norm, (glo, ghi), label, COLUMN.1, boxes);
+    }
+    // Areas, as shares of the area either body covers.
+    let nodal = nodal_areas(data);
+    let area = |keep: &dyn Fn(usize) -> bool| -> f64 {
+        // (A fold from +0: an empty sum is 0, not −0.)
+        (0..n).filter(|&i| keep(i)).fold(0.0, |a, i| a + nodal[i])
+    };
+    let cov_area = area(&|i| data.covered[i] || low.covered[i]);
+    let pct = |a: f64| {
+        if cov_area > 0.0 {
+            100.0 * a / cov_area
+        } else {
+            0.0
+        }
+    };
+    let contact_up = area(&|i| data.covered[i] && data.state[i] >= 0);
+    let contact_low = area(&|i| low.covered[i] && low.state[i] >= 0);
+    let squeezed = area(&|i| data.state[i] >= 0 && low.state[i] >= 0);
+    let covered_clear = |i: usize| (data.covered[i] || low.covered[i]) && clear(i);
+    let gap_area_up = area(&|i| covered_clear(i) && !nearer_low(i));
+    let gap_area_low = area(&|i| covered_clear(i) && nearer_low(i));
+    let aunit = match &options.units.length {
+        Some(u) if !u.trim().is_empty() => format!(" {}²", u.trim()),
+        _ => String::new(),
+    };
+    let (has_up, has_low) = (
+        data.covered.iter().any(|&c| c),
+        low.covered.iter().any(|&c| c),
+    );
+    let mut entries = Vec::new();
+    if has_up {
+        entries.push((
+            Swatch::Patch(CONTACT),
+            format!("obstacle: contact {:.1} %", pct(contact_up)),
+        ));
+    }
+    if has_low {
+        entries.push((
+            Swatch::Patch(LOWER_CONTACT),
+            format!("body below: contact {:.1} %", pct(contact_low)),
+        ));
+    }
+    if squeezed > 0.0 {
+        entries.push((
+            Swatch::Stripes(CONTACT, LOWER_CONTACT),
+            format!("both: squeezed {:.1} %", pct(squeezed)),
+        ));
+    }
+    if gr_up.is_some() {
+        entries.push((
+            Swatch::Patch(map_up.at(0.6)),
+            format!("obstacle: gap {:.1} %", pct(gap_area_up)),
+        ));
+    }
+    if gr_low.is_some() {
+        entries.push((
+            Swatch::Patch(map_low.at(0.6)),
+            format!("body below: gap {:.1} %", pct(gap_area_low)),
+        ));
+    }
+    if some_uncovered {
+        entries.push((Swatch::Patch(NOT_COVERED), "no body can touch".into()));
+    }
+    if contact_up > 0.0 {
+        entries.push((Swatch::Line(OUTLINE, 2.4), "obstacle: contact edge".into()));
+    }
+    if contact_low > 0.0 {
+        entries.push((
+            Swatch::Dashed(LOWER_OUTLINE, 2.4),
+            "body below: contact edge".into(),
+        ));
+    }
+    if some_uncovered {
+        entries.push((
+            Swatch::Dashed([60, 60, 60], 1.6),
+            "edge of the bodies".into(),
+        ));
+    }
+    entries.push((
+        Swatch::None,
+        format!(
+            "lift-off area {}{aunit}",
+            ticks::format_sig(gap_area_up + gap_area_low, 4)
+        ),
+    ));
+    entries.push((
+        Swatch::None,
+        format!("covered area {}{aunit}", ticks::format_sig(cov_area, 4)),
+    ));
+    for (r, name) in [(gr_up, "gap φ − u"), (gr_low, "gap u − φ_low")] {
+        if let Some((_, hi)) = r {
+            entries.push((
+                Swatch::None,
+                format!("{name} max {}", ticks::format_sig(hi, 5)),
+            ));
+        }
+    }
+    if bars.is_empty() {
+        entries.push((Swatch::None, "no lift-off".into()));
+    }
+    let y = match bars.len() {
+        0 => BAR.y0,
+        1 => BAR.y1 + 60,
+        _ => BAR_BOTTOM.y1 + 50,
+    };
+    axes::legend(canvas, COLUMN.0, y, COLUMN.1, &entries, boxes);
+    (shown, legend_labels(&entries))
+}
 
 /// "N contact vertices (P penetrating, T touching)".
 fn counts(data: &PlotData) -> String {
@@ -688,14 +1106,7 @@ struct Areas {
 
 impl Areas {
     fn of(data: &PlotData) -> Areas {
-        let mut nodal = vec![0.0; data.points.len()];
-        for t in data.triangles {
-            let [a, b, c] = t.map(|v| data.points[v as usize]);
-            let area = 0.5 * ((b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0])).abs();
-            for &v in t {
-                nodal[v as usize] += area / 3.0;
-            }
-        }
+        let nodal = nodal_areas(data);
         let mut r = Areas {
             covered: 0.0,
             contact: 0.0,
@@ -723,23 +1134,22 @@ pub(crate) fn titled(name: &str, options: &PlotOptions) -> String {
     }
 }
 
-/// Writes a colour map of any nodal field over a triangle mesh as a
+/// Draws a colour map of any nodal field over a triangle mesh as a
 /// [`MAP_WIDTH`] × [`MAP_HEIGHT`] PNG: smooth (P1-interpolated) viridis colours, labelled
 /// contour lines, the mesh boundary, axes of equal scale and a colour bar over the data
 /// range, titled `title`. For a quick look at a field the four standard pictures do not
 /// show. Errors: `values` not one per point, a triangle referring to a missing point, no
 /// finite value.
 pub fn field_plot(
-    path: &Path,
     points: &[[f64; 2]],
     triangles: &[[u32; 3]],
     values: &[f64],
     title: &str,
-) -> Result<()> {
+) -> Result<Canvas> {
     if values.len() != points.len() {
         return Err(Error::Data(format!(
             "field plot {}: {} values for {} points",
-            path.display(),
+            title,
             values.len(),
             points.len()
         )));
@@ -751,13 +1161,13 @@ pub fn field_plot(
     {
         return Err(Error::Data(format!(
             "field plot {}: triangle {k} {t:?} refers to a missing point",
-            path.display()
+            title
         )));
     }
     let Some((lo, hi)) = range(values, |_| true) else {
         return Err(Error::Data(format!(
             "field plot {}: no finite value",
-            path.display()
+            title
         )));
     };
     if triangles.is_empty()
@@ -767,7 +1177,7 @@ pub fn field_plot(
     {
         return Err(Error::Data(format!(
             "field plot {}: the mesh has no triangle or a non-finite coordinate",
-            path.display()
+            title
         )));
     }
     let mut b = [
@@ -818,21 +1228,24 @@ pub fn field_plot(
         &entries,
         &mut boxes,
     );
-    canvas.write_png(path)
+    Ok(canvas)
 }
 
 /// The mesh picture of an adaptive run (`mesh.png`): every edge of the mesh, the
 /// boundary, and the outline of the contact zone (`contact`: per vertex, in contact with
-/// a body), titled `title`, with the vertex and triangle counts in the legend.
+/// the obstacle), titled `title`, with the vertex and triangle counts in the legend. With
+/// a body below, `contact_low` (per vertex, in contact with it): each body's contact zone
+/// lightly filled in its own colour and outlined (the body below's dashed), named.
 pub fn mesh_plot(
-    path: &Path,
     points: &[[f64; 2]],
     triangles: &[[u32; 3]],
     contact: &[bool],
+    contact_low: Option<&[bool]>,
     title: &str,
     units: &Units,
-) -> Result<()> {
+) -> Result<Canvas> {
     if contact.len() != points.len()
+        || contact_low.is_some_and(|c| c.len() != points.len())
         || triangles.is_empty()
         || points
             .iter()
@@ -844,7 +1257,7 @@ pub fn mesh_plot(
         return Err(Error::Data(format!(
             "mesh picture {}: {} contact flags, {} points, {} triangles (a triangle out of \
              range or a non-finite coordinate?)",
-            path.display(),
+            title,
             contact.len(),
             points.len(),
             triangles.len()
@@ -873,12 +1286,20 @@ pub fn mesh_plot(
     let mut boxes = Vec::new();
     // The contact zone, lightly filled, under the edges.
     let inside = indicator(points.len(), |v| contact[v]);
+    let inside_low = contact_low.map(|c| indicator(points.len(), |v| c[v]));
     let f = &l.frags;
-    fill(&mut canvas, &l, |k, _, _| {
-        if f.interp(k, triangles, &inside) > 0.5 {
-            [253, 226, 200]
-        } else {
-            [255, 255, 255]
+    const LIGHT_CONTACT: Rgb = [253, 226, 200];
+    const LIGHT_LOWER: Rgb = [232, 220, 246];
+    fill(&mut canvas, &l, |k, x, y| {
+        let up = f.interp(k, triangles, &inside) > 0.5;
+        let low = inside_low
+            .as_ref()
+            .is_some_and(|c| f.interp(k, triangles, c) > 0.5);
+        match (up, low) {
+            (true, true) => stripe_color(x, y, LIGHT_CONTACT, LIGHT_LOWER),
+            (true, false) => LIGHT_CONTACT,
+            (false, true) => LIGHT_LOWER,
+            (false, false) => [255, 255, 255],
         }
     });
     // Every inside edge once (its two triangles run along it in opposite directions);
@@ -897,16 +1318,36 @@ pub fn mesh_plot(
     draw_boundary(&mut canvas, &l);
     let outline = level_mask(&canvas, &l, triangles, &inside, 0.5, 2.2, false);
     canvas.composite(&outline, OUTLINE, 1.0);
+    if let Some(c) = &inside_low {
+        let outline = level_mask(&canvas, &l, triangles, c, 0.5, 2.2, true);
+        canvas.composite(&outline, LOWER_OUTLINE, 1.0);
+    }
     furniture(&mut canvas, &l, units, title, None, &mut boxes);
-    let entries = vec![
-        (Swatch::Line([90, 90, 90], 1.0), "mesh edges".to_string()),
-        (
+    let mut entries = vec![(Swatch::Line([90, 90, 90], 1.0), "mesh edges".to_string())];
+    match contact_low {
+        None => entries.push((
             Swatch::Line(OUTLINE, 2.2),
             "contact zone outline".to_string(),
-        ),
+        )),
+        Some(low) => {
+            if contact.iter().any(|&c| c) {
+                entries.push((
+                    Swatch::Line(OUTLINE, 2.2),
+                    "contact with the obstacle".to_string(),
+                ));
+            }
+            if low.iter().any(|&c| c) {
+                entries.push((
+                    Swatch::Dashed(LOWER_OUTLINE, 2.2),
+                    "contact with the body below".to_string(),
+                ));
+            }
+        }
+    }
+    entries.extend([
         (Swatch::None, format!("{} vertices", points.len())),
         (Swatch::None, format!("{} triangles", triangles.len())),
-    ];
+    ]);
     axes::legend(
         &mut canvas,
         COLUMN.0,
@@ -915,5 +1356,123 @@ pub fn mesh_plot(
         &entries,
         &mut boxes,
     );
-    canvas.write_png(path)
+    Ok(canvas)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::BodyData;
+
+    /// A 20 × 20 grid on the unit square (two triangles per cell).
+    fn grid() -> (Vec<[f64; 2]>, Vec<[u32; 3]>) {
+        let m = 20u32;
+        let points = (0..=m)
+            .flat_map(|j| (0..=m).map(move |i| [i as f64 / m as f64, j as f64 / m as f64]))
+            .collect();
+        let v = |i: u32, j: u32| j * (m + 1) + i;
+        let triangles = (0..m)
+            .flat_map(|j| {
+                (0..m).flat_map(move |i| {
+                    [
+                        [v(i, j), v(i + 1, j), v(i + 1, j + 1)],
+                        [v(i, j), v(i + 1, j + 1), v(i, j + 1)],
+                    ]
+                })
+            })
+            .collect();
+        (points, triangles)
+    }
+
+    #[test]
+    fn the_body_below_is_validated_and_each_body_outlined_on_the_mesh() {
+        let (points, triangles) = grid();
+        let n = points.len();
+        // u rises to the right: the obstacle touched on the right, the body below on the left.
+        let u: Vec<f64> = points.iter().map(|p| p[0] - 0.5).collect();
+        let phi = vec![0.3; n];
+        let phi_low = vec![-0.3; n];
+        let state: Vec<i8> = u.iter().map(|&u| if u > 0.3 { 1 } else { -1 }).collect();
+        let state_low: Vec<i8> = u.iter().map(|&u| if u < -0.3 { 1 } else { -1 }).collect();
+        let pressure = vec![0.0; n];
+        let covered = vec![true; n];
+        let lower = BodyData {
+            phi: &phi_low,
+            state: &state_low,
+            pressure: &pressure,
+            covered: &covered,
+        };
+        let data = PlotData {
+            points: &points,
+            triangles: &triangles,
+            u: &u,
+            phi: &phi,
+            state: &state,
+            pressure: &pressure,
+            covered: &covered,
+            lower: Some(lower),
+        };
+        data.validate().unwrap();
+        let short = &state_low[1..];
+        let e = PlotData {
+            lower: Some(BodyData {
+                state: short,
+                ..lower
+            }),
+            ..data
+        }
+        .validate()
+        .unwrap_err()
+        .to_string();
+        assert!(e.contains("state_low"), "{e}");
+        let mut bad = state_low.clone();
+        bad[3] = 2;
+        let e = PlotData {
+            lower: Some(BodyData {
+                state: &bad,
+                ..lower
+            }),
+            ..data
+        }
+        .validate()
+        .unwrap_err()
+        .to_string();
+        assert!(e.contains("vertex 3 has state_low 2"), "{e}");
+        // The mesh picture: each body's outline on its own side.
+        let up: Vec<bool> = state.iter().map(|&s| s >= 0).collect();
+        let low: Vec<bool> = state_low.iter().map(|&s| s >= 0).collect();
+        let canvas = mesh_plot(
+            &points,
+            &triangles,
+            &up,
+            Some(&low),
+            "two bodies",
+            &Units::default(),
+        )
+        .unwrap();
+        let l = MapLayout::of(&points, &triangles, [0.0, 1.0, 0.0, 1.0]);
+        let mid = (l.frame.x0 + l.frame.x1) / 2;
+        let (mut left, mut right) = ([0usize; 2], [0usize; 2]);
+        for y in l.frame.y0..l.frame.y1 {
+            for x in l.frame.x0..l.frame.x1 {
+                let c = canvas.get(x as u32, y as u32);
+                let side = if x < mid { &mut left } else { &mut right };
+                side[0] += (c == OUTLINE) as usize;
+                side[1] += (c == LOWER_OUTLINE) as usize;
+            }
+        }
+        assert!(left[0] == 0 && left[1] > 20, "{left:?}");
+        assert!(right[1] == 0 && right[0] > 20, "{right:?}");
+        // The mesh picture without a body below has no dashed outline.
+        let one = mesh_plot(
+            &points,
+            &triangles,
+            &up,
+            None,
+            "one body",
+            &Units::default(),
+        )
+        .unwrap();
+        assert!(one.rgb.chunks(3).all(|c| c != LOWER_OUTLINE));
+    }
 }

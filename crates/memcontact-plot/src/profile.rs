@@ -1,29 +1,37 @@
 //! The profile picture: u and φ along a straight line against arc length, exactly as the
 //! P1 fields vary along it (one piece per triangle crossed), contact stretches shaded,
-//! gaps where the line leaves the mesh.
+//! gaps where the line leaves the mesh. With a body below, its surface φ_low too, and
+//! each body's contact stretches in its own shade (each surface drawn where its body
+//! covers the membrane).
 
 use crate::axes::{self, Axes, Swatch};
 use crate::canvas::{Canvas, Coverage, PixelRect, Rgb};
 use crate::ticks;
+use crate::{Error, Result};
 use crate::{Picture, PlotData, PlotKind, PlotOptions, PROFILE_HEIGHT, PROFILE_WIDTH};
-use memcontact::{Error, Result};
 use rayon::prelude::*;
 
 /// Colour of u.
 const U_COLOR: Rgb = [31, 90, 180];
 /// Colour of φ.
 const PHI_COLOR: Rgb = [140, 70, 20];
-/// Shade of the contact stretches.
+/// Colour of φ_low, the surface of the body below.
+const PHI_LOW_COLOR: Rgb = [110, 40, 160];
+/// Shade of the contact stretches (with a body below: of the contact with the obstacle).
 pub const CONTACT_SHADE: Rgb = [253, 208, 162];
+/// Shade of the stretches of contact with the body below.
+pub const LOWER_SHADE: Rgb = [222, 206, 240];
 
 /// One piece of the line inside one triangle: parameters, and u, φ, contact indicator at
-/// both ends.
+/// both ends; with a body below, φ_low and its contact indicator (NaN and 0 without).
 #[derive(Debug, Clone, Copy)]
 struct Piece {
     t: [f64; 2],
     u: [f64; 2],
     phi: [f64; 2],
     c: [f64; 2],
+    phi_low: [f64; 2],
+    c_low: [f64; 2],
 }
 
 /// The profile line of `options` (default: through the middle of the bounding box,
@@ -40,6 +48,19 @@ pub fn line_of(data: &PlotData, options: &PlotOptions) -> [[f64; 2]; 2] {
 fn pieces(data: &PlotData, a: [f64; 2], b: [f64; 2]) -> Vec<Piece> {
     let d = [b[0] - a[0], b[1] - a[1]];
     let contact = |i: usize| if data.state[i] >= 0 { 1.0 } else { 0.0 };
+    // With a body below, each surface is drawn where its body covers the membrane.
+    let phi = |i: usize| match data.lower {
+        Some(_) if !data.covered[i] => f64::NAN,
+        _ => data.phi[i],
+    };
+    let phi_low = |i: usize| match data.lower {
+        Some(low) if low.covered[i] => low.phi[i],
+        _ => f64::NAN,
+    };
+    let contact_low = |i: usize| match data.lower {
+        Some(low) if low.state[i] >= 0 => 1.0,
+        _ => 0.0,
+    };
     let chunks: Vec<Vec<Piece>> = data
         .triangles
         .par_chunks(1 << 14)
@@ -47,7 +68,7 @@ fn pieces(data: &PlotData, a: [f64; 2], b: [f64; 2]) -> Vec<Piece> {
             let mut out = Vec::new();
             for t in chunk {
                 let Some(([lo, hi], ab)) =
-                    memcontact::mesh::segment::clip(t.map(|v| data.points[v as usize]), a, d)
+                    crate::segment::clip(t.map(|v| data.points[v as usize]), a, d)
                 else {
                     continue;
                 };
@@ -60,8 +81,10 @@ fn pieces(data: &PlotData, a: [f64; 2], b: [f64; 2]) -> Vec<Piece> {
                 out.push(Piece {
                     t: [lo, hi],
                     u: at(&|i| data.u[i]),
-                    phi: at(&|i| data.phi[i]),
+                    phi: at(&phi),
                     c: at(&contact),
+                    phi_low: at(&phi_low),
+                    c_low: at(&contact_low),
                 });
             }
             out
@@ -98,11 +121,15 @@ fn polylines(pieces: &[Piece], len: f64, f: impl Fn(&Piece) -> [f64; 2]) -> Vec<
     out
 }
 
-/// The stretches `[s0, s1]` where the P1 contact indicator is ≥ ½.
-fn contact_stretches(pieces: &[Piece], len: f64) -> Vec<(f64, f64)> {
+/// The stretches `[s0, s1]` where the P1 contact indicator `c` is ≥ ½.
+fn contact_stretches(
+    pieces: &[Piece],
+    len: f64,
+    c: impl Fn(&Piece) -> [f64; 2],
+) -> Vec<(f64, f64)> {
     let mut out: Vec<(f64, f64)> = Vec::new();
     for p in pieces {
-        let [c0, c1] = p.c;
+        let [c0, c1] = c(p);
         let [t0, t1] = p.t;
         let cross = |c: f64| t0 + (t1 - t0) * (0.5 - c0) / (c - c0);
         let span = match (c0 >= 0.5, c1 >= 0.5) {
@@ -135,8 +162,15 @@ pub(crate) fn render(data: &PlotData, options: &PlotOptions) -> Result<Picture> 
     }
     let u_lines = polylines(&ps, len, |p| p.u);
     let phi_lines = polylines(&ps, len, |p| p.phi);
-    let stretches = contact_stretches(&ps, len);
-    let vals = u_lines.iter().chain(&phi_lines).flatten().map(|p| p.1);
+    let phi_low_lines = polylines(&ps, len, |p| p.phi_low);
+    let stretches = contact_stretches(&ps, len, |p| p.c);
+    let lower_stretches = contact_stretches(&ps, len, |p| p.c_low);
+    let vals = u_lines
+        .iter()
+        .chain(&phi_lines)
+        .chain(&phi_low_lines)
+        .flatten()
+        .map(|p| p.1);
     let (lo, hi) = vals.fold((f64::INFINITY, f64::NEG_INFINITY), |r, v| {
         (r.0.min(v), r.1.max(v))
     });
@@ -160,9 +194,26 @@ pub(crate) fn render(data: &PlotData, options: &PlotOptions) -> Result<Picture> 
         _ => "Profile".to_string(),
     };
     axes::title(&mut canvas, &title, 30.0, &mut boxes);
-    for &(s0, s1) in &stretches {
+    let columns = |(s0, s1): (f64, f64)| {
         let x0 = ax.px(s0).round() as i32;
         let x1 = (ax.px(s1).round() as i32).max(x0 + 1);
+        (x0, x1)
+    };
+    for &s in &lower_stretches {
+        let (x0, x1) = columns(s);
+        canvas.fill_rect(
+            PixelRect {
+                x0,
+                y0: ax.rect.y0,
+                x1,
+                y1: ax.rect.y1,
+            },
+            LOWER_SHADE,
+            1.0,
+        );
+    }
+    for &(s0, s1) in &stretches {
+        let (x0, x1) = columns((s0, s1));
         canvas.fill_rect(
             PixelRect {
                 x0,
@@ -173,6 +224,23 @@ pub(crate) fn render(data: &PlotData, options: &PlotOptions) -> Result<Picture> 
             CONTACT_SHADE,
             1.0,
         );
+        // Squeezed between the bodies: the obstacle's shade above, the body below's below.
+        for &(a, b) in &lower_stretches {
+            let (a, b) = (a.max(s0), b.min(s1));
+            if a < b {
+                let (x0, x1) = columns((a, b));
+                canvas.fill_rect(
+                    PixelRect {
+                        x0,
+                        y0: (ax.rect.y0 + ax.rect.y1) / 2,
+                        x1,
+                        y1: ax.rect.y1,
+                    },
+                    LOWER_SHADE,
+                    1.0,
+                );
+            }
+        }
     }
     ax.grid(&mut canvas);
     let px = |l: &Vec<(f64, f64)>| {
@@ -185,26 +253,68 @@ pub(crate) fn render(data: &PlotData, options: &PlotOptions) -> Result<Picture> 
         m.dashed(&px(l), 2.0, 9.0, 5.0);
     }
     canvas.composite(&m, PHI_COLOR, 1.0);
+    if !phi_low_lines.is_empty() {
+        let mut m = Coverage::new(canvas.width, canvas.height, ax.rect);
+        for l in &phi_low_lines {
+            m.dashed(&px(l), 2.0, 4.0, 4.0);
+        }
+        canvas.composite(&m, PHI_LOW_COLOR, 1.0);
+    }
     let mut m = Coverage::new(canvas.width, canvas.height, ax.rect);
     for l in &u_lines {
         m.polyline(&px(l), 2.2);
     }
     canvas.composite(&m, U_COLOR, 1.0);
     let unit = options.units.length_suffix();
+    let y_label = match data.lower {
+        None => format!("u, φ{unit}"),
+        Some(_) => format!("u, φ, φ_low{unit}"),
+    };
     ax.frame(
         &mut canvas,
         &format!("arc length s{unit}"),
-        &format!("u, φ{unit}"),
+        &y_label,
         &mut boxes,
     );
     let f = |v: f64| ticks::format_sig(v, 4);
-    let mut entries = vec![
-        (Swatch::Line(U_COLOR, 2.2), "deflection u".to_string()),
-        (Swatch::Dashed(PHI_COLOR, 2.0), "obstacle φ".to_string()),
-        (Swatch::Patch(CONTACT_SHADE), "contact (u ≥ φ)".to_string()),
+    let mut entries = vec![(Swatch::Line(U_COLOR, 2.2), "deflection u".to_string())];
+    match data.lower {
+        None => entries.extend([
+            (Swatch::Dashed(PHI_COLOR, 2.0), "obstacle φ".to_string()),
+            (Swatch::Patch(CONTACT_SHADE), "contact (u ≥ φ)".to_string()),
+        ]),
+        Some(low) => {
+            let (up, down) = (
+                data.covered.iter().any(|&c| c),
+                low.covered.iter().any(|&c| c),
+            );
+            if up {
+                entries.push((Swatch::Dashed(PHI_COLOR, 2.0), "obstacle φ".to_string()));
+            }
+            if down {
+                entries.push((
+                    Swatch::Dashed(PHI_LOW_COLOR, 2.0),
+                    "body below φ_low".to_string(),
+                ));
+            }
+            if up {
+                entries.push((
+                    Swatch::Patch(CONTACT_SHADE),
+                    "contact with the obstacle".to_string(),
+                ));
+            }
+            if down {
+                entries.push((
+                    Swatch::Patch(LOWER_SHADE),
+                    "contact with the body below".to_string(),
+                ));
+            }
+        }
+    }
+    entries.extend([
         (Swatch::None, format!("from ({}, {})", f(a[0]), f(a[1]))),
         (Swatch::None, format!("to ({}, {})", f(b[0]), f(b[1]))),
-    ];
+    ]);
     let covered: f64 = ps.iter().map(|p| p.t[1] - p.t[0]).sum::<f64>();
     if covered < 1.0 - 1e-6 {
         entries.push((Swatch::None, "gaps: outside the mesh".into()));
@@ -218,13 +328,22 @@ pub(crate) fn render(data: &PlotData, options: &PlotOptions) -> Result<Picture> 
         markers: false,
         range: Some((lo, hi)),
         axes: Some(ax),
+        legend: crate::maps::legend_labels(&entries),
     })
 }
 
-/// The contact stretches `[s0, s1]` (arc length) along the profile line of `options`: for
-/// checks, and for callers that report them.
+/// The contact stretches `[s0, s1]` (arc length) along the profile line of `options` (of
+/// the contact with the obstacle): for checks, and for callers that report them.
 pub fn contact_along(data: &PlotData, options: &PlotOptions) -> Vec<(f64, f64)> {
     let [a, b] = line_of(data, options);
     let len = ((b[0] - a[0]).powi(2) + (b[1] - a[1]).powi(2)).sqrt();
-    contact_stretches(&pieces(data, a, b), len)
+    contact_stretches(&pieces(data, a, b), len, |p| p.c)
+}
+
+/// The stretches `[s0, s1]` (arc length) of contact with the body below along the profile
+/// line of `options` (none without a body below).
+pub fn lower_contact_along(data: &PlotData, options: &PlotOptions) -> Vec<(f64, f64)> {
+    let [a, b] = line_of(data, options);
+    let len = ((b[0] - a[0]).powi(2) + (b[1] - a[1]).powi(2)).sqrt();
+    contact_stretches(&pieces(data, a, b), len, |p| p.c_low)
 }

@@ -6,15 +6,15 @@ use crate::case::{case_on_mesh, PyCase};
 use crate::convert::{py_err, to_py};
 use crate::mesh::PyMesh;
 use crate::result::{vtu_format, PyResult_};
+use memcontact::adapt::AdaptRow;
+use memcontact::adapt::{AdaptHistory, AdaptSet};
 use memcontact::outcome::summary::AdaptTotals;
-use memcontact::outcome::AdaptRow;
 use memcontact::problem::{GivenMesh, MeshSource};
 use memcontact::run::run_adapt;
 use memcontact::solve::Silent;
-use memcontact::write::{AdaptHistory, AdaptSet, WriteOptions};
+use memcontact::write::WriteOptions;
+use memcontact::write::{adapt_pictures, plot_options};
 use memcontact::Case;
-use memcontact_plot::write::{adapt_pictures, plot_options};
-use numpy::PyArray1;
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
@@ -47,6 +47,7 @@ fn run_loop(case: &Case, label: &str) -> memcontact::Result<Looped> {
     let started = Instant::now();
     let run = run_adapt(case, &mut Silent, &mut |_, _, _| Ok(()))?;
     let totals = run.totals();
+    let estimator: Vec<f64> = run.indicators.iter().map(|e| e.sqrt()).collect();
     let hierarchy = run.outcome.discretization.user_hierarchy();
     let mesh = PyMesh::new_from(hierarchy);
     // The result's case is what the last step solved: the data on the final mesh.
@@ -58,7 +59,14 @@ fn run_loop(case: &Case, label: &str) -> memcontact::Result<Looped> {
         rows: run.rows,
         indicators: run.indicators,
         totals,
-        result: PyResult_::new(label.to_string(), solved, mesh, run.outcome, started),
+        result: PyResult_::with_estimator(
+            label.to_string(),
+            solved,
+            mesh,
+            run.outcome,
+            started,
+            Some(estimator),
+        ),
         message: run.error.map(|e| e.to_string()),
     })
 }
@@ -145,15 +153,15 @@ impl PyAdapt {
 
     /// The final mesh (with every step's mesh as its levels).
     #[getter]
-    fn mesh(&self) -> PyMesh {
-        self.result.get().data().mesh.clone()
+    fn mesh<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        self.result.bind(py).getattr("mesh")
     }
 
-    /// η_T of the last step, one per triangle of the final mesh (energy-norm units).
+    /// η_T of the last step, one per triangle of the final mesh (energy-norm units;
+    /// `result.estimator`, read-only).
     #[getter]
-    fn estimator<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
-        let eta: Vec<f64> = self.indicators.iter().map(|e| e.sqrt()).collect();
-        PyArray1::from_vec(py, eta)
+    fn estimator<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        self.result.bind(py).getattr("estimator")
     }
 
     /// The loop's totals as in `summary.json` (`adapt_steps`, `adapt_estimator`,
@@ -229,6 +237,7 @@ impl PyAdapt {
                 run_id: None,
                 cell_data: Vec::new(),
                 adapt: None,
+                unconverged: false,
             };
             let history = AdaptHistory {
                 rows: &self.rows,
@@ -248,6 +257,17 @@ impl PyAdapt {
         })
         .map_err(py_err)?;
         to_py(py, &summary)
+    }
+
+    /// The rows as a `pandas.DataFrame` with the columns of the CSV file (see
+    /// `memcontact._notebook.to_pandas`).
+    fn to_pandas<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyAny>> {
+        crate::convert::call_helper(slf.py(), "to_pandas", (slf,), None)
+    }
+
+    /// The notebook's summary and table of rows (HTML).
+    fn _repr_html_<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyAny>> {
+        crate::convert::call_helper(slf.py(), "adapt_html", (slf,), None)
     }
 
     fn __len__(&self) -> usize {

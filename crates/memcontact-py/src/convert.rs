@@ -46,7 +46,21 @@ fn join(key: &str, part: &str) -> String {
 /// A Python value (dicts, lists, tuples, numbers, strings, booleans, NumPy arrays and
 /// scalars, paths) as a TOML value. `key` names the value in errors.
 pub fn to_toml(obj: &Bound<'_, PyAny>, key: &str) -> PyResult<toml::Value> {
+    to_toml_at(obj, key, 0)
+}
+
+/// How deeply a case's values may nest (a case file nests three or four levels; deeper
+/// values would only exhaust the stack).
+const MAX_DEPTH: usize = 32;
+
+fn to_toml_at(obj: &Bound<'_, PyAny>, key: &str, depth: usize) -> PyResult<toml::Value> {
     let bad = |what: String| PyValueError::new_err(format!("{}{what}", prefix(key)));
+    if depth > MAX_DEPTH {
+        return Err(bad(format!(
+            "the value nests more than {MAX_DEPTH} levels of lists and dicts"
+        )));
+    }
+    let to_toml = |v: &Bound<'_, PyAny>, k: &str| to_toml_at(v, k, depth + 1);
     if obj.is_instance_of::<PyBool>() {
         return Ok(toml::Value::Boolean(obj.extract::<bool>()?));
     }
@@ -97,6 +111,13 @@ pub fn to_toml(obj: &Bound<'_, PyAny>, key: &str) -> PyResult<toml::Value> {
     if obj.hasattr("tolist")? && obj.hasattr("dtype")? {
         let plain = obj.call_method0("tolist")?;
         return to_toml(&plain, key);
+    }
+    // The case file's sections as dataclasses (`memcontact.Membrane`, ...): their dicts.
+    if obj.hasattr("__dataclass_fields__")? && obj.hasattr("to_dict")? {
+        let plain = obj.call_method0("to_dict")?;
+        if plain.is_instance_of::<PyDict>() {
+            return to_toml(&plain, key);
+        }
     }
     // Paths.
     if obj.hasattr("__fspath__")? {
@@ -200,4 +221,40 @@ pub fn interruptible<T: Send>(
             }
         }
     })
+}
+
+/// Calls `name` of the pure-Python helpers (`memcontact._notebook`: plotting, tables,
+/// meshio, pyvista, scipy), which import their optional packages when called.
+pub fn call_helper<'py>(
+    py: Python<'py>,
+    name: &str,
+    args: impl pyo3::call::PyCallArgs<'py>,
+    kwargs: Option<&Bound<'py, PyDict>>,
+) -> PyResult<Bound<'py, PyAny>> {
+    py.import("memcontact._notebook")?
+        .getattr(name)?
+        .call(args, kwargs)
+}
+
+/// A count given in Python (an int, or a NumPy integer; not a bool): a `TypeError` for
+/// another type, a `ValueError` naming `what` for a negative or too large one.
+pub fn count(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<usize> {
+    use pyo3::exceptions::PyTypeError;
+    if obj.is_instance_of::<PyBool>() || !obj.hasattr("__index__")? {
+        return Err(PyTypeError::new_err(format!(
+            "{what}: an integer is needed, got a {}",
+            obj.get_type().name()?
+        )));
+    }
+    let index = obj.call_method0("__index__")?;
+    match index.extract::<i64>() {
+        Ok(v) if v >= 0 => usize::try_from(v)
+            .map_err(|_| PyValueError::new_err(format!("{what}: {v} is too large"))),
+        Ok(v) => Err(PyValueError::new_err(format!(
+            "{what}: must not be negative, got {v}"
+        ))),
+        Err(_) => Err(PyValueError::new_err(format!(
+            "{what}: {index} is too large"
+        ))),
+    }
 }

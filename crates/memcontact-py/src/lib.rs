@@ -9,6 +9,7 @@ mod mesh;
 mod result;
 mod study;
 mod sweep;
+mod views;
 
 use case::PyCase;
 use convert::interruptible;
@@ -88,6 +89,21 @@ fn solve_on(
     })
 }
 
+/// The sections of a case file as a dict (the TOML parsed, nothing checked yet): for a
+/// case file without `[mesh]` solved on a mesh given as data.
+#[pyfunction]
+fn _case_table<'py>(py: Python<'py>, path: std::path::PathBuf) -> PyResult<Bound<'py, PyAny>> {
+    let text = memcontact::case::read_case_text(&path).map_err(convert::py_err)?;
+    let table: toml::Table = toml::from_str(&text).map_err(|e| {
+        PyValueError::new_err(format!(
+            "{}: malformed TOML: {}",
+            path.display(),
+            e.message().trim()
+        ))
+    })?;
+    convert::to_py(py, &table)
+}
+
 /// The native module.
 #[pymodule]
 fn _memcontact(m: &Bound<'_, PyModule>) -> PyResult<()> {
@@ -110,6 +126,7 @@ fn _memcontact(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(mesh::_mesh_from_state, m)?)?;
     m.add_function(wrap_pyfunction!(result::_result_from_state, m)?)?;
     m.add_function(wrap_pyfunction!(case::_toml_value, m)?)?;
+    m.add_function(wrap_pyfunction!(_case_table, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }

@@ -2,6 +2,7 @@
 //! arrays, and the generators and the Gmsh reader that make one.
 
 use crate::convert::py_err;
+use crate::views::{self, Cache};
 use memcontact::mesh::generate::{self, Diagonal, PolygonSpec, RectangleSpec};
 use memcontact::mesh::refine::{Hierarchy, Refinement};
 use memcontact::mesh::{Circle, Mesh, Point};
@@ -21,13 +22,46 @@ use std::sync::Arc;
 #[derive(Clone)]
 pub struct PyMesh {
     pub hierarchy: Arc<Hierarchy>,
+    /// The arrays handed out (read-only, made once; shared by the copies of this mesh).
+    cache: Arc<Cache<{ MeshSlot::COUNT }>>,
+}
+
+/// The cached arrays of a mesh.
+#[derive(Clone, Copy)]
+enum MeshSlot {
+    Vertices,
+    Triangles,
+    Regions,
+    Boundary,
+    BoundaryEdges,
+    BoundaryTags,
+}
+
+impl MeshSlot {
+    const COUNT: usize = 6;
 }
 
 impl PyMesh {
     pub fn new_from(hierarchy: Hierarchy) -> PyMesh {
+        PyMesh::shared(Arc::new(hierarchy))
+    }
+
+    /// A mesh of a hierarchy shared with others (results, cases).
+    pub fn shared(hierarchy: Arc<Hierarchy>) -> PyMesh {
         PyMesh {
-            hierarchy: Arc::new(hierarchy),
+            hierarchy,
+            cache: Arc::default(),
         }
+    }
+
+    /// A cached array of this mesh.
+    fn cached<'py>(
+        &self,
+        py: Python<'py>,
+        slot: MeshSlot,
+        make: impl FnOnce() -> PyResult<Bound<'py, PyAny>>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        self.cache.get(py, slot as usize, make)
     }
 
     fn finest(&self) -> &Mesh {
@@ -144,6 +178,36 @@ fn regions_array<'py>(py: Python<'py>, mesh: &Mesh) -> Bound<'py, PyArray1<i64>>
     )
 }
 
+/// Names of tags given as a dict (tag → name): tags in 0..2³², names strings.
+fn tag_names(names: &Bound<'_, PyAny>, what: &str) -> PyResult<BTreeMap<u32, String>> {
+    let dict = names.cast::<PyDict>().map_err(|_| {
+        pyo3::exceptions::PyTypeError::new_err(format!(
+            "{what} must be a dict of tags to names, got a {}",
+            names
+                .get_type()
+                .name()
+                .map(|n| n.to_string())
+                .unwrap_or_default()
+        ))
+    })?;
+    let mut out = BTreeMap::new();
+    for (k, v) in dict.iter() {
+        let tag = crate::convert::count(&k, what)
+            .ok()
+            .and_then(|t| u32::try_from(t).ok())
+            .ok_or_else(|| {
+                PyValueError::new_err(format!("{what}: the tag {k} is not an integer in 0..2^32"))
+            })?;
+        let name: String = v.extract().map_err(|_| {
+            pyo3::exceptions::PyTypeError::new_err(format!(
+                "{what}: the name of tag {tag} must be a string"
+            ))
+        })?;
+        out.insert(tag, name);
+    }
+    Ok(out)
+}
+
 /// Builds and checks a mesh from arrays (see `Mesh.__new__`).
 pub fn mesh_from_arrays(
     vertices: &PyReadonlyArray2<'_, f64>,
@@ -179,11 +243,17 @@ impl PyMesh {
         vertices: &Bound<'_, PyAny>,
         triangles: &Bound<'_, PyAny>,
         regions: Option<&Bound<'_, PyAny>>,
-        region_names: Option<BTreeMap<u32, String>>,
+        region_names: Option<&Bound<'_, PyAny>>,
         boundary_edges: Option<&Bound<'_, PyAny>>,
         boundary_tags: Option<&Bound<'_, PyAny>>,
-        boundary_names: Option<BTreeMap<u32, String>>,
+        boundary_names: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<PyMesh> {
+        let region_names = region_names
+            .map(|n| tag_names(n, "region_names"))
+            .transpose()?;
+        let boundary_names = boundary_names
+            .map(|n| tag_names(n, "boundary_names"))
+            .transpose()?;
         let np = py.import("numpy")?;
         let float64 = np.getattr("float64")?;
         let v = np.call_method1("ascontiguousarray", (vertices, &float64))?;
@@ -266,18 +336,21 @@ impl PyMesh {
     /// or the generators' sides (a new array). Boundary edges not listed form the region
     /// `default`.
     #[getter]
-    fn boundary_edges<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<i64>> {
-        let b = &self.finest().boundary;
-        let flat: Vec<i64> = b.edges.iter().flat_map(|e| e.map(i64::from)).collect();
-        let a = Array2::from_shape_vec((b.edges.len(), 2), flat).expect("k x 2");
-        PyArray2::from_owned_array(py, a)
+    fn boundary_edges<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        self.cached(py, MeshSlot::BoundaryEdges, || {
+            let b = &self.finest().boundary;
+            let flat: Vec<i64> = b.edges.iter().flat_map(|e| e.map(i64::from)).collect();
+            views::owned2(py, flat, 2)
+        })
     }
 
     /// The boundary region tag of every edge of `boundary_edges`, shape (k,), int64.
     #[getter]
-    fn boundary_tags<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<i64>> {
-        let b = &self.finest().boundary;
-        PyArray1::from_owned_array(py, Array1::from_iter(b.tags.iter().map(|&t| i64::from(t))))
+    fn boundary_tags<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        self.cached(py, MeshSlot::BoundaryTags, || {
+            let b = &self.finest().boundary;
+            views::owned1(py, b.tags.iter().map(|&t| i64::from(t)).collect())
+        })
     }
 
     /// The names of the boundary region tags (the keys of `[boundary]` tables and
@@ -287,22 +360,37 @@ impl PyMesh {
         self.finest().boundary.names.clone()
     }
 
-    /// Vertex coordinates, shape (n, 2), float64 (a new array).
+    /// Vertex coordinates, shape (n, 2), float64 (a read-only view of the mesh's own
+    /// coordinates).
     #[getter]
-    fn vertices<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
-        vertices_array(py, self.finest())
+    fn vertices<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        self.cached(py, MeshSlot::Vertices, || {
+            let points = &self.finest().points;
+            // SAFETY: `[f64; 2]` is two f64 with no padding; the points live in the shared
+            // hierarchy, which the owner keeps alive and nobody mutates (it is behind an
+            // `Arc` that the owner shares, so never uniquely owned while the view lives).
+            let flat = unsafe {
+                std::slice::from_raw_parts(points.as_ptr().cast::<f64>(), 2 * points.len())
+            };
+            let owner = views::owner(py, self.hierarchy.clone())?;
+            unsafe { views::view2(flat, 2, &owner) }
+        })
     }
 
-    /// Triangles as vertex indices, shape (m, 3), int64, counter-clockwise (a new array).
+    /// Triangles as vertex indices, shape (m, 3), int64, counter-clockwise (read-only).
     #[getter]
-    fn triangles<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<i64>> {
-        triangles_array(py, self.finest())
+    fn triangles<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        self.cached(py, MeshSlot::Triangles, || {
+            views::read_only(triangles_array(py, self.finest()).into_any())
+        })
     }
 
-    /// The region tag of every triangle, shape (m,), int64 (a new array).
+    /// The region tag of every triangle, shape (m,), int64 (read-only).
     #[getter]
-    fn regions<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<i64>> {
-        regions_array(py, self.finest())
+    fn regions<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        self.cached(py, MeshSlot::Regions, || {
+            views::read_only(regions_array(py, self.finest()).into_any())
+        })
     }
 
     /// The names of the region tags that have one.
@@ -313,8 +401,10 @@ impl PyMesh {
 
     /// Whether each vertex lies on the boundary (where u = 0), shape (n,), bool.
     #[getter]
-    fn boundary<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<bool>> {
-        PyArray1::from_vec(py, self.finest().boundary_vertices())
+    fn boundary<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        self.cached(py, MeshSlot::Boundary, || {
+            views::owned1(py, self.finest().boundary_vertices())
+        })
     }
 
     /// The number of vertices.
@@ -353,8 +443,12 @@ impl PyMesh {
     /// The mesh refined uniformly `times` times (each triangle into four; new boundary
     /// vertices of a disc are moved onto its circle). The levels are kept, so a solve on
     /// the refined mesh can use multigrid.
-    #[pyo3(signature = (times=1))]
-    fn refine(&self, py: Python<'_>, times: usize) -> PyResult<PyMesh> {
+    #[pyo3(signature = (times=None), text_signature = "($self, times=1)")]
+    fn refine(&self, py: Python<'_>, times: Option<&Bound<'_, PyAny>>) -> PyResult<PyMesh> {
+        let times = match times {
+            Some(t) => crate::convert::count(t, "refine: times")?,
+            None => 1,
+        };
         if times > memcontact::problem::MAX_REFINE {
             return Err(PyValueError::new_err(format!(
                 "refine: {times} refinements is too many (at most {}: each multiplies the \
@@ -375,6 +469,62 @@ impl PyMesh {
         let mut h = (*self.hierarchy).clone();
         crate::convert::detached(py, || h.refine(times));
         Ok(PyMesh::new_from(h))
+    }
+
+    /// Draws the mesh with matplotlib: edges, regions and named boundary regions.
+    ///
+    /// Parameters
+    /// ----------
+    /// ax : matplotlib.axes.Axes, optional
+    ///     Where to draw (default: a new figure).
+    /// **kwargs
+    ///     `regions=False`, `boundary=False`, `title`; the rest goes to `Axes.triplot`.
+    ///
+    /// Returns
+    /// -------
+    /// matplotlib.axes.Axes
+    ///
+    /// Raises
+    /// ------
+    /// ImportError
+    ///     matplotlib is not installed.
+    #[pyo3(signature = (ax=None, **kwargs))]
+    fn plot<'py>(
+        slf: &Bound<'py, Self>,
+        ax: Option<&Bound<'py, PyAny>>,
+        kwargs: Option<&Bound<'py, PyDict>>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        crate::convert::call_helper(slf.py(), "mesh_plot", (slf, ax), kwargs)
+    }
+
+    /// A mesh from a `meshio.Mesh`: its 3-node triangles (unused points dropped), Gmsh
+    /// physical surfaces as named regions and physical curves on the boundary as boundary
+    /// regions (lines inside the mesh skipped with a warning).
+    ///
+    /// Parameters
+    /// ----------
+    /// mesh : meshio.Mesh
+    /// regions : str, optional
+    ///     The cell data of the region tags (default `gmsh:physical`, else `region`).
+    ///
+    /// Returns
+    /// -------
+    /// Mesh
+    ///
+    /// Raises
+    /// ------
+    /// ValueError
+    ///     Other cells than triangles, lines and vertices, a mesh not plane or not valid.
+    /// TypeError
+    ///     Not a meshio mesh.
+    #[staticmethod]
+    #[pyo3(signature = (mesh, regions=None))]
+    fn from_meshio<'py>(
+        py: Python<'py>,
+        mesh: &Bound<'py, PyAny>,
+        regions: Option<&str>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        crate::convert::call_helper(py, "mesh_from_meshio", (mesh, regions), None)
     }
 
     fn __repr__(&self) -> String {

@@ -4,19 +4,22 @@
 use crate::case::PyCase;
 use crate::convert::{py_err, to_py};
 use crate::mesh::{hierarchy_from_state, mesh_state, PyMesh};
+use crate::views::{self, Cache};
 use memcontact::case::VtuFormat;
-use memcontact::certificate::Certificate;
 use memcontact::discretization::Phase;
 use memcontact::outcome::fields::{LowerFields, NodalFields};
+use memcontact::outcome::{SparseRows, System, SystemBody};
 use memcontact::run::step_discretization;
+use memcontact::solve::Certificate;
 use memcontact::solve::{Choice, Fallback, IterationRecord, Multipliers, Silent};
+use memcontact::write::PlotKind;
 use memcontact::write::{input_hash, new_run_id, WriteOptions};
+use memcontact::write::{plot_options, write_result};
 use memcontact::{Case, Discretization, Method, Outcome, Report, Status, Summary};
-use memcontact_plot::write::{plot_options, write_result};
 use numpy::{PyArray1, PyReadonlyArray1};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
-use pyo3::types::{PyDict, PyTuple};
+use pyo3::types::{PyBytes, PyDict, PyTuple};
 use serde::{Deserialize, Serialize};
 use std::path::PathBuf;
 use std::sync::{Arc, Mutex};
@@ -43,6 +46,8 @@ pub struct ResultData {
     /// For a step of a sweep or a load case: its index among the case's steps (the model
     /// is the step's, not the base case's).
     pub step: Option<usize>,
+    /// For the last step of an adaptive loop: η_T per triangle (energy-norm units).
+    pub estimator: Option<Vec<f64>>,
 }
 
 /// The result of a solve: the vertex fields as NumPy arrays, the status, the report and
@@ -53,6 +58,31 @@ pub struct PyResult_ {
     data: Arc<ResultData>,
     /// The discretisation and report, kept for `write` (rebuilt after unpickling).
     outcome: Mutex<Option<Arc<Outcome>>>,
+    /// The arrays and the mesh handed out (made once, read-only).
+    cache: Cache<{ Slot::COUNT }>,
+}
+
+/// What a result hands out once and caches.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Slot {
+    U,
+    Phi,
+    Penetration,
+    Pressure,
+    ContactForce,
+    State,
+    PhiLow,
+    PenetrationLow,
+    PressureLow,
+    ContactForceLow,
+    StateLow,
+    Estimator,
+    Mesh,
+    Png,
+}
+
+impl Slot {
+    const COUNT: usize = 14;
 }
 
 impl PyResult_ {
@@ -64,11 +94,26 @@ impl PyResult_ {
         outcome: Outcome,
         started: Instant,
     ) -> PyResult_ {
+        Self::with_estimator(label, case, mesh, outcome, started, None)
+    }
+
+    /// [`PyResult_::new`] with the error estimator η_T per triangle (an adaptive loop's
+    /// last step).
+    pub fn with_estimator(
+        label: String,
+        case: Case,
+        mesh: PyMesh,
+        outcome: Outcome,
+        started: Instant,
+        estimator: Option<Vec<f64>>,
+    ) -> PyResult_ {
         let seconds = started.elapsed().as_secs_f64();
-        let data = Self::data_of(label, case, mesh, &outcome, seconds, None);
+        let mut data = Self::data_of(label, case, mesh, &outcome, seconds, None);
+        data.estimator = estimator;
         PyResult_ {
             data: Arc::new(data),
             outcome: Mutex::new(Some(Arc::new(outcome))),
+            cache: Cache::default(),
         }
     }
 
@@ -93,6 +138,7 @@ impl PyResult_ {
                 Some(index),
             )),
             outcome: Mutex::new(None),
+            cache: Cache::default(),
         }
     }
 
@@ -127,6 +173,7 @@ impl PyResult_ {
             warnings: outcome.discretization.warnings.clone(),
             seconds,
             step,
+            estimator: None,
         }
     }
 
@@ -159,6 +206,94 @@ impl PyResult_ {
     fn f64_array<'py>(py: Python<'py>, v: &[f64]) -> Bound<'py, PyArray1<f64>> {
         PyArray1::from_slice(py, v)
     }
+
+    /// The read-only view of a vector of this result's data, made once: `pick` chooses
+    /// the vector (None: the result has no such field).
+    fn view<'py, T: numpy::Element>(
+        &self,
+        py: Python<'py>,
+        slot: Slot,
+        pick: impl Fn(&ResultData) -> Option<&[T]>,
+    ) -> PyResult<Option<Bound<'py, PyAny>>> {
+        if pick(&self.data).is_none() {
+            return Ok(None);
+        }
+        self.cache
+            .get(py, slot as usize, || {
+                let data = pick(&self.data).expect("checked above");
+                let owner = views::owner(py, self.data.clone())?;
+                // SAFETY: the vector belongs to the immutable `ResultData` behind the `Arc`
+                // the owner holds: it neither moves nor changes while the owner lives.
+                unsafe { views::view1(data, &owner) }
+            })
+            .map(Some)
+    }
+
+    /// [`PyResult_::view`] of a field every result has.
+    fn field<'py, T: numpy::Element>(
+        &self,
+        py: Python<'py>,
+        slot: Slot,
+        pick: impl Fn(&ResultData) -> &[T],
+    ) -> PyResult<Bound<'py, PyAny>> {
+        Ok(self
+            .view(py, slot, |d| Some(pick(d)))?
+            .expect("every result has the field"))
+    }
+
+    /// The deflection picture (`deflection.png` of the result set) as PNG bytes, drawn in
+    /// memory.
+    fn deflection_png(&self) -> memcontact::Result<Vec<u8>> {
+        let d = &self.data;
+        let options = plot_options(&d.case, &d.label);
+        memcontact::write::render_png(
+            d.mesh.hierarchy.finest(),
+            &d.fields,
+            &options,
+            PlotKind::Deflection,
+        )
+    }
+}
+
+/// The assembled system of an outcome as Python values: arrays over the unknowns and the
+/// compressed rows of its matrices (`memcontact._notebook.matrices` makes them
+/// scipy.sparse matrices).
+fn system_parts<'py>(py: Python<'py>, s: &System) -> PyResult<Bound<'py, PyDict>> {
+    let rows = |m: &SparseRows| -> PyResult<Bound<'py, PyTuple>> {
+        let ptr: Vec<i64> = m.row_ptr.iter().map(|&x| x as i64).collect();
+        let col: Vec<i64> = m.col.iter().map(|&x| i64::from(x)).collect();
+        PyTuple::new(
+            py,
+            [
+                PyArray1::from_vec(py, ptr).into_any(),
+                PyArray1::from_vec(py, col).into_any(),
+                PyArray1::from_slice(py, &m.val).into_any(),
+            ],
+        )
+    };
+    let body = |b: &SystemBody| -> PyResult<Bound<'py, PyDict>> {
+        let d = PyDict::new(py);
+        match &b.l {
+            Some(l) => d.set_item("L", rows(l)?)?,
+            None => d.set_item("L", py.None())?,
+        }
+        d.set_item("lumped", b.lumped)?;
+        d.set_item("phi", PyArray1::from_slice(py, &b.phi))?;
+        d.set_item("can_touch", PyArray1::from_slice(py, &b.can_touch))?;
+        d.set_item("rigid", PyArray1::from_slice(py, &b.rigid))?;
+        Ok(d)
+    };
+    let d = PyDict::new(py);
+    let unknowns: Vec<i64> = s.unknowns.iter().map(|&v| i64::from(v)).collect();
+    d.set_item("unknowns", PyArray1::from_vec(py, unknowns))?;
+    d.set_item("S", rows(&s.s)?)?;
+    d.set_item("D", PyArray1::from_slice(py, &s.d))?;
+    d.set_item("obstacle", body(&s.obstacle)?)?;
+    match &s.lower {
+        Some(b) => d.set_item("lower", body(b)?)?,
+        None => d.set_item("lower", py.None())?,
+    }
+    Ok(d)
 }
 
 /// The serialisable form of a [`Report`] (for pickling).
@@ -169,7 +304,7 @@ struct ReportState {
     requested: Method,
     method: Method,
     #[serde(default)]
-    coarsening: Option<memcontact::solve::multigrid::Kind>,
+    coarsening: Option<memcontact::solve::HierarchyKind>,
     choice: Choice,
     fallback: Option<Fallback>,
     message: Option<String>,
@@ -219,74 +354,86 @@ const LOWER_NAMES: [&str; 4] = [
 impl PyResult_ {
     /// The deflection u at every vertex (u = 0 on the boundary), in the mesh's vertex order.
     #[getter]
-    fn u<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
-        Self::f64_array(py, &self.data.fields.u)
+    fn u<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        self.field(py, Slot::U, |d| &d.fields.u)
     }
 
     /// The sampled obstacle surface φₙ at every vertex.
     #[getter]
-    fn phi<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
-        Self::f64_array(py, &self.data.fields.phi)
+    fn phi<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        self.field(py, Slot::Phi, |d| &d.fields.phi)
     }
 
     /// The penetration (u − φ)⁺ at every vertex (0 where the obstacle cannot touch).
     #[getter]
-    fn penetration<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
-        Self::f64_array(py, &self.data.fields.penetration)
+    fn penetration<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        self.field(py, Slot::Penetration, |d| &d.fields.penetration)
     }
 
     /// The contact pressure h (u − φ)⁺ (rigid obstacle: contact force per nodal area).
     #[getter]
-    fn pressure<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
-        Self::f64_array(py, &self.data.fields.pressure)
+    fn pressure<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        self.field(py, Slot::Pressure, |d| &d.fields.pressure)
     }
 
     /// The nodal contact force X₁ = D − SU on M (0 elsewhere).
     #[getter]
-    fn contact_force<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
-        Self::f64_array(py, &self.data.fields.contact_force)
+    fn contact_force<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        self.field(py, Slot::ContactForce, |d| &d.fields.contact_force)
     }
 
     /// The vertex state: −1 clear, 0 touching (U = φ), 1 penetrating (int8).
     #[getter]
-    fn state<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<i8>> {
-        PyArray1::from_slice(py, &self.data.fields.state)
+    fn state<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        self.field(py, Slot::State, |d| &d.fields.state)
     }
 
     /// The body below's sampled surface φ_low at every vertex (`None` without one).
     #[getter]
-    fn phi_low<'py>(&self, py: Python<'py>) -> Option<Bound<'py, PyArray1<f64>>> {
-        let l = self.data.fields.lower.as_ref()?;
-        Some(Self::f64_array(py, &l.phi))
+    fn phi_low<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyAny>>> {
+        self.view(py, Slot::PhiLow, |d| {
+            d.fields.lower.as_ref().map(|l| l.phi.as_slice())
+        })
     }
 
     /// The penetration into the body below (φ_low − u)⁺ (`None` without one).
     #[getter]
-    fn penetration_low<'py>(&self, py: Python<'py>) -> Option<Bound<'py, PyArray1<f64>>> {
-        let l = self.data.fields.lower.as_ref()?;
-        Some(Self::f64_array(py, &l.penetration))
+    fn penetration_low<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyAny>>> {
+        self.view(py, Slot::PenetrationLow, |d| {
+            d.fields.lower.as_ref().map(|l| l.penetration.as_slice())
+        })
     }
 
     /// The body below's contact pressure (pushing up; `None` without one).
     #[getter]
-    fn pressure_low<'py>(&self, py: Python<'py>) -> Option<Bound<'py, PyArray1<f64>>> {
-        let l = self.data.fields.lower.as_ref()?;
-        Some(Self::f64_array(py, &l.pressure))
+    fn pressure_low<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyAny>>> {
+        self.view(py, Slot::PressureLow, |d| {
+            d.fields.lower.as_ref().map(|l| l.pressure.as_slice())
+        })
     }
 
     /// The body below's nodal contact force (pushing up; `None` without one).
     #[getter]
-    fn contact_force_low<'py>(&self, py: Python<'py>) -> Option<Bound<'py, PyArray1<f64>>> {
-        let l = self.data.fields.lower.as_ref()?;
-        Some(Self::f64_array(py, &l.contact_force))
+    fn contact_force_low<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyAny>>> {
+        self.view(py, Slot::ContactForceLow, |d| {
+            d.fields.lower.as_ref().map(|l| l.contact_force.as_slice())
+        })
     }
 
     /// The state toward the body below: −1 clear, 0 touching (U = φ_low), 1 sunk into it
     /// (int8; `None` without a body below).
     #[getter]
-    fn state_low<'py>(&self, py: Python<'py>) -> Option<Bound<'py, PyArray1<i8>>> {
-        let l = self.data.fields.lower.as_ref()?;
-        Some(PyArray1::from_slice(py, &l.state))
+    fn state_low<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyAny>>> {
+        self.view(py, Slot::StateLow, |d| {
+            d.fields.lower.as_ref().map(|l| l.state.as_slice())
+        })
+    }
+
+    /// For the last step of an adaptive loop: the error estimator η_T, one value per
+    /// triangle of the mesh (energy-norm units); None for other results.
+    #[getter]
+    fn estimator<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyAny>>> {
+        self.view(py, Slot::Estimator, |d| d.estimator.as_deref())
     }
 
     /// How the solve ended: "converged", "rounding_floor", "iteration_limit", "stalled"
@@ -354,8 +501,10 @@ impl PyResult_ {
 
     /// The solved mesh.
     #[getter]
-    fn mesh(&self) -> PyMesh {
-        self.data.mesh.clone()
+    fn mesh<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        self.cache.get(py, Slot::Mesh as usize, || {
+            Ok(Bound::new(py, self.data.mesh.clone())?.into_any())
+        })
     }
 
     /// The case solved.
@@ -412,11 +561,120 @@ impl PyResult_ {
                 run_id: None,
                 cell_data: Vec::new(),
                 adapt: None,
+                unconverged: false,
             };
             write_result(&directory, &outcome, &self.data.case, &options, &plots)
         })
         .map_err(py_err)?;
         to_py(py, &summary)
+    }
+
+    /// The assembled discrete problem over the unknowns (SPEC §2, §5), for scipy.
+    ///
+    /// Unknown `k` is vertex `unknowns[k]` (increasing): `U = result.u[m["unknowns"]]`.
+    /// U minimises `½ VᵀSV − VᵀD + ½ pᵀLp` (`p = (V − φ)⁺`; with a body below
+    /// `+ ½ qᵀ L_low q`, `q = (φ_low − V)⁺`).
+    ///
+    /// Returns
+    /// -------
+    /// dict
+    ///     `S` and `L` (scipy.sparse.csr_array; L the consistent foundation matrix or the
+    ///     lumped diagonal; None for a rigid obstacle, whose condition is U ≤ φ), `D`
+    ///     (the load minus the lifting of the boundary heights), `phi`, `unknowns`,
+    ///     `can_touch` (M), `rigid`, `foundation`; with a body below `L_low`, `phi_low`,
+    ///     `can_touch_low`, `rigid_low`, `foundation_low`.
+    ///
+    /// Raises
+    /// ------
+    /// ImportError
+    ///     scipy is not installed.
+    fn matrices<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyAny>> {
+        let py = slf.py();
+        let this = slf.get();
+        let system = crate::convert::detached(py, || this.outcome()?.system()).map_err(py_err)?;
+        let parts = system_parts(py, &system)?;
+        crate::convert::call_helper(py, "matrices", (parts,), None)
+    }
+
+    /// Draws a field on the mesh with matplotlib, each body's contact outlined (the
+    /// obstacle's solid black, the body below's dashed red), with a colour bar.
+    ///
+    /// Parameters
+    /// ----------
+    /// field : str or array_like
+    ///     `u` (default), `phi`, `penetration`, `pressure`, `contact_force`, `state`,
+    ///     `gap` (φ − u), with a body below the `_low` fields and `gap_low` (u − φ_low),
+    ///     the cell fields `region` and `estimator`; or one value per vertex or triangle.
+    /// ax : matplotlib.axes.Axes, optional
+    ///     Where to draw (default: a new figure).
+    /// **kwargs
+    ///     `kind` ("tripcolor" or "tricontourf"), `levels`, `contact`, `colorbar`,
+    ///     `title`; the rest goes to matplotlib (`cmap`, `vmin`, ...).
+    ///
+    /// Returns
+    /// -------
+    /// matplotlib.axes.Axes
+    ///
+    /// Raises
+    /// ------
+    /// ValueError, TypeError
+    ///     An unknown field or an array of the wrong size or type.
+    /// ImportError
+    ///     matplotlib is not installed.
+    #[pyo3(
+        signature = (field=None, ax=None, **kwargs),
+        text_signature = "($self, field='u', ax=None, **kwargs)"
+    )]
+    fn plot<'py>(
+        slf: &Bound<'py, Self>,
+        field: Option<&Bound<'py, PyAny>>,
+        ax: Option<&Bound<'py, PyAny>>,
+        kwargs: Option<&Bound<'py, PyDict>>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        crate::convert::call_helper(slf.py(), "result_plot", (slf, field, ax), kwargs)
+    }
+
+    /// The result as a `meshio.Mesh`: points (z = 0), triangles, every point field of
+    /// `nodes.csv` and the cell fields `region` (and `estimator`), as copies.
+    ///
+    /// Returns
+    /// -------
+    /// meshio.Mesh
+    ///
+    /// Raises
+    /// ------
+    /// ImportError
+    ///     meshio is not installed.
+    fn to_meshio<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyAny>> {
+        crate::convert::call_helper(slf.py(), "result_to_meshio", (slf,), None)
+    }
+
+    /// The result as a `pyvista.UnstructuredGrid` with every point and cell field.
+    ///
+    /// Returns
+    /// -------
+    /// pyvista.UnstructuredGrid
+    ///
+    /// Raises
+    /// ------
+    /// ImportError
+    ///     pyvista is not installed.
+    fn to_pyvista<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyAny>> {
+        crate::convert::call_helper(slf.py(), "result_to_pyvista", (slf,), None)
+    }
+
+    /// The notebook's summary table (HTML).
+    fn _repr_html_<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyAny>> {
+        crate::convert::call_helper(slf.py(), "result_html", (slf,), None)
+    }
+
+    /// The deflection picture of the result set (`deflection.png`), drawn in memory once,
+    /// as PNG bytes (IPython asks for it at every display of the result).
+    fn _repr_png_<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        self.cache.get(py, Slot::Png as usize, || {
+            let png = crate::convert::detached(py, || self.deflection_png()).map_err(py_err)?;
+            Ok(PyBytes::new(py, &png).into_any())
+        })
     }
 
     fn __repr__(&self) -> String {
@@ -497,6 +755,9 @@ impl PyResult_ {
                 state.set_item("x1_low", Self::f64_array(py, &m.x1_low))?;
                 state.set_item("x2_low", Self::f64_array(py, &m.x2_low))?;
             }
+        }
+        if let Some(eta) = &d.estimator {
+            state.set_item("estimator", Self::f64_array(py, eta))?;
         }
         state.set_item("mesh", mesh_state(py, &d.mesh.hierarchy)?)?;
         let rebuild = py
@@ -616,7 +877,12 @@ pub fn _result_from_state(state: &Bound<'_, PyDict>) -> PyResult<PyResult_> {
             warnings: meta.warnings,
             seconds: meta.seconds,
             step: meta.step,
+            estimator: match state.get_item("estimator")? {
+                Some(_) => Some(vec("estimator")?),
+                None => None,
+            },
         }),
         outcome: Mutex::new(None),
+        cache: Cache::default(),
     })
 }

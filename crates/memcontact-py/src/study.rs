@@ -161,13 +161,43 @@ impl PyStudy {
         crate::convert::detached(py, || {
             write_study(&directory, force, &self.case, &self.outcome, &mut |dir| {
                 if pictures {
-                    memcontact_plot::write::study_pictures(dir, &self.outcome, &file_name)
+                    memcontact::write::study_pictures(dir, &self.outcome, &file_name)
                 } else {
                     Ok(Vec::new())
                 }
             })
         })
         .map_err(py_err)
+    }
+
+    /// The columns of `convergence.csv` (or `h_sweep.csv`), in order.
+    #[getter]
+    fn columns(&self) -> Vec<&'static str> {
+        let names = |c: Vec<(&'static str, StudyColumn)>| c.into_iter().map(|(n, _)| n).collect();
+        match &self.outcome.result {
+            StudyResult::Convergence(studies) => names(convergence_columns(&studies[0].1)),
+            StudyResult::RigidLimit {
+                sweep,
+                exact_distance,
+                ..
+            } => names(h_sweep_columns(&sweep.rows, exact_distance)),
+        }
+    }
+
+    /// The rows of one CSV file (`variant`: a file name of `variants`; default the
+    /// first, the file of `rows`) as a `pandas.DataFrame` with its columns (see
+    /// `memcontact._notebook.to_pandas`).
+    #[pyo3(signature = (variant=None))]
+    fn to_pandas<'py>(
+        slf: &Bound<'py, Self>,
+        variant: Option<&str>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        crate::convert::call_helper(slf.py(), "to_pandas", (slf, variant), None)
+    }
+
+    /// The notebook's summary and table of rows (HTML).
+    fn _repr_html_<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyAny>> {
+        crate::convert::call_helper(slf.py(), "study_html", (slf,), None)
     }
 
     fn __len__(&self) -> usize {

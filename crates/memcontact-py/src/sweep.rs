@@ -11,8 +11,8 @@ use memcontact::outcome::StepRow;
 use memcontact::run::run_sweep;
 use memcontact::solve::Silent;
 use memcontact::write::step_label;
+use memcontact::write::SweepWriter;
 use memcontact::{Case, Error};
-use memcontact_plot::write::SweepWriter;
 use pyo3::exceptions::{PyIndexError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
@@ -210,12 +210,39 @@ impl PySweep {
         to_py(py, &summaries)
     }
 
+    /// The rows as a `pandas.DataFrame` with the columns of the CSV file (see
+    /// `memcontact._notebook.to_pandas`).
+    fn to_pandas<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyAny>> {
+        crate::convert::call_helper(slf.py(), "to_pandas", (slf,), None)
+    }
+
+    /// The notebook's summary and table of rows (HTML).
+    fn _repr_html_<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyAny>> {
+        crate::convert::call_helper(slf.py(), "sweep_html", (slf,), None)
+    }
+
     fn __len__(&self) -> usize {
         self.results.len()
     }
 
-    fn __getitem__(&self, py: Python<'_>, index: isize) -> PyResult<Py<PyResult_>> {
+    fn __getitem__(&self, py: Python<'_>, index: &Bound<'_, PyAny>) -> PyResult<Py<PyResult_>> {
         let n = self.results.len() as isize;
+        let index: isize = index
+            .call_method0("__index__")
+            .map_err(|_| {
+                pyo3::exceptions::PyTypeError::new_err(format!(
+                    "a sweep's steps are indexed by integers, not {}",
+                    index
+                        .get_type()
+                        .name()
+                        .map(|n| n.to_string())
+                        .unwrap_or_default()
+                ))
+            })?
+            .extract()
+            .map_err(|_| {
+                PyIndexError::new_err(format!("step {index} is not one of the {n} steps solved"))
+            })?;
         let i = if index < 0 { index + n } else { index };
         if !(0..n).contains(&i) {
             return Err(PyIndexError::new_err(format!(

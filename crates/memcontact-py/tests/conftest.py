@@ -5,6 +5,14 @@ import subprocess
 from pathlib import Path
 
 import pytest
+from hypothesis import settings
+
+# Hypothesis: few examples in the test command; HYPOTHESIS_PROFILE=long for a long run.
+settings.register_profile("default", max_examples=25, deadline=10_000)
+settings.register_profile(
+    "long", max_examples=int(os.environ.get("HYPOTHESIS_EXAMPLES", "5000")), deadline=None
+)
+settings.load_profile(os.environ.get("HYPOTHESIS_PROFILE", "default"))
 
 REPO = Path(__file__).resolve().parents[3]
 EXAMPLES = REPO / "examples"

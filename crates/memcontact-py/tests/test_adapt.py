@@ -107,5 +107,11 @@ def test_bad_input_and_other_runs_are_refused():
         mc.adapt(mc.load_case(mc_example("roof-corner.toml"), {"adapt.max_vertices": 50}))
     with pytest.raises(ValueError, match=r"\[adapt\]"):
         mc.adapt(mc.load_case(mc_example("roof.toml")))
-    with pytest.raises(TypeError):
-        mc.adapt(case, mesh=mc.rectangle(0.0, 0.0, 1.0, 1.0, 4, 4))
+    # A case file with [mesh] and mesh= is refused; a Case's own mesh is replaced.
+    start = mc.rectangle(0.0, 0.0, 12.0, 8.0, 6, 4)
+    with pytest.raises(ValueError, match=r"\[mesh\]"):
+        mc.adapt(mc_example("roof-corner.toml"), mesh=start)
+    small = mc.load_case(mc_example("roof-corner.toml"), {"adapt.max_vertices": 120})
+    a = mc.adapt(small, mesh=start)
+    assert a.rows[0]["vertices"] == start.n_vertices == 35
+    assert a.case.to_dict()["adapt"]["max_vertices"] == 120

@@ -221,6 +221,7 @@ def test_what_only_the_mesh_reveals_is_refused_before_solving():
         mc.solve(case)
 
 
+@pytest.mark.filterwarnings("ignore:solve_mesh is deprecated:DeprecationWarning")
 def test_solve_mesh_errors_name_the_argument():
     mesh = mc.rectangle(nx=4)
     kwargs = dict(tension=1.0, load=1.0, shape=0.5, stiffness=10.0)

@@ -1,6 +1,6 @@
 """Beyond the paper's frame from Python: cases with [boundary] and [lower] in dicts give
-the command-line tool's answer; solve_mesh takes boundary heights, free edges and a body
-below as keyword arguments (numbers, expressions, region dicts or arrays); meshes carry
+the command-line tool's answer; solve(mesh=) takes boundary heights, free edges and a body
+below as sections (numbers, expressions, region dicts or arrays); meshes carry
 named boundary regions; results carry the body below's fields and pickle with them."""
 
 import pickle
@@ -46,29 +46,29 @@ def test_cases_with_a_body_below_equal_the_cli(cli, examples, tmp_path, example)
         assert np.array_equal(getattr(back, name), getattr(r, name)), name
 
 
-def test_solve_mesh_takes_heights_free_edges_and_a_body_below():
+def test_solve_on_a_mesh_takes_heights_free_edges_and_a_body_below():
     mesh = mc.rectangle(nx=16, ny=16)
     assert mesh.boundary_names == {1: "bottom", 2: "right", 3: "top", 4: "left"}
     assert mesh.boundary_edges.shape == (64, 2)
     # Linear heights, no contact: P1 reproduces them exactly (the top side free, where
     # g = 0.3 + 0.2x has no normal derivative).
-    r = mc.solve_mesh(mesh, tension=1.0, load=0.0, shape=5.0, stiffness=10.0,
-                      boundary_height="0.3 + 0.2*x", free=["top"])
+    membrane, obstacle = mc.Membrane(1.0, 0.0), mc.Obstacle(5.0, 10.0)
+    r = mc.solve(mesh=mesh, membrane=membrane, obstacle=obstacle,
+                 boundary=mc.Boundary(height="0.3 + 0.2*x", free=["top"]))
     x = mesh.vertices[:, 0]
     assert np.allclose(r.u, 0.3 + 0.2 * x, atol=1e-10)
     assert r.phi_low is None and r.state_low is None
     # An array of heights gives the same answer as the expression.
     g = 0.3 + 0.2 * x
-    a = mc.solve_mesh(mesh, tension=1.0, load=0.0, shape=5.0, stiffness=10.0,
-                      boundary_height=g, free=["top"])
+    a = mc.solve(mesh=mesh, membrane=membrane, obstacle=obstacle,
+                 boundary=mc.Boundary(height=g, free=["top"]))
     assert np.allclose(a.u, r.u, atol=1e-13)
     # A body below, as numbers and as arrays of nodal values.
-    kw = dict(tension=1.0, load="-20*(1 + x)", shape=0.3, stiffness=500.0)
-    b = mc.solve_mesh(mesh, lower_shape=-0.1, lower_stiffness=400.0, **kw)
+    kw = dict(membrane=mc.Membrane(1.0, "-20*(1 + x)"), obstacle=mc.Obstacle(0.3, 500.0))
+    b = mc.solve(mesh=mesh, lower=mc.Lower(-0.1, 400.0), **kw)
     assert np.any(b.state_low >= 0)
     assert np.all(b.penetration_low >= 0)
-    c = mc.solve_mesh(mesh, lower_shape=np.full(mesh.n_vertices, -0.1),
-                      lower_stiffness=400.0, **kw)
+    c = mc.solve(mesh=mesh, lower=mc.Lower(np.full(mesh.n_vertices, -0.1), 400.0), **kw)
     assert np.allclose(b.u, c.u, atol=1e-12)
     # The body below's forces balance the load it carries (no obstacle contact, g = 0):
     # Σ X_low = −∫ f minus what the fixed boundary takes, so it is positive and smaller.
@@ -81,8 +81,8 @@ def test_meshes_from_arrays_name_their_boundary_regions():
     m = mc.Mesh(v, t, boundary_edges=[[6, 7], [7, 8]], boundary_tags=[7, 7],
                 boundary_names={7: "lid"})
     assert m.boundary_names == {7: "lid"}
-    r = mc.solve_mesh(m, tension=1.0, load=1.0, shape=1.0, stiffness=0.0, free=["lid"],
-                      boundary_height=0.0)
+    r = mc.solve(mesh=m, membrane=mc.Membrane(1.0, 1.0), obstacle=mc.Obstacle(1.0, 0.0),
+                 boundary=mc.Boundary(height=0.0, free=["lid"]))
     # The lid's middle vertex carries an unknown now, with the centre (its corners stay on
     # the fixed sides); with no force across the free edge it rises above the centre's
     # neighbours on the fixed sides.
@@ -122,18 +122,21 @@ def test_gmsh_physical_curves_are_boundary_regions(examples):
     assert gmsh.boundary_names == {11: "bottom", 12: "right", 13: "top", 14: "left",
                                    15: "seam"}
     grid = mc.rectangle(x1=2.0, nx=16, ny=8)
-    kw = dict(tension=1.0, load="2 - 4*x*y", shape=0.05, stiffness=200.0, free=["top"],
-              boundary_height={"bottom": "0.01*x", "left": "0.02*y", "right": "0.02"})
-    a, b = mc.solve_mesh(gmsh, **kw), mc.solve_mesh(grid, **kw)
+    case = {"membrane": {"tension": 1.0, "load": "2 - 4*x*y"},
+            "obstacle": {"shape": 0.05, "stiffness": 200.0},
+            "boundary": {"free": ["top"], "height": {"bottom": "0.01*x", "left": "0.02*y",
+                                                     "right": "0.02"}}}
+    a, b = mc.solve(case, mesh=gmsh), mc.solve(case, mesh=grid)
     key = lambda v: [tuple(p) for p in np.round(v, 9)]
     order_a = sorted(range(gmsh.n_vertices), key=lambda i: key(gmsh.vertices)[i])
     order_b = sorted(range(grid.n_vertices), key=lambda i: key(grid.vertices)[i])
     assert np.allclose(a.u[order_a], b.u[order_b], rtol=0, atol=1e-9)
     with pytest.raises(ValueError, match=r"curves: bottom, right, top, left; regions of "
                                          r"triangles, surfaces: lower, upper"):
-        mc.solve_mesh(gmsh, **{**kw, "free": ["crest"]})
+        mc.solve(case, mesh=gmsh, boundary={"free": ["crest"]})
 
 
+@pytest.mark.filterwarnings("ignore:solve_mesh is deprecated:DeprecationWarning")
 def test_bad_extension_data_raises_value_errors_naming_the_key():
     mesh = mc.rectangle(nx=8)
     kw = dict(tension=1.0, load=1.0, shape=0.5, stiffness=100.0)

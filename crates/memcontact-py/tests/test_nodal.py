@@ -20,15 +20,29 @@ def nodal(mesh, f):
 @pytest.mark.parametrize("method", ["active-set", "qp"])
 def test_arrays_equal_expressions_for_linear_data(foundation, method):
     mesh = mc.disk(radius=1.0, size=0.1)
-    common = dict(tension=1.5, foundation=foundation, method=method)
-    by_expr = mc.solve_mesh(mesh, load=F, shape=PHI, stiffness=H, **common)
-    by_array = mc.solve_mesh(
-        mesh,
-        load=nodal(mesh, lambda x, y: 6 + 2 * x - y),
-        shape=nodal(mesh, lambda x, y: 0.9 - 0.2 * x + 0.1 * y),
-        stiffness=nodal(mesh, lambda x, y: 80 + 30 * x + 10 * y),
-        **common,
+    solver = mc.Solver(method=method)
+    by_expr = mc.solve(mesh=mesh, membrane=mc.Membrane(1.5, F),
+                       obstacle=mc.Obstacle(PHI, H, foundation=foundation), solver=solver)
+    by_array = mc.solve(
+        mesh=mesh,
+        membrane=mc.Membrane(1.5, nodal(mesh, lambda x, y: 6 + 2 * x - y)),
+        obstacle=mc.Obstacle(
+            shape=nodal(mesh, lambda x, y: 0.9 - 0.2 * x + 0.1 * y),
+            stiffness=nodal(mesh, lambda x, y: 80 + 30 * x + 10 * y),
+            foundation=foundation,
+        ),
+        solver=solver,
     )
+    # A vectorised function of (x, y) is its values at the vertices.
+    by_function = mc.solve(
+        mesh=mesh,
+        membrane=mc.Membrane(1.5, lambda x, y: 6 + 2 * x - y),
+        obstacle=mc.Obstacle(shape=lambda x, y: 0.9 - 0.2 * x + 0.1 * y,
+                             stiffness=lambda x, y: 80 + 30 * x + 10 * y,
+                             foundation=foundation),
+        solver=solver,
+    )
+    assert np.array_equal(by_function.u, by_array.u)
     assert (by_expr.state == 1).sum() > 10, "the case must have contact"
     assert np.array_equal(by_expr.state, by_array.state)
     for name in ["u", "penetration", "pressure", "contact_force"]:
@@ -42,7 +56,8 @@ def test_a_nodal_obstacle_is_sampled_exactly_and_solved_consistently():
     mesh = mc.rectangle(nx=24)
     rng = np.random.default_rng(7)
     phi = 0.3 + 0.05 * rng.random(mesh.n_vertices)
-    r = mc.solve_mesh(mesh, tension=1.0, load=20.0, shape=phi, stiffness="rigid")
+    r = mc.solve(mesh=mesh, membrane=mc.Membrane(1.0, 20.0),
+                 obstacle=mc.Obstacle(phi, "rigid"))
     assert np.array_equal(r.phi, phi)
     inner = ~mesh.boundary
     # The rigid obstacle: u ≤ φ inside, with equality where the membrane touches.
@@ -55,7 +70,8 @@ def test_a_nodal_obstacle_is_sampled_exactly_and_solved_consistently():
 def test_nodal_arrays_in_a_case_dict_and_pickling(tmp_path):
     mesh = mc.disk(radius=1.0, size=0.3)
     load = nodal(mesh, lambda x, y: 8 + x)
-    r = mc.solve_mesh(mesh, tension=1.0, load=load, shape=1.0, stiffness=100.0)
+    r = mc.solve({"membrane": {"tension": 1.0, "load": load},
+                  "obstacle": {"shape": 1.0, "stiffness": 100.0}}, mesh=mesh)
     back = pickle.loads(pickle.dumps(r))
     assert np.array_equal(back.u, r.u)
     # Writing after unpickling assembles again from the stored values.
@@ -65,6 +81,7 @@ def test_nodal_arrays_in_a_case_dict_and_pickling(tmp_path):
     assert back.case.to_dict()["membrane"]["load"] == pytest.approx(list(load), abs=0)
 
 
+@pytest.mark.filterwarnings("ignore:solve_mesh is deprecated:DeprecationWarning")
 def test_bad_nodal_arrays():
     mesh = mc.disk(radius=1.0, size=0.3)
     n = mesh.n_vertices

@@ -47,7 +47,8 @@ def test_result_survives_pickling(tmp_path):
 def test_result_on_a_hierarchy_pickles_with_its_levels(tmp_path):
     mesh = mc.rectangle(nx=16)
     assert mesh.levels == 4
-    r = mc.solve_mesh(mesh, tension=1.0, load=20.0, shape="0.3 + 0.2*x*y", stiffness="rigid")
+    r = mc.solve(mesh=mesh, membrane=mc.Membrane(1.0, 20.0),
+                 obstacle=mc.Obstacle("0.3 + 0.2*x*y", "rigid"))
     assert r.method == "multigrid"
     back = pickle.loads(pickle.dumps(r))
     assert_same(r, back)
@@ -93,6 +94,7 @@ def test_unconverged_solve_raises_solver_error_with_the_result():
     assert r.summary["converged"] is False and r.summary["accepted"] is False
 
 
+@pytest.mark.filterwarnings("ignore:solve_mesh is deprecated:DeprecationWarning")
 def test_solve_mesh_arrays_equal_mesh_object_and_case():
     mesh = mc.disk(radius=1.0, size=0.15)
     kwargs = dict(tension=1.0, load=8.0, shape=1.0, stiffness=100.0)
@@ -114,8 +116,8 @@ def test_region_data_from_python():
     assert mesh.region_names == {1: "soft", 2: "hard"}
     assert mesh.boundary.sum() == 8
     tension, f, phi, h = 2.0, 5.0, 0.1, {1: 3.0, 2: 40.0}
-    r = mc.solve_mesh(mesh, tension=tension, load=f, shape=phi,
-                      stiffness={"soft": h[1], "hard": h[2]})
+    r = mc.solve(mesh=mesh, membrane=mc.Membrane(tension, f),
+                 obstacle=mc.Obstacle(phi, {"soft": h[1], "hard": h[2]}))
     # The one-unknown problem by hand: S = t Σ area |∇λ|², D = f Σ area/3,
     # L = Σ h area/6 (the consistent mass of a constant h), U = (D + L φ)/(S + L) if > φ.
     S = D = L = 0.0
@@ -135,8 +137,8 @@ def test_region_data_from_python():
     assert r.state[4] == 1
     assert r.pressure[4] == pytest.approx(mesh_h_at_vertex(h, regions, t) * (u - phi), rel=1e-12)
     # Regions by tag as well as by name:
-    r2 = mc.solve_mesh(mesh, tension=tension, load=f, shape=phi,
-                       stiffness={1: h[1], "2": h[2]})
+    r2 = mc.solve(mesh=mesh, membrane=mc.Membrane(tension, f),
+                  obstacle=mc.Obstacle(phi, {1: h[1], "2": h[2]}))
     assert r2.u[4] == r.u[4]
 
 
@@ -153,9 +155,9 @@ def test_solves_release_the_gil():
 
     def work():
         span["start"] = time.perf_counter()
-        mc.solve_mesh(mesh, tension=1.0, load=20.0,
-                      shape="0.5 + 0.1*sin(2*pi*x)*cos(2*pi*y)", stiffness=1000.0,
-                      method="active-set")
+        mc.solve(mesh=mesh, membrane=mc.Membrane(1.0, 20.0),
+                 obstacle=mc.Obstacle("0.5 + 0.1*sin(2*pi*x)*cos(2*pi*y)", 1000.0),
+                 solver=mc.Solver(method="active-set"))
         span["end"] = time.perf_counter()
 
     ticks = []

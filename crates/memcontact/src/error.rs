@@ -70,6 +70,13 @@ pub enum Error {
     },
 }
 
+/// A picture that cannot be drawn is bad data (its message names what).
+impl From<memcontact_plot::Error> for Error {
+    fn from(e: memcontact_plot::Error) -> Error {
+        Error::Data(e.to_string())
+    }
+}
+
 /// `file:line: key: message`, leaving out what is not known.
 fn case_message(
     file: Option<&std::path::Path>,

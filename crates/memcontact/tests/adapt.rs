@@ -4,9 +4,10 @@
 //! manufactured solutions (a free edge and a body below among them), a rigid region, and
 //! the loop's own guarantees (nested meshes, certified steps, bounded iterations).
 
+use memcontact::adapt::AdaptRow;
 use memcontact::case::Case;
 use memcontact::mesh::Mesh;
-use memcontact::outcome::{AdaptRow, Outcome};
+use memcontact::outcome::Outcome;
 use memcontact::run::{run_adapt, AdaptRun, AdaptStop};
 use memcontact::solve::Silent;
 use memcontact::verify::exact::{ExactSolution, Manufactured, ManufacturedCosine};

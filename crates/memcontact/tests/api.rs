@@ -63,8 +63,7 @@ fn toml_rust_and_json_describe_the_same_problem_and_run_alike() {
     let json = serde_json::to_string(&from_toml).unwrap();
     assert_eq!(Case::from_json_str(&json).unwrap(), from_toml);
     let a = run(&from_toml, &mut Silent).unwrap();
-    let b = memcontact::run::run_problem(&problem_in_rust(), &Settings::default(), &mut Silent)
-        .unwrap();
+    let b = run(&Case::new(problem_in_rust()), &mut Silent).unwrap();
     assert_eq!(a.status(), Status::Converged);
     assert_eq!(a.report.u, b.report.u);
     assert!(a.report.certificate.kkt() <= 1e-10);
@@ -195,6 +194,7 @@ fn a_result_set_is_written_and_read_back_without_the_cli() {
         run_id: None,
         cell_data: Vec::new(),
         adapt: None,
+        unconverged: false,
     };
     let written =
         write_result_set(&out, &outcome, &case, &options, &mut |_, _| Ok(vec![])).unwrap();
@@ -227,7 +227,7 @@ fn a_result_set_is_written_and_read_back_without_the_cli() {
 }
 
 #[test]
-fn a_run_for_writing_solves_alike_and_then_refuses_to_solve_again() {
+fn a_run_to_files_solves_alike_writes_and_then_refuses_to_solve_again() {
     let disk = std::fs::read_to_string(
         std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/disk.toml"),
     )
@@ -244,7 +244,28 @@ fn a_run_for_writing_solves_alike_and_then_refuses_to_solve_again() {
     ] {
         let case = Case::from_toml_str(text, None).unwrap();
         let a = run(&case, &mut Silent).unwrap();
-        let b = memcontact::run::run_for_writing(&case, &mut Silent).unwrap();
+        let dir = tempfile::tempdir().unwrap();
+        let w = memcontact::run::run_to_files(
+            &case,
+            &dir.path().join("out"),
+            &WriteOptions::new(name),
+            &mut Silent,
+        )
+        .unwrap();
+        let summary = w.summary.expect("written");
+        assert_eq!(summary.iterations, a.report.iterations, "{name}");
+        for file in [
+            "solution.vtu",
+            "nodes.csv",
+            "summary.json",
+            "deflection.png",
+        ] {
+            assert!(
+                dir.path().join("out").join(file).is_file(),
+                "{name}: {file}"
+            );
+        }
+        let b = w.outcome;
         assert_eq!(a.report.method, Method::Multigrid, "{name}");
         assert_eq!(a.report.u, b.report.u, "{name}");
         assert_eq!(a.report.iterations, b.report.iterations, "{name}");

@@ -253,7 +253,9 @@ fn bad_boundary_data_is_refused_before_any_solve() {
 
 #[test]
 fn generators_name_their_sides_and_refinement_keeps_them() {
-    use memcontact::mesh::generate::{disk, polygon, PolygonSpec};
+    use memcontact::mesh::generate::{
+        disk, polygon, rectangle, Diagonal, PolygonSpec, RectangleSpec,
+    };
     use memcontact::mesh::{refine::Hierarchy, Mesh, VertexTriangles};
     // Every boundary edge's tag agrees with the geometry, on every refined level.
     let check = |m: &Mesh, side: &dyn Fn([f64; 2]) -> &'static str| {
@@ -266,14 +268,19 @@ fn generators_name_their_sides_and_refinement_keeps_them() {
             assert_eq!(m.boundary.name(tag), side(mid), "edge at {mid:?}");
         }
     };
-    let spec = case(&BASE.replace(
-        "ny = 8",
-        "ny = 8
-refine = 2",
-    ))
-    .problem
-    .mesh;
-    let (h, _) = memcontact::discretization::build_mesh(&spec).unwrap();
+    // A generated square (the generator of `[mesh] nx, ny`), refined twice as `refine = 2`
+    // does.
+    let mut h = rectangle(&RectangleSpec {
+        x0: 0.0,
+        y0: 0.0,
+        x1: 1.0,
+        y1: 1.0,
+        nx: 8,
+        ny: 8,
+        diagonal: Diagonal::Right,
+    })
+    .unwrap();
+    h.refine(2);
     for m in &h.levels {
         check(m, &|p| match p {
             [_, 0.0] => "bottom",

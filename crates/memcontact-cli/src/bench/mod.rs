@@ -13,7 +13,7 @@ pub mod standard;
 
 use anyhow::{bail, Context, Result};
 use memcontact::problem::MeshSource;
-use memcontact::solve::multigrid::Kind;
+use memcontact::solve::HierarchyKind as Kind;
 use memcontact::solve::{HierarchyChoice, Method, Silent};
 use memcontact::write::WriteOptions;
 use memcontact::Case;
@@ -156,9 +156,10 @@ pub fn run_case(case: &Case, scratch: &Path, pictures: bool) -> Result<CaseRun> 
         run_id: None,
         cell_data: Vec::new(),
         adapt: None,
+        unconverged: false,
     };
-    let plots = memcontact_plot::write::plot_options(&case, "bench");
-    let written = memcontact_plot::write::write_result(&dir, &outcome, &case, &options, &plots);
+    let plots = memcontact::write::plot_options(&case, "bench");
+    let written = memcontact::write::write_result(&dir, &outcome, &case, &options, &plots);
     let write = t_write.elapsed().as_secs_f64();
     let total = started.elapsed().as_secs_f64();
     let stolen = stolen_seconds()

@@ -116,7 +116,7 @@ tolerance = 1e-10
         let d = Discretization::new(&case.problem, &mut Silent)?;
         let t_setup = w.read();
         let points: Vec<[f64; 2]> = case.sensors.iter().map(|s| s.at).collect();
-        let inside = memcontact::sensitivity::outputs::locate(d.mesh(), &points)?;
+        let inside = memcontact::bench::locate(d.mesh(), &points)?;
         let mut k = 0;
         case.sensors.retain(|_| {
             k += 1;

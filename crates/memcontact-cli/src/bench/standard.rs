@@ -9,11 +9,11 @@
 //! multigrid V-cycle (from zero, to the same relative tolerance), as the yardstick. `memcontact bench` prints the rows.
 
 use super::proc::{peak_memory, reset_peak_memory};
+use memcontact::bench::{self as multigrid, BodyStiffness, Model, ProblemData, TnnmgOptions};
 use memcontact::error::Result;
 use memcontact::field::FnCoefficient;
 use memcontact::mesh::generate::{rectangle, Diagonal, RectangleSpec};
-use memcontact::model::{BodyStiffness, Foundation, Model, ProblemData, Sampling};
-use memcontact::solve::multigrid::{self, TnnmgOptions};
+use memcontact::model::{Foundation, Sampling};
 use memcontact::solve::{Method, Settings, Silent};
 use std::f64::consts::PI;
 use std::time::Instant;

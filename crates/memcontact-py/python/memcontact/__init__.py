@@ -8,26 +8,27 @@ The same cases as the ``memcontact`` command-line tool, from Python::
     import memcontact as mc
 
     mesh = mc.disk(radius=1.0, size=0.05)
-    r = mc.solve_mesh(mesh, tension=1.0, load=8.0, shape=1.0, stiffness=100.0)
-    r.u, r.pressure, r.state          # NumPy arrays over the mesh's vertices
+    r = mc.solve(mesh=mesh,
+                 membrane=mc.Membrane(tension=1.0, load=8.0),
+                 obstacle=mc.Obstacle(shape=lambda x, y: 1 - 0.3 * x, stiffness=100.0))
+    r.u, r.pressure, r.state          # read-only NumPy views over the mesh's vertices
     r.summary["contact_area"]         # the scalars of summary.json
-    r.write("out/disk")               # solution.vtu, nodes.csv, summary.json
+    r.plot("pressure")                # matplotlib, each body's contact outlined
+    r.matrices()["S"]                 # S, L, D, φ over the unknowns (scipy.sparse)
+    r.write("out/disk")               # solution.vtu, nodes.csv, pictures, summary.json
 
     case = mc.load_case("examples/disk.toml", {"mesh.size": 0.1})
     results = mc.solve_many([case, ...], executor=client)   # any concurrent.futures-like
 
     s = mc.sweep("roof-sweep.toml")   # a case with [sweep] or [[load_case]] entries
-    s.rows                            # the rows of sweep.csv
-    s.write("out/roof-sweep")         # a directory per step, sweep.csv, sweep.png
-
+    s.to_pandas()                     # the rows of sweep.csv
     a = mc.adapt("examples/roof-corner.toml")   # a case with [adapt]
-    a.rows                            # the rows of adapt.csv, one per step
-    a.result.u, a.mesh                # the final step's result and mesh
-    a.write("out/roof-corner")        # the final files, adapt.csv, mesh.png
 
-Solves run with the GIL released. Bad data raises ``ValueError`` naming the key; a solve
-that does not reach its tolerance raises :class:`SolverError`, whose ``result`` holds the
-iterate, its status and its certificate.
+Solves run with the GIL released. Bad data raises ``ValueError`` (or ``TypeError`` for a
+value of the wrong kind) naming the key; a solve that does not reach its tolerance raises
+:class:`SolverError`, whose ``result`` holds the iterate, its status and its certificate.
+Plotting (matplotlib), tables (pandas), interoperability (meshio, pyvista) and the
+matrices (scipy) import their package only when used.
 """
 
 from __future__ import annotations
@@ -51,46 +52,78 @@ import numpy as np
 
 from . import _memcontact as _native
 from ._memcontact import Adapt, Case, Mesh, Result, Study, Sweep
+from ._sections import (
+    SECTIONS as _SECTIONS,
+    Boundary,
+    Data,
+    Lower,
+    Membrane,
+    Obstacle,
+    Output,
+    Solver,
+    Units,
+)
 
 __version__: str = _native.__version__
 
 __all__ = [
     "Adapt",
+    "Boundary",
     "Case",
+    "Lower",
+    "Membrane",
     "Mesh",
+    "Obstacle",
+    "Output",
     "Result",
+    "Solver",
+    "SolverError",
     "Study",
     "Sweep",
-    "SolverError",
+    "Units",
     "adapt",
     "convergence",
-    "load_case",
-    "rectangle",
     "disk",
+    "load_case",
     "polygon",
     "read_gmsh",
+    "rectangle",
     "refine",
     "solve",
-    "solve_mesh",
     "solve_many",
+    "solve_mesh",
     "sweep",
 ]
 
 PathLike = Union[str, "os.PathLike[str]"]
-#: What a data argument may be: a number, an expression of x and y (a string), a dict of
-#: region names (or tags) to numbers or expressions, or (where noted) a NumPy array of
-#: one value per mesh vertex.
-Data = Union[float, int, str, Mapping[Union[str, int], Union[float, int, str]], np.ndarray]
+#: A case: a :class:`Case`, a dict in the case file's schema (whose sections may be the
+#: dataclasses :class:`Membrane`, :class:`Obstacle`, ...), or the path of a case file.
 CaseLike = Union[Case, Mapping[str, Any], PathLike]
+#: A section: its dataclass or a dict of its keys.
+SectionLike = Union[Mapping[str, Any], Membrane, Obstacle, Boundary, Solver, Output, Units]
 Point = Tuple[float, float]
 
 
 class SolverError(RuntimeError):
     """A solve whose outcome the settings do not accept (iteration limit, stall, numerical
-    failure, or the rounding floor when the settings do not allow it). ``result`` is the
-    :class:`Result` with the best iterate, its ``status`` and its certificate
-    (``result.kkt_residual``); for a sweep, ``sweep`` holds the steps solved until then
-    (``result`` is the last of them)."""
+    failure, or the rounding floor when the settings do not allow it).
+
+    Parameters
+    ----------
+    message : str
+        What went wrong.
+    result : Result
+        The result with the best iterate, its status and its certificate.
+    sweep : Sweep, optional
+        For a sweep: the steps solved until then (``result`` is the last of them).
+
+    Attributes
+    ----------
+    result : Result
+        The best iterate (``result.kkt_residual``: its certificate).
+    sweep : Sweep or None
+        The steps solved, for a sweep.
+    """
 
     def __init__(self, message: str, result: Result, sweep: Optional[Sweep] = None) -> None:
         super().__init__(message, result)
@@ -114,11 +147,31 @@ def load_case(
     path: PathLike,
     overrides: Optional[Union[Mapping[str, Any], Sequence[str]]] = None,
 ) -> Case:
-    """Reads a case file (TOML). ``overrides`` sets keys first, like the command line's
-    ``--set``: a dict of dotted keys to values (``{"mesh.nx": 64, "obstacle.foundation":
-    "lumped"}``) or a list of ``"key=value"`` strings with TOML values. Mesh paths are
-    relative to the case file. Bad data raises ``ValueError`` naming the file, the line and
-    the key."""
+    """Reads a case file (TOML).
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The case file. Mesh paths in it are relative to it.
+    overrides : dict or list of str, optional
+        Keys set first, like the command line's ``--set``: a dict of dotted keys to
+        values (``{"mesh.nx": 64, "obstacle.foundation": "lumped"}``) or a list of
+        ``"key=value"`` strings with TOML values.
+
+    Returns
+    -------
+    Case
+        The case, checked.
+
+    Raises
+    ------
+    ValueError
+        Bad data, naming the file, the line and the key.
+    FileNotFoundError
+        The file does not exist.
+    TypeError
+        ``overrides`` is a string.
+    """
     if overrides is None:
         items: List[str] = []
     elif isinstance(overrides, Mapping):
@@ -130,11 +183,41 @@ def load_case(
     return Case.load(os.fspath(path), items)
 
 
+def _sections_of(data: Mapping[str, Any]) -> Dict[str, Any]:
+    """A case dict with its dataclass sections as dicts (a new dict; section dicts are
+    copied one level deep)."""
+    out: Dict[str, Any] = {}
+    for key, value in data.items():
+        if not isinstance(key, str):
+            raise TypeError(f"a case's sections are named by strings, got {key!r}")
+        if hasattr(value, "__dataclass_fields__") and hasattr(value, "to_dict"):
+            value = value.to_dict()
+        elif isinstance(value, Mapping):
+            value = dict(value)
+        out[key] = value
+    return out
+
+
+def _section(name: str, value: SectionLike) -> Dict[str, Any]:
+    """A section given as a keyword: its dataclass or a dict."""
+    if isinstance(value, Mapping):
+        return dict(value)
+    cls = _SECTIONS[name]
+    if hasattr(value, "__dataclass_fields__") and hasattr(value, "to_dict"):
+        if name != "lower" and isinstance(value, Lower) and cls is Obstacle:
+            raise TypeError(f"{name}: a Lower is the body below; give an Obstacle")
+        return value.to_dict()  # type: ignore[union-attr]
+    raise TypeError(
+        f"{name}: give a {cls.__name__} or a dict of the [{name}] keys, got "
+        f"{type(value).__name__}"
+    )
+
+
 def _as_case(case: CaseLike) -> Case:
     if isinstance(case, Case):
         return case
     if isinstance(case, Mapping):
-        return Case(dict(case))
+        return Case(_sections_of(case))
     if isinstance(case, (str, os.PathLike)):
         return load_case(case)
     raise TypeError(
@@ -142,12 +225,148 @@ def _as_case(case: CaseLike) -> Case:
     )
 
 
+def _case_data(case: Optional[CaseLike]) -> Tuple[Dict[str, Any], str, bool]:
+    """The sections of a case to be solved on a given mesh, its label, and whether it came
+    with a ``[mesh]`` of its own that the given mesh replaces (a :class:`Case` always has
+    one)."""
+    if case is None:
+        return {}, "mesh", False
+    if isinstance(case, Case):
+        data = _sections_of(case.to_dict())
+        data.pop("mesh", None)
+        return data, case.label, True
+    if isinstance(case, Mapping):
+        return _sections_of(case), "mesh", False
+    if isinstance(case, (str, os.PathLike)):
+        return _sections_of(_native._case_table(os.fspath(case))), os.fspath(case), False
+    raise TypeError(
+        f"a case is a Case, a dict or the path of a case file, got {type(case).__name__}"
+    )
+
+
+# The data keys that may be arrays of one value per vertex or functions of (x, y).
+_NODAL_KEYS = (
+    ("membrane", "load"),
+    ("obstacle", "shape"),
+    ("obstacle", "stiffness"),
+    ("boundary", "height"),
+    ("lower", "shape"),
+    ("lower", "stiffness"),
+)
+
+
+def _real_array(a: np.ndarray, key: str, what: str) -> np.ndarray:
+    if a.dtype.kind not in "iuf":
+        raise TypeError(f"{key}: {what} must be real numbers, got dtype {a.dtype}")
+    return np.ascontiguousarray(a, dtype=np.float64)
+
+
+def _evaluate(f: Callable[..., Any], mesh: Mesh, key: str) -> np.ndarray:
+    """A vectorised function of (x, y) at the mesh's vertices: one float per vertex."""
+    v = mesh.vertices
+    n = mesh.n_vertices
+    try:
+        value = f(v[:, 0], v[:, 1])
+    except Exception as e:
+        raise ValueError(f"{key}: the function raised {type(e).__name__}: {e}") from e
+    try:
+        a = np.asarray(value)
+    except Exception as e:
+        raise TypeError(
+            f"{key}: the function returned a {type(value).__name__}, not an array of "
+            "numbers"
+        ) from e
+    if a.ndim == 0:
+        a = np.full(n, a)
+    a = _real_array(a, key, "the function's values")
+    if a.shape != (n,):
+        raise ValueError(
+            f"{key}: the function returned shape {a.shape}, but one value per vertex "
+            f"({n},) is needed (a vectorised f(x, y) of the vertex coordinates)"
+        )
+    bad = ~np.isfinite(a)
+    if bad.any():
+        i = int(np.argmax(bad))
+        raise ValueError(
+            f"{key}: the function's value at vertex {i} ({v[i, 0]:g}, {v[i, 1]:g}) is "
+            f"{a[i]}; values must be finite ({int(bad.sum())} are not)"
+        )
+    return a
+
+
+def _bind(data: Dict[str, Any], mesh: Mesh) -> Dict[str, Any]:
+    """The data keys of a case on a known mesh: functions evaluated at its vertices, NumPy
+    arrays checked to hold one real number per vertex."""
+    n = mesh.n_vertices
+    for section, key in _NODAL_KEYS:
+        s = data.get(section)
+        if not isinstance(s, dict) or key not in s:
+            continue
+        value = s[key]
+        name = f"{section}.{key}"
+        if isinstance(value, np.ndarray):
+            a = _real_array(value, name, "nodal values")
+            if a.shape != (n,):
+                raise ValueError(
+                    f"{name}: nodal values must have shape ({n},), one per vertex, got "
+                    f"shape {value.shape}"
+                )
+            s[key] = a
+        elif callable(value) and not isinstance(value, (str, type)):
+            s[key] = _evaluate(value, mesh, name)
+    return data
+
+
+def _refuse_functions(data: Mapping[str, Any]) -> None:
+    for section, key in _NODAL_KEYS:
+        s = data.get(section)
+        if isinstance(s, Mapping) and callable(s.get(key)) and not isinstance(s.get(key), str):
+            raise TypeError(
+                f"{section}.{key}: a function of (x, y) needs the mesh: give the mesh as "
+                "mesh= (and the case without [mesh])"
+            )
+
+
 # ---------------------------------------------------------------------------------------
 # Meshes.
 
 
+def _int(value: Any, name: str) -> int:
+    """A count: an integer (or an integral float), not negative."""
+    if isinstance(value, (bool, np.bool_)):
+        raise TypeError(f"{name}: an integer is needed, got a bool")
+    if isinstance(value, (float, np.floating)) and float(value).is_integer():
+        value = int(value)
+    try:
+        v = int(value.__index__())
+    except (AttributeError, TypeError):
+        raise TypeError(f"{name}: an integer is needed, got {type(value).__name__}") from None
+    if v < 0:
+        raise ValueError(f"{name}: must not be negative, got {v}")
+    if v >= 2**63:
+        raise ValueError(f"{name}: {v} is too large")
+    return v
+
+
+def _float(value: Any, name: str) -> float:
+    """A real number (its checks are the library's)."""
+    if isinstance(value, (str, bytes, bool, np.bool_)) or value is None:
+        raise TypeError(f"{name}: a number is needed, got {type(value).__name__}")
+    try:
+        return float(value)
+    except OverflowError:
+        raise ValueError(f"{name}: {value} is too large") from None
+    except (TypeError, ValueError):
+        raise TypeError(f"{name}: a number is needed, got {type(value).__name__}") from None
+
+
 def _points(p: Any, name: str) -> List[Point]:
-    a = np.asarray(p, dtype=np.float64)
+    try:
+        a = np.asarray(p, dtype=np.float64)
+    except OverflowError:
+        raise ValueError(f"{name}: a coordinate is too large") from None
+    except (TypeError, ValueError) as e:
+        raise ValueError(f"{name}: expected points of shape (k, 2): {e}") from None
     if a.ndim != 2 or a.shape[1] != 2:
         raise ValueError(f"{name}: expected points of shape (k, 2), got shape {a.shape}")
     return [(float(x), float(y)) for x, y in a]
@@ -162,21 +381,76 @@ def rectangle(
     ny: Optional[int] = None,
     diagonal: str = "right",
 ) -> Mesh:
-    """The structured mesh of [x0, x1] × [y0, y1] with nx × ny cells (ny defaults to nx),
-    each cut along ``diagonal``: ``"right"`` (from (xᵢ, yⱼ) to (xᵢ₊₁, yⱼ₊₁)), ``"left"``,
-    ``"alternate"`` or ``"crossed"`` (four triangles). With the right or left diagonal and
-    nx, ny sharing a power-of-two factor the coarser levels are kept (multigrid)."""
-    return _native.rectangle(x0, y0, x1, y1, int(nx), None if ny is None else int(ny), diagonal)
+    """The structured mesh of the rectangle [x0, x1] × [y0, y1].
+
+    Parameters
+    ----------
+    x0, y0, x1, y1 : float
+        The corners.
+    nx : int
+        Cells along x.
+    ny : int, optional
+        Cells along y (default ``nx``).
+    diagonal : {"right", "left", "alternate", "crossed"}
+        How each cell is cut: along the diagonal from (xᵢ, yⱼ) to (xᵢ₊₁, yⱼ₊₁)
+        (``"right"``), the other one, alternating, or into four triangles. With the right
+        or left diagonal and nx, ny sharing a power-of-two factor the coarser levels are
+        kept (multigrid).
+
+    Returns
+    -------
+    Mesh
+        The mesh; its sides are the boundary regions ``bottom``, ``right``, ``top``,
+        ``left``.
+
+    Raises
+    ------
+    ValueError
+        Bad sizes or corners.
+    """
+    if not isinstance(diagonal, str):
+        raise TypeError(f"diagonal: a string is needed, got {type(diagonal).__name__}")
+    return _native.rectangle(
+        _float(x0, "x0"), _float(y0, "y0"), _float(x1, "x1"), _float(y1, "y1"),
+        _int(nx, "nx"), None if ny is None else _int(ny, "ny"), diagonal,
+    )
 
 
 def disk(
     center: Point = (0.0, 0.0), radius: float = 1.0, size: Optional[float] = None
 ) -> Mesh:
-    """An unstructured mesh of a disc with elements of about ``size`` (default radius/8);
-    the boundary vertices lie on the circle, and refining keeps them there. A mesh of more
-    than about 150 000 triangles is a coarser Delaunay mesh refined uniformly, and carries
-    its levels for multigrid."""
-    return _native.disk((float(center[0]), float(center[1])), float(radius), size)
+    """An unstructured mesh of a disc.
+
+    Parameters
+    ----------
+    center : (float, float)
+        The centre.
+    radius : float
+        The radius.
+    size : float, optional
+        The elements' size (default radius/8).
+
+    Returns
+    -------
+    Mesh
+        The mesh; boundary vertices lie on the circle, and refining keeps them there. A
+        mesh of more than about 150 000 triangles is a coarser Delaunay mesh refined
+        uniformly, and carries its levels for multigrid.
+
+    Raises
+    ------
+    ValueError
+        A radius or size that is not positive and finite, or too many triangles.
+    """
+    try:
+        cx, cy = center
+    except (TypeError, ValueError):
+        raise TypeError("center: a pair of numbers (x, y) is needed") from None
+    return _native.disk(
+        (_float(cx, "center"), _float(cy, "center")),
+        _float(radius, "radius"),
+        None if size is None else _float(size, "size"),
+    )
 
 
 def polygon(
@@ -186,13 +460,36 @@ def polygon(
     regions: Optional[Union[Mapping[str, Any], Sequence[Tuple[str, Any]]]] = None,
     min_angle: float = 25.0,
 ) -> Mesh:
-    """A constrained Delaunay mesh of the polygon ``outer`` (k × 2 points) minus ``holes``,
-    elements of about ``size``, angles of at least ``min_angle`` degrees (≤ 30).
-    ``regions`` names sub-polygons (a dict name → points, or a list of ``(name, points)``
-    or of the case file's ``{"name": ..., "polygon": ...}``): their triangles get a tag named
-    after them (usable as keys of region tables); the rest is the region ``"default"``.
-    A mesh of more than about 150 000 triangles is a coarser Delaunay mesh refined
-    uniformly, and carries its levels for multigrid."""
+    """A constrained Delaunay mesh of a polygon.
+
+    Parameters
+    ----------
+    outer : array_like, shape (k, 2)
+        The outer polygon.
+    size : float
+        The elements' size.
+    holes : sequence of array_like, optional
+        Polygons cut out.
+    regions : dict or sequence, optional
+        Named sub-polygons (a dict name → points, a list of ``(name, points)`` or of the
+        case file's ``{"name": ..., "polygon": ...}``): their triangles get a tag named
+        after them (usable as keys of region tables); the rest is the region
+        ``"default"``.
+    min_angle : float
+        The smallest angle in degrees (≤ 30).
+
+    Returns
+    -------
+    Mesh
+        The mesh (with its levels for multigrid when it is large).
+
+    Raises
+    ------
+    ValueError
+        A bad polygon, size or angle.
+    """
+    size = _float(size, "size")
+    min_angle = _float(min_angle, "min_angle")
     hole_list = [_points(h, "holes") for h in (holes or [])]
     if regions is None:
         region_list: List[Tuple[str, List[Point]]] = []
@@ -202,19 +499,44 @@ def polygon(
         region_list = []
         for item in regions:
             # (name, points) pairs, or the case file's {"name": ..., "polygon": ...}.
-            k, v = (item["name"], item["polygon"]) if isinstance(item, Mapping) else item
+            try:
+                k, v = (item["name"], item["polygon"]) if isinstance(item, Mapping) else item
+            except KeyError as e:
+                raise ValueError(f"regions: a region needs {e.args[0]!r}") from None
+            except (TypeError, ValueError):
+                raise TypeError(
+                    "regions: give (name, points) pairs or {'name': ..., 'polygon': ...}"
+                ) from None
             region_list.append((str(k), _points(v, f"regions[{k!r}]")))
-    return _native.polygon(
-        _points(outer, "outer"), float(size), hole_list, region_list, float(min_angle)
-    )
+    return _native.polygon(_points(outer, "outer"), size, hole_list, region_list, min_angle)
 
 
 def read_gmsh(path: PathLike) -> Mesh:
-    """Reads a Gmsh mesh (MSH 2.2 or 4.1, ASCII or binary, 3-node triangles); physical
-    surfaces become named regions, physical curves on the boundary become boundary regions
-    (`boundary_edges`, `boundary_tags`, `boundary_names`: the keys of `free` and of
-    boundary height tables; boundary edges no curve covers form the region `default`).
-    Skipped elements and physical curves inside the mesh are reported as warnings."""
+    """Reads a Gmsh mesh (MSH 2.2 or 4.1, ASCII or binary, 3-node triangles).
+
+    Physical surfaces become named regions, physical curves on the boundary become
+    boundary regions (``boundary_edges``, ``boundary_tags``, ``boundary_names``: the keys
+    of ``free`` and of boundary height tables; boundary edges no curve covers form the
+    region ``default``). Skipped elements and physical curves inside the mesh are reported
+    as warnings.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The ``.msh`` file.
+
+    Returns
+    -------
+    Mesh
+        The mesh.
+
+    Raises
+    ------
+    ValueError
+        A file that does not parse or a mesh that is not valid.
+    FileNotFoundError
+        The file does not exist.
+    """
     mesh, notes = _native.read_gmsh(os.fspath(path))
     for note in notes:
         warnings.warn(f"{os.fspath(path)}: {note}", stacklevel=2)
@@ -222,9 +544,29 @@ def read_gmsh(path: PathLike) -> Mesh:
 
 
 def refine(mesh: Mesh, times: int = 1) -> Mesh:
-    """``mesh`` refined uniformly ``times`` times (each triangle into four; a disc's new
-    boundary vertices move onto its circle). The levels are kept for multigrid."""
-    return mesh.refine(int(times))
+    """A mesh refined uniformly.
+
+    Parameters
+    ----------
+    mesh : Mesh
+        The mesh.
+    times : int
+        How many times each triangle is cut into four (a disc's new boundary vertices
+        move onto its circle).
+
+    Returns
+    -------
+    Mesh
+        The refined mesh, with the levels kept for multigrid.
+
+    Raises
+    ------
+    ValueError
+        Too many refinements for the memory available.
+    """
+    if not isinstance(mesh, Mesh):
+        raise TypeError(f"refine: a Mesh is needed, got {type(mesh).__name__}")
+    return mesh.refine(_int(times, "times"))
 
 
 # ---------------------------------------------------------------------------------------
@@ -239,43 +581,163 @@ def _check(result: Result) -> Result:
     return result
 
 
-def solve(case: CaseLike) -> Result:
-    """Solves a case (a :class:`Case`, a dict in the case file's schema, or the path of a
-    case file) end to end, as ``memcontact solve`` does, with the GIL released.
-
-    Raises ``ValueError`` for bad data and :class:`SolverError` (with the result) when the
-    certificate does not reach the tolerance. A case with a ``[sweep]`` or
-    ``[[load_case]]`` entries raises ``ValueError``: solve its steps with :func:`sweep`;
-    so does a case with ``[adapt]``: run its loop with :func:`adapt`."""
-    return _check(_native.solve(_as_case(case)))
+def _with_sections(data: Dict[str, Any], sections: Dict[str, Any]) -> Dict[str, Any]:
+    for name, value in sections.items():
+        if value is not None:
+            data[name] = _section(name, value)
+    return data
 
 
-def adapt(case: CaseLike, *, mesh: Optional[Mesh] = None, check: bool = True) -> Adapt:
+def solve(
+    case: Optional[CaseLike] = None,
+    *,
+    mesh: Optional[Mesh] = None,
+    membrane: Optional[SectionLike] = None,
+    obstacle: Optional[SectionLike] = None,
+    lower: Optional[SectionLike] = None,
+    boundary: Optional[SectionLike] = None,
+    solver: Optional[SectionLike] = None,
+    output: Optional[SectionLike] = None,
+    units: Optional[SectionLike] = None,
+    check: bool = True,
+) -> Result:
+    """Solves a case end to end, as ``memcontact solve`` does, with the GIL released.
+
+    Parameters
+    ----------
+    case : Case, dict or path, optional
+        The case: a :class:`Case`, a dict in the case file's schema (its sections may be
+        dicts or the dataclasses :class:`Membrane`, :class:`Obstacle`, :class:`Lower`,
+        :class:`Boundary`, :class:`Solver`, :class:`Output`, :class:`Units`), or the path
+        of a case file. With ``mesh``, a case without ``[mesh]`` (a :class:`Case`'s own
+        mesh is replaced by ``mesh``).
+    mesh : Mesh, optional
+        The mesh to solve on (from the generators, :func:`read_gmsh`,
+        :meth:`Mesh.from_meshio` or arrays). With it, data may be NumPy arrays of one
+        value per vertex or vectorised functions ``f(x, y)`` of the vertex coordinates
+        (evaluated once at the vertices): ``membrane.load``, ``obstacle.shape``,
+        ``obstacle.stiffness``, ``boundary.height``, ``lower.shape``,
+        ``lower.stiffness``.
+    membrane, obstacle, lower, boundary, solver, output, units : dataclass or dict, optional
+        Sections given one by one; each replaces the case's section of that name.
+    check : bool
+        Raise :class:`SolverError` when the settings do not accept the outcome (default);
+        ``False`` returns the result whatever its status.
+
+    Returns
+    -------
+    Result
+        The fields (read-only arrays over the vertices), status, report and summary.
+
+    Raises
+    ------
+    ValueError
+        Bad data (naming the key), a function that raises or returns non-finite values,
+        an array or function result of the wrong shape, a case with ``[mesh]`` and
+        ``mesh=``, a case with steps (``[sweep]``, ``[[load_case]]``: see :func:`sweep`) or
+        with ``[adapt]`` (see :func:`adapt`).
+    TypeError
+        A value of the wrong kind (a section that is neither a dict nor its dataclass,
+        an array of strings, a function without ``mesh=``).
+    SolverError
+        The certificate did not reach the tolerance (with ``check``).
+
+    Examples
+    --------
+    >>> mesh = mc.disk(radius=1.0, size=0.1)
+    >>> r = mc.solve(mesh=mesh, membrane=mc.Membrane(tension=1.0, load=8.0),
+    ...              obstacle=mc.Obstacle(shape=lambda x, y: 1 - 0.3 * x, stiffness=100.0))
+    >>> r.status
+    'converged'
+    """
+    sections = {
+        "membrane": membrane,
+        "obstacle": obstacle,
+        "lower": lower,
+        "boundary": boundary,
+        "solver": solver,
+        "output": output,
+        "units": units,
+    }
+    given = any(v is not None for v in sections.values())
+    if mesh is None:
+        if case is None:
+            raise TypeError("solve needs a case, or a mesh= and the case's sections")
+        if isinstance(case, Case) and not given:
+            c = case
+        else:
+            if isinstance(case, Case):
+                data, label = _sections_of(case.to_dict()), case.label
+            elif isinstance(case, Mapping):
+                data, label = _sections_of(case), "case"
+            else:
+                c = load_case(case)  # type: ignore[arg-type]
+                data, label = _sections_of(c.to_dict()), c.label
+            data = _with_sections(data, sections)
+            _refuse_functions(data)
+            c = Case(data, label)
+        result = _native.solve(c)
+    else:
+        if not isinstance(mesh, Mesh):
+            raise TypeError(f"mesh: give a memcontact.Mesh, got {type(mesh).__name__}")
+        data, label, replaced = _case_data(case)
+        if "mesh" in data and not replaced:
+            raise ValueError(
+                "mesh: the case has a [mesh] section and mesh= gives a mesh: leave one out"
+            )
+        data = _bind(_with_sections(data, sections), mesh)
+        result = _native.solve_on(mesh, data, label)
+    return _check(result) if check else result
+
+
+def adapt(
+    case: CaseLike,
+    *,
+    mesh: Optional[Mesh] = None,
+    check: bool = True,
+) -> Adapt:
     """Runs the adaptive loop of a case with an ``[adapt]`` section, as ``memcontact
     solve`` does (solve, estimate, mark, refine by newest-vertex bisection, solve again
     from the previous answer), with the GIL released; Ctrl-C stops it.
 
-    ``case`` is a :class:`Case`, a dict in the case file's schema or the path of a case
-    file. With ``mesh``, ``case`` is a dict of the sections but ``mesh`` and the loop
-    starts from that :class:`Mesh`; its data may then be NumPy arrays of one value per
-    vertex, which are interpolated (P1) onto the new vertices (``interpolated`` names
-    them).
+    Parameters
+    ----------
+    case : Case, dict or path
+        The case. With ``mesh``, a case without ``[mesh]`` (a :class:`Case`'s own mesh is
+        replaced).
+    mesh : Mesh, optional
+        The start mesh. Data given as NumPy arrays of one value per vertex (or functions
+        of (x, y), evaluated at its vertices) are interpolated (P1) onto the new vertices
+        (``interpolated`` names them).
+    check : bool
+        Raise :class:`SolverError` when a step is not accepted (default); ``False``
+        returns the loop instead.
 
-    Returns an :class:`Adapt`: ``rows`` (the rows of ``adapt.csv``: step, vertices,
-    unknowns, estimator, energy, contact_area, iterations, kkt_residual, seconds),
-    ``result`` (the final step's :class:`Result`), ``mesh`` (the final mesh),
-    ``estimator`` (η_T per triangle of it), ``stop``, ``totals`` and
-    ``write(directory)``, which writes the command-line tool's files.
+    Returns
+    -------
+    Adapt
+        ``rows`` (the rows of ``adapt.csv``), ``to_pandas()``, ``result`` (the final
+        step's :class:`Result`, with ``estimator``), ``mesh``, ``estimator``, ``stop``,
+        ``totals`` and ``write(directory)``.
 
-    Raises ``ValueError`` for bad data (``[adapt]`` settings included: ``theta`` outside
-    (0, 1], ``steps`` < 1, ``max_vertices`` below the start mesh) and for a case without
-    ``[adapt]`` or with a ``[sweep]`` or load cases. A step the settings do not accept
-    ends the loop: with ``check`` that raises :class:`SolverError` (its ``result`` is that
-    step's); ``check=False`` returns the loop instead."""
+    Raises
+    ------
+    ValueError
+        Bad data (``[adapt]`` settings included), a case without ``[adapt]`` or with steps.
+    TypeError
+        A value of the wrong kind.
+    SolverError
+        A step the settings do not accept (with ``check``; its ``result`` is that step's).
+    """
     if mesh is not None:
-        if not isinstance(case, Mapping):
-            raise TypeError("with mesh, give the case's data as a dict (its sections but mesh)")
-        a = _native.adapt_on(mesh, dict(case), "mesh")
+        if not isinstance(mesh, Mesh):
+            raise TypeError(f"mesh: give a memcontact.Mesh, got {type(mesh).__name__}")
+        data, label, replaced = _case_data(case)
+        if "mesh" in data and not replaced:
+            raise ValueError(
+                "mesh: the case has a [mesh] section and mesh= gives a mesh: leave one out"
+            )
+        a = _native.adapt_on(mesh, _bind(data, mesh), label)
     else:
         a = _native.adapt(_as_case(case))
     for note in a.result.warnings:
@@ -287,20 +749,35 @@ def adapt(case: CaseLike, *, mesh: Optional[Mesh] = None, check: bool = True) ->
 
 def sweep(case: CaseLike, warm: bool = True, *, check: bool = True) -> Sweep:
     """Solves the steps of a case with a ``[sweep]`` (one parameter over a list of values)
-    or ``[[load_case]]`` entries in turn on one mesh, as ``memcontact solve`` does: each
-    step is warm-started from the previous answer (``warm=False``: each from the usual
-    start), with the GIL released.
+    or ``[[load_case]]`` entries in turn on one mesh, as ``memcontact solve`` does, with
+    the GIL released.
 
-    Returns a :class:`Sweep`: ``results`` (one :class:`Result` per step), ``rows`` (the
-    rows of ``sweep.csv``: step, name, value, max_deflection, contact_area, liftoff_area,
-    total_contact_force, max_pressure, energy, iterations, kkt_residual, seconds), and
-    ``write(directory)``, which writes the command-line tool's files (a directory per
-    step, ``sweep.csv``, ``sweep.png``).
+    Parameters
+    ----------
+    case : Case, dict or path
+        The case.
+    warm : bool
+        Start each step from the previous answer (default); ``False``: each from the
+        usual start.
+    check : bool
+        Raise :class:`SolverError` when a step is not accepted (default); ``False``
+        returns the shorter sweep.
 
-    Raises ``ValueError`` for bad data (every load case's data is checked on the mesh
-    before the first step is solved). A step the settings do not accept ends the sweep:
-    with ``check`` that raises :class:`SolverError` (its ``sweep`` holds the steps solved,
-    its ``result`` the failed one); ``check=False`` returns the shorter sweep instead."""
+    Returns
+    -------
+    Sweep
+        ``results`` (one :class:`Result` per step), ``rows`` (the rows of ``sweep.csv``),
+        ``to_pandas()`` and ``write(directory)`` (a directory per step, ``sweep.csv``,
+        ``sweep.png``).
+
+    Raises
+    ------
+    ValueError
+        Bad data (every load case's data is checked on the mesh before the first step).
+    SolverError
+        A step the settings do not accept (with ``check``; its ``sweep`` holds the steps
+        solved, its ``result`` the failed one).
+    """
     s = _native.sweep(_as_case(case), bool(warm))
     results = s.results
     if results:
@@ -319,26 +796,44 @@ def convergence(
     h_sweep: bool = False,
     h_values: Optional[Sequence[float]] = None,
 ) -> Study:
-    """The convergence study of a case, as ``memcontact convergence`` runs it (the same
-    options as keywords): the case's mesh (level 0) and ``levels`` successive uniform
-    refinements, each solved and measured against the exact solution of the case's
-    ``[exact]`` section (without one, against the finest level's solution), with the GIL
-    released. ``compare="foundation"`` (consistent against lumped L) or ``"sampling"``
-    (nodal against mollified φ) studies both variants; ``h_sweep=True`` runs the rigid
-    limit instead, on the case's mesh refined ``levels`` times, with the stiffnesses
-    ``h_values`` (default 10, 10², …, 10⁶).
+    """The convergence study of a case, as ``memcontact convergence`` runs it, with the GIL
+    released: the case's mesh (level 0) and ``levels`` successive uniform refinements,
+    each solved and measured against the exact solution of the case's ``[exact]`` section
+    (without one, against the finest level's solution).
 
-    Returns a :class:`Study`: ``rows`` (one dict per level keyed by the columns of
-    ``convergence.csv``, or of ``h_sweep.csv`` for the rigid limit; a missing value is
-    None), ``variants`` (the rows of every variant by file name), ``exact``, and
-    ``write(directory)``, which writes the command-line tool's files. Raises
-    ``ValueError`` for bad data."""
+    Parameters
+    ----------
+    case : Case, dict or path
+        The case.
+    levels : int
+        Refinements.
+    compare : {"foundation", "sampling"}, optional
+        Study both variants: consistent against lumped L, or nodal against mollified φ.
+    h_sweep : bool
+        Run the rigid limit instead, on the case's mesh refined ``levels`` times.
+    h_values : sequence of float, optional
+        The stiffnesses of the rigid limit (default 10, 10², …, 10⁶).
+
+    Returns
+    -------
+    Study
+        ``rows`` (the rows of ``convergence.csv`` or ``h_sweep.csv``; a missing value is
+        None), ``columns``, ``variants``, ``to_pandas()``, ``exact`` and
+        ``write(directory)``.
+
+    Raises
+    ------
+    ValueError
+        Bad data or options.
+    """
+    if compare is not None and not isinstance(compare, str):
+        raise TypeError(f"compare: a string is needed, got {type(compare).__name__}")
     s = _native.convergence(
         _as_case(case),
-        int(levels),
+        _int(levels, "levels"),
         compare,
         bool(h_sweep),
-        None if h_values is None else [float(h) for h in h_values],
+        None if h_values is None else [_float(h, "h_values") for h in h_values],
     )
     for note in s.warnings:
         warnings.warn(note, stacklevel=2)
@@ -402,28 +897,53 @@ def solve_mesh(
     lower_sampling: str = "nodal",
     check: bool = True,
 ) -> Result:
-    """Solves the membrane problem on a mesh given as arrays (``vertices`` (n, 2),
-    ``triangles`` (m, 3), optional ``regions`` (m,) tags and ``region_names``) or as a
-    :class:`Mesh` (then ``triangles`` is left out and its levels serve multigrid).
+    """Deprecated: use :func:`solve` with ``mesh=`` and the sections.
 
-    ``tension`` is t > 0; ``load`` f, ``shape`` φ and ``stiffness`` h (or ``"rigid"``) are
-    numbers, expressions of x and y, dicts of region names (or tags) to those, or NumPy
-    arrays of one value per vertex: their P1 interpolant enters the quadrature of f and h,
-    and φ's values are its samples (nodal sampling only). A stiffness dict may make some
-    regions ``"rigid"`` and others elastic.
-    ``foundation`` is ``"consistent"`` or ``"lumped"``, ``sampling`` ``"nodal"`` or
-    ``"mollified"`` (with ``epsilon``), ``method`` one of ``auto``, ``linear``,
-    ``active-set``, ``qp``, ``coordinate``, ``multigrid``.
+    ``solve_mesh(mesh, tension=t, load=f, shape=φ, stiffness=h, ...)`` is
+    ``solve(mesh=mesh, membrane=Membrane(t, f), obstacle=Obstacle(φ, h, ...),
+    boundary=Boundary(...), lower=Lower(...), solver=Solver(...))``; it is kept for a
+    deprecation period and warns.
 
-    Beyond the paper's frame: ``boundary_height`` g (the same kinds of data, a dict keyed
-    by boundary region names such as ``"left"``, or an array) fixes u = g on the boundary
-    except on the boundary regions listed in ``free``; ``lower_shape`` and
-    ``lower_stiffness`` (with ``lower_foundation``, ``lower_sampling``) add a body below
-    the membrane, whose fields the result gives as ``phi_low``, ``pressure_low``, ...
+    Parameters
+    ----------
+    vertices : Mesh or array_like, shape (n, 2)
+        A :class:`Mesh`, or the vertices (then ``triangles`` and optionally ``regions``
+        and ``region_names`` give the rest of the mesh).
+    triangles : array_like, shape (m, 3), optional
+        Vertex indices of the triangles.
+    tension, load, shape, stiffness, foundation, sampling, epsilon : optional
+        The keys of ``[membrane]`` and ``[obstacle]``.
+    method, tolerance, max_iterations : optional
+        The keys of ``[solver]``.
+    regions, region_names : optional
+        Region tags per triangle and their names.
+    boundary_height, free : optional
+        The keys of ``[boundary]``.
+    lower_shape, lower_stiffness, lower_foundation, lower_sampling : optional
+        The keys of ``[lower]``.
+    check : bool
+        As in :func:`solve`.
 
-    Raises ``ValueError`` naming the argument for bad data and :class:`SolverError` when
-    the certificate does not reach ``tolerance`` (``check=False`` returns the result
-    instead)."""
+    Returns
+    -------
+    Result
+        The result.
+
+    Raises
+    ------
+    ValueError
+        Bad data, naming the argument.
+    TypeError
+        Inconsistent arguments.
+    SolverError
+        As in :func:`solve`.
+    """
+    warnings.warn(
+        "solve_mesh is deprecated: use memcontact.solve(mesh=..., membrane=Membrane(...), "
+        "obstacle=Obstacle(...), ...)",
+        DeprecationWarning,
+        stacklevel=2,
+    )
     if isinstance(vertices, Mesh):
         if triangles is not None or regions is not None or region_names is not None:
             raise TypeError("give either a Mesh or vertices and triangles, not both")
@@ -434,60 +954,27 @@ def solve_mesh(
         mesh = Mesh(vertices, triangles, regions, region_names)
     if (lower_shape is None) != (lower_stiffness is None):
         raise TypeError("a body below needs both lower_shape and lower_stiffness")
-    # NumPy arrays (one value per vertex) go to the library as they are.
-    given: Dict[str, Any] = {"load": load, "shape": shape, "stiffness": stiffness}
-    if boundary_height is not None:
-        given["height"] = boundary_height
-    if lower_shape is not None:
-        given["lower_shape"] = lower_shape
-        given["lower_stiffness"] = lower_stiffness
-    for name, value in given.items():
-        if isinstance(value, np.ndarray):
-            a = np.ascontiguousarray(value, dtype=np.float64)
-            if a.ndim != 1 or a.shape[0] != mesh.n_vertices:
-                raise ValueError(
-                    f"{name}: nodal values must have shape ({mesh.n_vertices},), one per "
-                    f"vertex, got shape {value.shape}"
-                )
-            given[name] = a
-    obstacle: Dict[str, Any] = {
-        "shape": given["shape"],
-        "stiffness": given["stiffness"],
-        "foundation": foundation,
-        "sampling": sampling,
-    }
-    if epsilon is not None:
-        obstacle["epsilon"] = epsilon
-    solver: Dict[str, Any] = {"method": method, "tolerance": tolerance}
-    if max_iterations is not None:
-        solver["max_iterations"] = max_iterations
+    if isinstance(free, str):
+        raise TypeError("free: give a list of boundary region names")
     data: Dict[str, Any] = {
-        "membrane": {"tension": tension, "load": given["load"]},
-        "obstacle": obstacle,
-        "solver": solver,
+        "membrane": {"tension": tension, "load": load},
+        "obstacle": Obstacle(shape, stiffness, foundation, sampling, epsilon).to_dict(),
+        "solver": Solver(method=method, tolerance=tolerance,
+                         max_iterations=max_iterations).to_dict(),
     }
     if boundary_height is not None or free:
-        boundary: Dict[str, Any] = {}
-        if boundary_height is not None:
-            boundary["height"] = given["height"]
-        if free:
-            if isinstance(free, str):
-                raise TypeError("free: give a list of boundary region names")
-            boundary["free"] = [str(f) for f in free]
-        data["boundary"] = boundary
+        data["boundary"] = Boundary(
+            boundary_height, [str(f) for f in free] if free else None
+        ).to_dict()
     if lower_shape is not None:
-        data["lower"] = {
-            "shape": given["lower_shape"],
-            "stiffness": given["lower_stiffness"],
-            "foundation": lower_foundation,
-            "sampling": lower_sampling,
-        }
+        data["lower"] = Lower(
+            lower_shape, lower_stiffness, lower_foundation, lower_sampling  # type: ignore[arg-type]
+        ).to_dict()
     # Errors name the case's keys; this function's arguments are named after them.
     try:
-        result = _native.solve_on(mesh, data, "mesh")
-    except ValueError as e:
-        raise ValueError(_rename_keys(str(e))) from None
-    return _check(result) if check else result
+        return solve(data, mesh=mesh, check=check)
+    except (ValueError, TypeError) as e:
+        raise type(e)(_rename_keys(str(e))) from None
 
 
 def solve_many(
@@ -498,15 +985,33 @@ def solve_many(
 ) -> List[Result]:
     """Solves every case and returns the results in the order of ``cases``.
 
-    ``executor`` is anything with the ``concurrent.futures`` interface (``submit``
-    returning futures with ``result()``): a ``ProcessPoolExecutor``, a
-    ``dask.distributed.Client`` (a ``LocalCluster`` or a Slurm cluster of
-    dask-jobqueue), Ray's or submitit's executors. Without one the cases are solved here,
-    one after the other (each solve uses all cores). Cases and results pickle, so they
-    cross processes and machines; mesh files must be readable where the case is solved.
+    Parameters
+    ----------
+    cases : iterable of Case, dict or path
+        The cases (each with its ``[mesh]``).
+    executor : optional
+        Anything with the ``concurrent.futures`` interface (``submit`` returning futures
+        with ``result()``): a ``ProcessPoolExecutor``, a ``dask.distributed.Client`` (a
+        ``LocalCluster`` or a Slurm cluster of dask-jobqueue), Ray's or submitit's
+        executors. Without one the cases are solved here, one after the other (each solve
+        uses all cores). Cases and results pickle; mesh files must be readable where the
+        case is solved.
+    check : bool
+        Raise the :class:`SolverError` of a case that does not converge (the remaining
+        futures are cancelled); ``False`` returns its result instead.
 
-    With ``check`` a case that does not converge raises its :class:`SolverError` (the
-    remaining futures are cancelled); ``check=False`` returns its result instead."""
+    Returns
+    -------
+    list of Result
+        In the order of ``cases``.
+
+    Raises
+    ------
+    ValueError
+        Bad data in a case.
+    SolverError
+        A case that does not converge (with ``check``).
+    """
     prepared = [_as_case(c) for c in cases]
     fn: Callable[[Case], Result] = solve if check else _solve_any
     if executor is None:

@@ -124,6 +124,24 @@ impl From<Case> for CaseFile {
 }
 
 impl Case {
+    /// A case of `problem` alone: the default `[solver]`, `[output]` and `[units]`, no
+    /// steps, no adaptive loop, no exact solution, no sensors, sensitivities or fit.
+    pub fn new(problem: Problem) -> Case {
+        Case {
+            problem,
+            settings: Settings::default(),
+            output: OutputOptions::default(),
+            exact: None,
+            units: Units::default(),
+            sweep: None,
+            load_cases: Vec::new(),
+            adapt: None,
+            sensors: Vec::new(),
+            sensitivity: None,
+            fit: None,
+        }
+    }
+
     /// Whether the case has steps to solve in turn (a `[sweep]` or `[[load_case]]`
     /// entries): then it is run by [`crate::run::run_sweep`], not [`crate::run::run`].
     pub fn is_sweep(&self) -> bool {
@@ -213,6 +231,59 @@ impl Case {
         Ok(case)
     }
 
+    /// Parses a fragment of a case file (some sections or keys, as the documentation shows
+    /// them): the keys and values it gives are checked as in a whole case, on top of the
+    /// fewest keys that complete it (a small rectangle mesh, or the generator its `[mesh]`
+    /// keys name; tension, load, shape and stiffness 1). Nothing that needs the mesh is
+    /// checked. `memcontact check --fragment` calls it.
+    pub fn from_fragment_str(text: &str, file: Option<&Path>) -> Result<Case> {
+        let table: toml::Table = toml::from_str(text).map_err(|e| Error::Case {
+            file: file.map(Path::to_path_buf),
+            line: e.span().map(|s| line_of(text, s.start)),
+            key: String::new(),
+            message: format!("malformed TOML: {}", e.message().trim()),
+        })?;
+        let section = |name: &str| table.get(name).and_then(toml::Value::as_table);
+        let has = |name: &str, key: &str| section(name).is_some_and(|t| t.contains_key(key));
+        let mut fill: Vec<String> = Vec::new();
+        if !(has("mesh", "file") || has("mesh", "generator") || has("mesh", "given")) {
+            let any = |keys: &[&str]| keys.iter().any(|k| has("mesh", k));
+            if any(&["outer", "holes", "regions", "min_angle"]) {
+                fill.push("mesh.generator=\"polygon\"".into());
+                if !has("mesh", "outer") {
+                    fill.push("mesh.outer=[[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]]".into());
+                }
+                if !has("mesh", "size") {
+                    fill.push("mesh.size=0.5".into());
+                }
+            } else if any(&["center", "radius", "size"]) {
+                fill.push("mesh.generator=\"disk\"".into());
+            } else {
+                fill.push("mesh.generator=\"rectangle\"".into());
+                if !has("mesh", "nx") {
+                    fill.push("mesh.nx=2".into());
+                }
+            }
+        }
+        for (name, key) in [
+            ("membrane", "tension"),
+            ("membrane", "load"),
+            ("obstacle", "shape"),
+            ("obstacle", "stiffness"),
+        ] {
+            if !has(name, key) {
+                fill.push(format!("{name}.{key}=1.0"));
+            }
+        }
+        let whole = apply_overrides(text, &fill).map_err(|(key, message)| Error::Case {
+            file: file.map(Path::to_path_buf),
+            line: None,
+            key,
+            message,
+        })?;
+        Case::from_toml_str(&whole, file)
+    }
+
     /// Reads a case file (a regular file of at most [`crate::io::input::CASE_FILE_CAP`] bytes), applies
     /// `key=value` overrides (dotted keys, TOML values; a value that is not TOML is taken
     /// as a string) and parses it; relative paths are relative to the case file.
@@ -227,14 +298,28 @@ impl Case {
         Case::from_toml_str(&text, Some(path))
     }
 
+    /// Reads a fragment of a case file ([`Case::from_fragment_str`]), with overrides as
+    /// [`Case::load`] applies them.
+    pub fn load_fragment(path: &Path, overrides: &[String]) -> Result<Case> {
+        let text = read_case_text(path)?;
+        let text = apply_overrides(&text, overrides).map_err(|(key, message)| Error::Case {
+            file: Some(path.to_path_buf()),
+            line: None,
+            key,
+            message,
+        })?;
+        Case::from_fragment_str(&text, Some(path))
+    }
+
     /// The case as TOML text (round-trips through [`Case::from_toml_str`]).
     pub fn to_toml_string(&self) -> Result<String> {
         toml::to_string(self).map_err(|e| Error::Data(format!("cannot write the case: {e}")))
     }
 }
 
-/// Reads a case file: a regular file, at most [`crate::io::input::CASE_FILE_CAP`] bytes, UTF-8.
-fn read_case_text(path: &Path) -> Result<String> {
+/// Reads a case file's text: a regular file, at most [`CASE_FILE_CAP`](super::CASE_FILE_CAP)
+/// bytes, UTF-8 (errors name the file).
+pub fn read_case_text(path: &Path) -> Result<String> {
     let bytes = crate::io::input::read_input(path, crate::io::input::CASE_FILE)?;
     String::from_utf8(bytes).map_err(|e| Error::File {
         path: path.to_path_buf(),

@@ -4,15 +4,16 @@
 //!
 //! A [`Case`] is a [`crate::problem::Problem`], the solver [`crate::solve::Settings`], the
 //! [`OutputOptions`], the [`ExactSpec`] of a closed-form solution for convergence studies,
-//! the steps of a load sweep or of load combinations, and the sensors, sensitivities and
-//! fit of [`sensitivity`].
+//! the steps of a load sweep or of load combinations, and the [`Sensor`]s, the
+//! [`SensitivitySpec`] and the [`FitSpec`] of a sensitivity run or a fit.
 
 mod adapt;
 mod exact;
 mod file;
+pub mod keys;
 mod output;
 mod overrides;
-pub mod sensitivity;
+pub(crate) mod sensitivity;
 mod sweep;
 #[cfg(test)]
 mod tests;
@@ -20,7 +21,7 @@ mod tests;
 pub use crate::io::input::CASE_FILE_CAP;
 pub use adapt::AdaptSpec;
 pub use exact::{BenchmarkBody, ExactSpec, ManufacturedDomain, ManufacturedForm};
-pub use file::{steps, Case};
+pub use file::{read_case_text, steps, Case};
 pub use output::{OutputOptions, PictureKind, Units, VtuFormat};
 pub use overrides::apply_overrides;
 pub use sensitivity::{

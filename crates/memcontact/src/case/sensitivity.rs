@@ -315,7 +315,7 @@ fn field_kind(target: ParameterTarget, f: &Field) -> (ParameterKind, f64) {
 
 impl ParameterKey {
     /// Parses `key` against the case's problem. Errors name the key and list the valid
-    /// ones ([`valid_keys`]).
+    /// ones.
     pub fn parse(problem: &Problem, key: &str) -> std::result::Result<ParameterKey, String> {
         let unknown = || {
             format!(

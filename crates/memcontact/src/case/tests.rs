@@ -113,3 +113,40 @@ fn overrides_keep_the_other_lines() {
     assert!(apply_overrides(DISK, &["nokey".into()]).is_err());
     assert!(apply_overrides(DISK, &["mesh..x=1".into()]).is_err());
 }
+
+#[test]
+fn a_fragment_is_checked_on_top_of_the_fewest_keys_that_complete_it() {
+    // Valid fragments: a section alone, keys of a generator without its name, an array of
+    // tables.
+    for text in [
+        "[obstacle]\nfoundation = \"lumped\"\n",
+        "[mesh]\nnx = 64\nny = 32\n",
+        "[mesh]\nradius = 2.0\nsize = 0.5\n",
+        "[mesh]\nouter = [[0.0, 0.0], [2.0, 0.0], [0.0, 2.0]]\n",
+        "[[load_case]]\nname = \"dead\"\n\n[[load_case]]\nname = \"snow\"\nload_factor = 1.35\n",
+        "[adapt]\ntheta = 0.6\n",
+        "[lower]\nshape = -0.1\nstiffness = \"rigid\"\n",
+    ] {
+        let case = Case::from_fragment_str(text, None).unwrap_or_else(|e| panic!("{text}: {e}"));
+        assert_eq!(case.problem.membrane.tension, 1.0, "{text}");
+    }
+    // Invalid fragments keep their errors, named by key.
+    for (text, key) in [
+        (
+            "[obstacle]\nfoundation = \"lumpy\"\n",
+            "obstacle.foundation",
+        ),
+        ("[adapt]\ntheta = 1.5\n", "adapt.theta"),
+        ("[solver]\ntolerance = 0.5\n", "solver.tolerance"),
+        ("[mesh]\nnx = 4\nradius = 1.0\n", "mesh"),
+        ("[membrane]\ntension = -1.0\n", "membrane.tension"),
+        ("[units]\nlength = \"m\"\nmass = \"kg\"\n", "units"),
+    ] {
+        let e = Case::from_fragment_str(text, None).unwrap_err().to_string();
+        assert!(e.contains(key), "{text}: {e}");
+    }
+    assert!(Case::from_fragment_str("[obstacle\n", None)
+        .unwrap_err()
+        .to_string()
+        .contains("malformed TOML"));
+}

@@ -3,10 +3,13 @@
 //! sweeps reuse it.
 
 mod binding;
+pub(crate) mod case_checks;
 mod discrete;
 mod meshing;
+#[cfg(test)]
+mod ordering_tests;
 
-pub(crate) use binding::bind_height;
-pub use binding::{assemble_model, bind_and_check, BoundBody, BoundData};
+pub(crate) use binding::{assemble_model, bind_and_check, bind_height, BoundData};
+pub(crate) use case_checks::check_case_on_mesh;
 pub use discrete::{Discretization, Phase};
-pub use meshing::build_mesh;
+pub(crate) use meshing::build_mesh;

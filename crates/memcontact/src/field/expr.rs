@@ -49,10 +49,10 @@ const INLINE_STACK: usize = 24;
 /// A compiled scalar expression of `x` and `y`.
 ///
 /// Parse with [`Expr::parse`] (or `str::parse`), evaluate with [`Expr::eval`]. The grammar
-/// is described in the [module documentation](self).
+/// is that of the case file (docs/case-file/index.md#expressions).
 ///
 /// ```
-/// use memcontact::field::expr::Expr;
+/// use memcontact::field::Expr;
 /// let e = Expr::parse("0.5 + 0.1*sin(2*pi*x)*cos(2*pi*y)").unwrap();
 /// assert!((e.eval(0.25, 0.0) - 0.6).abs() < 1e-15);
 /// assert_eq!(Expr::parse("2^10 - 24").unwrap().constant_value(), Some(1000.0));

@@ -192,11 +192,6 @@ impl NodalP1 {
         }
         (best.0 >= -1e-9).then_some((best.2, best.1))
     }
-
-    /// The values at the vertices.
-    pub fn values(&self) -> &[f64] {
-        &self.values
-    }
 }
 
 #[cfg(test)]

@@ -103,7 +103,7 @@ pub fn parse_measurements(text: &str) -> std::result::Result<Vec<Sensor>, (usize
     Ok(out)
 }
 
-/// Reads a measurements file (a regular file of at most [`MEASUREMENTS_CAP`] bytes,
+/// Reads a measurements file (a regular file of at most 16 MiB,
 /// UTF-8); errors name the file, the line and the key `fit.measurements`.
 pub fn read_measurements(path: &Path) -> Result<Vec<Sensor>> {
     let kind = crate::io::input::InputKind {

@@ -1,16 +1,17 @@
-//! Back-analysis (docs/theory.md#sensitivities): case parameters fitted to measured
+//! Back-analysis (docs/theory.md#back-analysis): case parameters fitted to measured
 //! deflections by minimising `½ Σₖ ((Qₖ(p) − mₖ)/σₖ)² (+ ½ α ‖ln p − ln p₀‖²)` over
 //! bounds, in `q = ln p` for positive parameters, with the exact Jacobian of the sensors'
-//! deflections from tangent solves ([`crate::sensitivity`]). Here: the optimiser
-//! ([`optimizer`], bounded Levenberg-Marquardt), the measurements file ([`measurements`])
-//! and the statistics of the answer ([`statistics`]: covariance `σ̂² (JᵀWJ)⁻¹`, standard
-//! errors, correlations, the singular values of the scaled Jacobian and the
-//! identifiability warning). [`crate::run::run_fit`] runs the fit.
+//! deflections from tangent solves ([`crate::sensitivity`]). Here: the optimiser (bounded
+//! Levenberg-Marquardt), the measurements file ([`parse_measurements`]) and the
+//! statistics of the answer ([`Statistics`]: covariance `σ̂² (JᵀWJ)⁻¹`, standard errors,
+//! correlations, the singular values of the scaled Jacobian and the identifiability
+//! warning). [`crate::run::run_fit`] runs the fit.
 
-pub mod measurements;
-pub mod optimizer;
+pub(crate) mod measurements;
+pub(crate) mod optimizer;
 
-pub use optimizer::{Iterate, Stop};
+pub use measurements::{parse_measurements, read_measurements};
+pub use optimizer::Stop;
 
 /// A condition number of the scaled Jacobian above this means the measurements cannot tell
 /// the parameters apart.
@@ -44,7 +45,7 @@ pub struct Statistics {
 /// weighted residuals `r` in the fitted variables x (ln p where `log[j]`), `p` the
 /// parameters, `sigmas_given` whether every measurement has its σ, `prior` the weight α,
 /// `names` the parameters' keys (for the warning).
-pub fn statistics(
+pub(crate) fn statistics(
     jacobian: &[f64],
     r: &[f64],
     p: &[f64],
@@ -133,13 +134,13 @@ pub fn statistics(
     for j in 0..n {
         for k in j + 1..n {
             let c = correlation[j * n + k];
-            if !(c.abs() <= worst.0) {
+            if c.is_nan() || c.abs() > worst.0 {
                 worst = (if c.is_nan() { 1.0 } else { c.abs() }, j, k);
             }
         }
     }
     let mut reasons = Vec::new();
-    if !(condition_number <= CONDITION_LIMIT) {
+    if condition_number.is_nan() || condition_number > CONDITION_LIMIT {
         reasons.push(format!(
             "the scaled Jacobian's condition number is {condition_number:.2e} (above {CONDITION_LIMIT:.0e})"
         ));

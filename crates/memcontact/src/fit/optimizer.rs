@@ -1,5 +1,5 @@
 //! Bounded Levenberg-Marquardt on a small least-squares problem
-//! `min ½ ‖r(x)‖² + ½ α ‖x − x₀‖²` over a box (docs/theory.md#sensitivities): the exact
+//! `min ½ ‖r(x)‖² + ½ α ‖x − x₀‖²` over a box (docs/theory.md#back-analysis): the exact
 //! Jacobian from the caller, a Marquardt-scaled damping updated by the gain ratio
 //! (Nielsen's rule), steps limited to a trust radius in the variables (1 at the start: a
 //! factor e on a logarithmic variable; doubled after a step the model predicted well,
@@ -100,8 +100,6 @@ pub struct Minimum {
     pub history: Vec<Iterate>,
     /// Why it stopped.
     pub stop: Stop,
-    /// Model evaluations.
-    pub evaluations: usize,
 }
 
 /// Minimises `½ ‖r(x)‖² + ½ α ‖x − x₀‖²` over `lo ≤ x ≤ hi` from `x0` (see the module
@@ -296,7 +294,6 @@ pub fn minimize(
     if !model_at_x {
         // The model's last evaluation was a rejected trial: back to the best point.
         r = model.residuals(&x)?;
-        evaluations += 1;
         jac = model.jacobian()?;
     }
     Ok(Minimum {
@@ -306,7 +303,6 @@ pub fn minimize(
         cost,
         history,
         stop,
-        evaluations,
     })
 }
 

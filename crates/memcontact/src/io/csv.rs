@@ -91,45 +91,6 @@ fn format_rows(columns: &[(&str, DataArray)], range: std::ops::Range<usize>) -> 
     buf
 }
 
-/// Writes a small table: the `header` row, then every row of `rows`, each of which must have
-/// as many values as the header ([`Error::Data`] naming the row otherwise). NaN is written as
-/// an empty field (see the module documentation).
-pub fn write_table_csv(path: &Path, header: &[&str], rows: &[Vec<f64>]) -> Result<()> {
-    if let Some((i, row)) = rows
-        .iter()
-        .enumerate()
-        .find(|(_, r)| r.len() != header.len())
-    {
-        return Err(Error::Data(format!(
-            "CSV table row {i} has {} values, the header has {} columns",
-            row.len(),
-            header.len()
-        )));
-    }
-    crate::io::write_atomic(path, |w| {
-        let mut buf = Vec::with_capacity(CHUNK + 4096);
-        push_header(&mut buf, header);
-        for row in rows {
-            for (k, &x) in row.iter().enumerate() {
-                if k > 0 {
-                    buf.push(b',');
-                }
-                push_f64(&mut buf, x);
-            }
-            buf.push(b'\n');
-            if buf.len() >= CHUNK {
-                w.write_all(&buf)?;
-                buf.clear();
-            }
-        }
-        w.write_all(&buf)
-    })
-    .map(|_| ())
-}
-
-/// Size of the staging buffer, in bytes.
-const CHUNK: usize = 1 << 16;
-
 fn push_header(buf: &mut Vec<u8>, names: &[&str]) {
     for (k, name) in names.iter().enumerate() {
         if k > 0 {
@@ -304,32 +265,9 @@ pub(crate) mod tests {
             "{e}"
         );
         assert!(write_columns_csv(&path, &[]).is_err());
-        let e = write_table_csv(&path, &["x", "y"], &[vec![1.0, 2.0], vec![3.0]]).unwrap_err();
-        assert!(matches!(&e, Error::Data(m) if m.contains("row 1")), "{e}");
         assert!(!path.exists());
     }
 
-    #[test]
-    fn table_round_trips_with_nan_as_empty() {
-        let rows = vec![
-            vec![0.5, 1.0 / 3.0, f64::NAN],
-            vec![1e20, f64::INFINITY, 2.0],
-        ];
-        let path = tmp("table.csv");
-        write_table_csv(&path, &["h", "error", "rate"], &rows).unwrap();
-        let text = std::fs::read_to_string(&path).unwrap();
-        let lines: Vec<&str> = text.lines().collect();
-        assert_eq!(lines[0], "h,error,rate");
-        assert_eq!(lines[1], "0.5,0.3333333333333333,");
-        assert_eq!(lines[2], "1e20,inf,2.0");
-        for (line, row) in lines[1..].iter().zip(&rows) {
-            let back: Vec<f64> = line.split(',').map(parse).collect();
-            assert!(back.iter().zip(row).all(|(x, y)| same(*x, *y)));
-        }
-        std::fs::remove_file(&path).unwrap();
-    }
-
-    /// Release-mode timing: `cargo test --release -p memcontact csv_speed -- --ignored --nocapture`.
     #[test]
     #[ignore]
     fn csv_speed_one_million_rows() {

@@ -1,13 +1,13 @@
 //! Readers and writers: Gmsh meshes in, VTU / CSV / JSON out. Plain functions over library types.
 
 mod atomic;
-pub mod csv;
+pub(crate) mod csv;
 mod direct_writer;
 pub mod gmsh;
-pub mod input;
-pub mod json;
-pub mod numbers;
-pub mod result_set;
+pub(crate) mod input;
+pub(crate) mod json;
+pub(crate) mod numbers;
+pub(crate) mod result_set;
 pub mod vtu;
 pub use atomic::{write_atomic, Written};
 

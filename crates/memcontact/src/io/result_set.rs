@@ -153,11 +153,6 @@ impl ResultSet {
         &self.staging
     }
 
-    /// The directory the set will replace.
-    pub fn target(&self) -> &Path {
-        &self.target
-    }
-
     /// Flushes the staged files to disk and moves the set into place in one step,
     /// replacing what was there as a whole.
     pub fn commit(mut self) -> Result<()> {

@@ -1,14 +1,11 @@
 //! Triangular meshes: the type, its checks and quality report, the boundary and the map
 //! between vertices and unknowns (SPEC §2: the unknowns are the interior vertices).
 
-pub mod bisect;
-pub mod boundary;
+pub(crate) mod boundary;
 pub mod generate;
-pub mod mark;
 pub mod refine;
-pub mod regions;
-pub mod reorder;
-pub mod segment;
+pub(crate) mod regions;
+pub(crate) mod reorder;
 
 pub use boundary::BoundaryRegions;
 

@@ -1,12 +1,13 @@
-//! A run with `[fit]`: case parameters fitted to measured deflections (docs/theory.md#
-//! sensitivities). The mesh is built and the model assembled once; every parameter enters
-//! the model linearly, so an iterate's model is the start's moved by the parameters'
-//! derivative data ([`crate::sensitivity::parameters::DataDerivative::move_model`]), solved
-//! warm from the previous answer; the Jacobian of the sensors' deflections comes from
-//! tangent solves on the certified active set. The optimiser is [`crate::fit::optimizer`].
+//! A run with `[fit]`: case parameters fitted to measured deflections
+//! (docs/theory.md#back-analysis). The mesh is built and the model assembled once;
+//! every parameter enters the model linearly, so an iterate's model is the start's
+//! moved by the parameters' derivative data
+//! ([`crate::sensitivity::parameters::DataDerivative::move_model`]), solved warm from
+//! the previous answer; the Jacobian of the sensors' deflections comes from tangent
+//! solves on the certified active set. The optimiser is [`crate::fit::optimizer`].
 
-use super::checks::check_case_on_mesh;
 use crate::case::{Case, ParameterKey, Sensor};
+use crate::discretization::check_case_on_mesh;
 use crate::discretization::Discretization;
 use crate::error::{Error, Invalid, Result};
 use crate::fit::{optimizer, statistics, FitIteration, FitResult, Fitted, FittedParameter};
@@ -24,6 +25,10 @@ pub const JACOBIAN_TOLERANCE: f64 = 1e-3;
 /// The tightest relative residual of a fit's tangent solves (at the answer, where the
 /// Jacobian also gives the statistics).
 pub const JACOBIAN_TOLERANCE_FINAL: f64 = 1e-10;
+
+/// Where a fit's Jacobian was computed: the parameters, the answer (over the unknowns)
+/// and its tangents dU/dp, one per parameter.
+type Anchor = (Vec<f64>, Vec<f64>, Vec<Vec<f64>>);
 
 /// A fit's model: the residuals `(Q(p) − m)/σ` of the measured deflections and their
 /// Jacobian in the parameters p (physical units), one warm-started solve per new p. The
@@ -47,7 +52,7 @@ pub struct FitProblem {
     /// Where the Jacobian was last computed: the parameters, the answer and its tangents
     /// dU/dp; the next solves start from the first-order prediction
     /// `U + Σⱼ (dU/dpⱼ) (p − p₀)ⱼ`.
-    anchor: Option<(Vec<f64>, Vec<f64>, Vec<Vec<f64>>)>,
+    anchor: Option<Anchor>,
     solves: usize,
     /// Seconds in forward solves, and in derivatives.
     seconds: (f64, f64),
@@ -448,10 +453,7 @@ pub struct FitRun {
 /// a start whose solve is not accepted, are errors.
 pub fn run_fit(case: &Case, observer: &mut dyn Observer) -> Result<FitRun> {
     let t0 = Instant::now();
-    let observer = &mut solve::Cancellable {
-        inner: observer,
-        cancel: &case.settings.cancel,
-    };
+    let observer = &mut solve::Cancellable::new(observer, &case.settings.cancel);
     let mut problem = FitProblem::new(case, observer)?;
     let spec = case.fit.as_ref().expect("validated");
     let p0 = problem.start();

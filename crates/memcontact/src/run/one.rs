@@ -1,15 +1,14 @@
 //! One run: a problem solved on its discretisation, by the method the settings name or the
 //! one `auto` picks, checked before anyone reports or writes it.
 
-use super::checks::check_case_on_mesh;
 use crate::case::Case;
-use crate::discretization::{Discretization, Phase};
-use crate::error::Error;
-use crate::error::{Invalid, Result};
+use crate::discretization::{check_case_on_mesh, Discretization, Phase};
+use crate::error::{Error, Invalid, Result};
 use crate::outcome::fields::derive_from;
-use crate::outcome::{Outcome, Report};
-use crate::problem::Problem;
-use crate::solve::{self, Choice, Method, Observer, Settings};
+use crate::outcome::{Outcome, Report, Summary};
+use crate::solve::{self, Cancellable, Choice, Method, Observer, Settings};
+use crate::write::WriteOptions;
+use std::path::Path;
 use std::time::Instant;
 
 impl Discretization {
@@ -79,7 +78,7 @@ impl Discretization {
         self.finish_solve(a, settings, t0, rebuilt, observer)
     }
 
-    /// The checks before a solve (not released, fits in memory); starts its phase.
+    /// The checks before a solve (not released); starts its phase.
     fn begin_solve(&self, settings: &Settings, observer: &mut dyn Observer) -> Result<Instant> {
         if self.is_released() {
             return Err(Error::Solver {
@@ -89,19 +88,19 @@ impl Discretization {
                     .into(),
             });
         }
-        self.check_memory(settings)?;
         observer.phase_started("solve");
         Ok(Instant::now())
     }
 
-    /// The solver's attempt on the model (with the levels built beforehand, if any).
+    /// The solver's attempt on the model ([`solve::solve_model`], with the levels built
+    /// beforehand, if any).
     fn attempt(
         &self,
         settings: &Settings,
         start: Option<&[f64]>,
         observer: &mut dyn Observer,
     ) -> Result<solve::Attempt> {
-        solve::attempt_with_levels(
+        solve::solve_model(
             &self.model,
             self.levels(),
             self.built_levels(),
@@ -111,9 +110,8 @@ impl Discretization {
         )
     }
 
-    /// The report of an attempt: its answer checked, its fields and totals derived on the
-    /// mesh and checked, the phase ended after `t0` (less `excluded` seconds spent on
-    /// something else).
+    /// The report of an attempt: its fields and totals derived on the mesh and checked,
+    /// the phase ended after `t0` (less `excluded` seconds spent on something else).
     fn finish_solve(
         &self,
         a: solve::Attempt,
@@ -122,11 +120,6 @@ impl Discretization {
         excluded: f64,
         observer: &mut dyn Observer,
     ) -> Result<Report> {
-        crate::outcome::checks::check_solution(
-            a.solution.energy,
-            a.solution.certificate.kkt(),
-            self.model.is_rigid(),
-        )?;
         // The fields and totals of the answer (pressures, forces, areas) must be finite
         // too: refused here, before any caller reports or writes them.
         let (fields, totals) = derive_from(self.mesh(), &self.model, &a.solution.u);
@@ -172,13 +165,14 @@ impl Discretization {
 /// the mesh checked (regions, data on the boundary, the profile line of `[output]`), then
 /// the solve. The outcome is returned whatever the solve's status; bad input is an `Err`.
 /// A case with steps (`[sweep]`, `[[load_case]]`) is refused: [`super::run_sweep`] runs
-/// those.
+/// those, and [`super::run_adapt`] a case with `[adapt]`.
+///
+/// The outcome keeps everything: its discretisation can be solved again (with other
+/// settings, from another start) and its matrices read. [`run_to_files`] is the same run
+/// for a caller that only writes its result set, at a lower peak of memory.
 pub fn run(case: &Case, observer: &mut dyn Observer) -> Result<Outcome> {
     check_one_step(case)?;
-    let observer = &mut solve::Cancellable {
-        inner: observer,
-        cancel: &case.settings.cancel,
-    };
+    let observer = &mut Cancellable::new(observer, &case.settings.cancel);
     let discretization = Discretization::new(&case.problem, observer)?;
     case.settings.cancel.check()?;
     check_case_on_mesh(case, discretization.mesh(), false)?;
@@ -189,17 +183,34 @@ pub fn run(case: &Case, observer: &mut dyn Observer) -> Result<Outcome> {
     })
 }
 
-/// [`run`] for a run whose outcome is only written afterwards (`memcontact solve`): the
-/// discretisation keeps only what the solve and then the writers read
-/// ([`Discretization::for_one_solve`], [`Discretization::release_solver_data`]), so that
-/// the peak memory of a large run is lower. The outcome's discretisation cannot be solved
-/// again.
-pub fn run_for_writing(case: &Case, observer: &mut dyn Observer) -> Result<Outcome> {
+/// What [`run_to_files`] did: the outcome, and the summary of the result set written (none
+/// when the solve was not accepted and [`WriteOptions::unconverged`] was not set).
+#[derive(Debug)]
+pub struct Written {
+    /// The outcome (its discretisation cannot be solved again).
+    pub outcome: Outcome,
+    /// `summary.json`'s values, when the files were written.
+    pub summary: Option<Summary>,
+}
+
+/// Runs a case of one step ([`run`]) and writes its result set into `target` as
+/// `memcontact solve` does: `solution.vtu`, `nodes.csv`, the pictures of `[output]` and
+/// `summary.json`, as one atomic set ([`crate::write::write_result`]). An outcome the
+/// settings do not accept is written only with [`WriteOptions::unconverged`] (marked in
+/// `summary.json`).
+///
+/// The run keeps only what the solve and then the writers read: a generated mesh is
+/// built again after the solve instead of being held through it, and the matrices go
+/// before the files are written, so the peak memory of a large run is lower than
+/// [`run`]'s.
+pub fn run_to_files(
+    case: &Case,
+    target: &Path,
+    options: &WriteOptions,
+    observer: &mut dyn Observer,
+) -> Result<Written> {
     check_one_step(case)?;
-    let observer = &mut solve::Cancellable {
-        inner: observer,
-        cancel: &case.settings.cancel,
-    };
+    let observer = &mut Cancellable::new(observer, &case.settings.cancel);
     let mut discretization =
         Discretization::for_one_solve(&case.problem, &case.settings, observer)?;
     case.settings.cancel.check()?;
@@ -207,51 +218,78 @@ pub fn run_for_writing(case: &Case, observer: &mut dyn Observer) -> Result<Outco
     discretization.release_mesh(&case.problem.mesh);
     let report = discretization.solve_once(&case.settings, observer)?;
     discretization.release_solver_data();
-    Ok(Outcome {
+    let outcome = Outcome {
         discretization,
         report,
-    })
-}
-
-/// The discretisation `memcontact solve` of `case` solves on, built as that run builds it
-/// (not solved): the lean one of [`run_for_writing`] for one solve, everything kept for a
-/// sweep, load cases, the adaptive loop, sensitivities or a fit. `memcontact check` reports on it, so that its
-/// memory estimate is the one the run checks.
-pub fn discretize_as_run(case: &Case, observer: &mut dyn Observer) -> Result<Discretization> {
-    if case.is_sweep() || case.adapt.is_some() || case.sensitivity.is_some() || case.fit.is_some() {
-        Discretization::new(&case.problem, observer)
-    } else {
-        Discretization::for_one_solve(&case.problem, &case.settings, observer)
-    }
-}
-
-/// Runs a problem end to end (mesh, assembly, solve) with `settings`: [`run`] for a
-/// problem and settings without the rest of a case.
-pub fn run_problem(
-    problem: &Problem,
-    settings: &Settings,
-    observer: &mut dyn Observer,
-) -> Result<Outcome> {
-    settings.validate().map_err(Invalid::into_error)?;
-    let observer = &mut solve::Cancellable {
-        inner: observer,
-        cancel: &settings.cancel,
     };
-    let discretization = Discretization::new(problem, observer)?;
-    settings.cancel.check()?;
-    let report = discretization.solve(settings, observer)?;
-    Ok(Outcome {
+    let summary = if outcome.report.accepted || options.unconverged {
+        let plots = crate::write::plot_options(case, &options.label);
+        Some(crate::write::write_result(
+            target, &outcome, case, options, &plots,
+        )?)
+    } else {
+        None
+    };
+    Ok(Written { outcome, summary })
+}
+
+/// What [`check`] found: the discretisation the run would solve on (built as the run
+/// builds it, not solved), every check of the case on its mesh passed.
+#[derive(Debug)]
+pub struct Checked {
+    /// The mesh levels and the assembled model.
+    pub discretization: Discretization,
+    /// The method `auto` picks on this problem, and why.
+    pub auto: (Method, Choice),
+    /// The estimated peak memory of the run (bytes).
+    pub memory_needed: f64,
+    /// The memory available to the run (bytes), and where that figure comes from.
+    pub memory_available: (u64, String),
+}
+
+/// Checks a case as `memcontact check` does: everything the run would refuse, without
+/// solving. The case is validated; the mesh built and the model assembled as the run
+/// builds them (lean for one solve; everything kept for a sweep, load cases, the adaptive
+/// loop, sensitivities or a fit), so that the memory estimate is the one the run checks;
+/// the load cases' data are assembled on the mesh, the profile line, the adaptive loop's
+/// limits, the sensors, the outputs and parameters of `[sensitivity]` and the
+/// measurements of `[fit]` checked against it; and a solve that would not fit in the
+/// memory available is refused.
+pub fn check(case: &Case, observer: &mut dyn Observer) -> Result<Checked> {
+    case.validate().map_err(Invalid::into_error)?;
+    // The memory available is read before the check's own mesh and model take theirs.
+    let memory_available = crate::limits::available_memory();
+    let observer = &mut Cancellable::new(observer, &case.settings.cancel);
+    let keeps_everything =
+        case.is_sweep() || case.adapt.is_some() || case.sensitivity.is_some() || case.fit.is_some();
+    let discretization = if keeps_everything {
+        Discretization::new(&case.problem, observer)?
+    } else {
+        Discretization::for_one_solve(&case.problem, &case.settings, observer)?
+    };
+    check_case_on_mesh(case, discretization.mesh(), true)?;
+    discretization.check_memory(&case.settings)?;
+    if let Some(a) = &case.adapt {
+        crate::adapt::check_adapt_on_mesh(a, discretization.mesh())?;
+    }
+    super::sensitivity::check_sensitivity_on_mesh(case, &discretization)?;
+    Ok(Checked {
+        auto: discretization.auto_choice(),
+        memory_needed: discretization.memory_estimate(&case.settings),
+        memory_available,
         discretization,
-        report,
     })
 }
 
-/// What the one-step runs ([`run`], [`run_for_writing`]) refuse before any work: a case
-/// with steps, an invalid case, a case with `[adapt]`.
+/// What the one-step runs ([`run`], [`run_to_files`]) refuse before any work: a case
+/// with steps, an invalid case, a case with `[adapt]` or `[fit]` (a case with
+/// `[sensitivity]` is solved, without its derivatives: [`super::run_sensitivity`] computes
+/// them).
 fn check_one_step(case: &Case) -> Result<()> {
     refuse_steps(case)?;
     case.validate().map_err(Invalid::into_error)?;
-    refuse_adapt(case)
+    refuse_adapt(case)?;
+    refuse_fit(case)
 }
 
 /// A case with steps is refused by the one-step runs.
@@ -279,6 +317,20 @@ fn refuse_adapt(case: &Case) -> Result<()> {
             line: None,
             key: "adapt".into(),
             message: "the case refines its mesh adaptively: run its adaptive loop".into(),
+        });
+    }
+    Ok(())
+}
+
+/// A case with `[fit]` is refused by the one-step runs: its answer is at the fitted
+/// parameters, not the case's own.
+fn refuse_fit(case: &Case) -> Result<()> {
+    if case.fit.is_some() {
+        return Err(Error::Case {
+            file: None,
+            line: None,
+            key: "fit".into(),
+            message: "the case fits parameters to measurements: run its fit".into(),
         });
     }
     Ok(())

@@ -1,8 +1,8 @@
 //! A run with `[sensitivity]`: the case solved, then the derivatives of its outputs in its
 //! parameters (docs/theory.md#sensitivities).
 
-use super::checks::check_case_on_mesh;
 use crate::case::Case;
+use crate::discretization::check_case_on_mesh;
 use crate::discretization::Discretization;
 use crate::error::{Error, Invalid, Result};
 use crate::outcome::Outcome;
@@ -52,10 +52,7 @@ pub fn run_request(
                 .into(),
         });
     }
-    let observer = &mut solve::Cancellable {
-        inner: observer,
-        cancel: &case.settings.cancel,
-    };
+    let observer = &mut solve::Cancellable::new(observer, &case.settings.cancel);
     let discretization = Discretization::new(&case.problem, observer)?;
     case.settings.cancel.check()?;
     check_case_on_mesh(case, discretization.mesh(), false)?;

@@ -8,8 +8,8 @@
 //! L, the tension S, and the obstacle offset adds to φₙ. A load case with new data
 //! assembles once on the same mesh.
 
-use super::checks::check_case_on_mesh;
 use crate::case::{steps, Case, StepSpec, SweepParameter};
+use crate::discretization::check_case_on_mesh;
 use crate::discretization::{assemble_model, Discretization, Phase};
 use crate::error::{Error, Result};
 use crate::mesh::refine::Hierarchy;
@@ -153,10 +153,7 @@ pub fn run_sweep(
     on_step: &mut dyn FnMut(&StepSpec, &Outcome, &StepRow) -> Result<()>,
 ) -> Result<SweepRun> {
     case.validate().map_err(crate::error::Invalid::into_error)?;
-    let observer = &mut crate::solve::Cancellable {
-        inner: observer,
-        cancel: &case.settings.cancel,
-    };
+    let observer = &mut crate::solve::Cancellable::new(observer, &case.settings.cancel);
     let base = Discretization::new(&case.problem, observer)?;
     run_sweep_on(case, base, warm, observer, on_step)
 }
@@ -351,9 +348,13 @@ stiffness = 300
         .unwrap();
         let d = Discretization::new(&c.problem, &mut Silent).unwrap();
         for assemble in [false, true] {
-            let e = super::super::checks::check_load_cases_on_mesh(&c, d.mesh(), assemble)
-                .unwrap_err()
-                .to_string();
+            let e = crate::discretization::case_checks::check_load_cases_on_mesh(
+                &c,
+                d.mesh(),
+                assemble,
+            )
+            .unwrap_err()
+            .to_string();
             assert!(e.contains("load_case.1.shape") && e.contains("clay"), "{e}");
         }
         let mut solved = 0;

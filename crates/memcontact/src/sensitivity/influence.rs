@@ -1,5 +1,5 @@
 //! Influence maps: the derivative of an output in the stiffness at every vertex, "where
-//! the soil stiffness matters" (docs/theory.md#sensitivities). The stiffness is perturbed
+//! the soil stiffness matters" (docs/theory.md#adjoint). The stiffness is perturbed
 //! by a hat function ψ_v of the vertex (over the body's elastic triangles): the consistent
 //! L changes by `∫ ψ_v gᵢ gⱼ`, the lumped l by `∫ ψ_v gᵢ`. Then
 //!
@@ -43,9 +43,9 @@ pub fn vertex_map(
             let mut s = 0.0;
             match foundation {
                 Foundation::Consistent => {
-                    for b in 0..3 {
-                        for c in 0..3 {
-                            s += xs[b] * ys[c] * triple(a, b, c);
+                    for (b, &xb) in xs.iter().enumerate() {
+                        for (c, &yc) in ys.iter().enumerate() {
+                            s += xb * yc * triple(a, b, c);
                         }
                     }
                 }

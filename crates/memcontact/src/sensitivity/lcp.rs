@@ -1,4 +1,4 @@
-//! One-sided derivatives at biactive vertices (docs/theory.md#sensitivities; Mignot 1976,
+//! One-sided derivatives at biactive vertices (docs/theory.md#biactive; Mignot 1976,
 //! and for the Winkler term Christof, Clason, Meyer & Walther 2018). Where a vertex lies on
 //! a body's surface with its contact force at an end of its range, the solution map is
 //! only directionally differentiable: the derivative δU in a direction δp solves the

@@ -1,4 +1,4 @@
-//! The Jacobian of a smooth piece and its linear solves (docs/theory.md#sensitivities):
+//! The Jacobian of a smooth piece and its linear solves (docs/theory.md#tangent):
 //! `K = S + E_P L E_P (+ E_Q L_low E_Q)` on the free unknowns, the held ones eliminated
 //! (their rows and columns zero), filled by the solvers' own truncated Newton system
 //! ([`crate::solve::newton`]). K is symmetric positive definite: tangent and adjoint solves
@@ -11,8 +11,8 @@ use super::states::PieceStates;
 use crate::error::{Error, Result};
 use crate::mesh::refine::Hierarchy;
 use crate::model::Model;
-use crate::solve::multigrid::cycle::FcgWork;
-use crate::solve::multigrid::{Levels, Multigrid};
+use crate::solve::multigrid::cycle::{FcgWork, Multigrid};
+use crate::solve::multigrid::Levels;
 use crate::solve::newton::newton_system;
 use crate::sparse::{Cholesky, Csr};
 use std::time::Instant;
@@ -138,11 +138,6 @@ impl<'a> Jacobian<'a> {
         &self.held
     }
 
-    /// `K x` (held rows and columns zero).
-    pub fn mul(&self, x: &[f64]) -> Vec<f64> {
-        self.a.mul(x)
-    }
-
     /// Solves `K x = b` on the free unknowns (`b` must be zero on the held ones; `x` is
     /// zero there), certified by its residual; `what` names the solve in the record.
     pub fn solve(&mut self, b: &[f64], what: &str) -> Result<(Vec<f64>, SolveRecord)> {
@@ -200,7 +195,7 @@ impl<'a> Jacobian<'a> {
         let residual = if norm_b == 0.0 { 0.0 } else { res / norm_b };
         let seconds = t0.elapsed().as_secs_f64() + std::mem::take(&mut self.pending);
         // Certified: a residual far above the one asked for is a failure, not an answer.
-        if !(residual <= (100.0 * self.tolerance).max(1e-6)) {
+        if residual.is_nan() || residual > (100.0 * self.tolerance).max(1e-6) {
             return Err(Error::Solver {
                 solver: format!("sensitivity {}", self.solver_name()),
                 message: format!(

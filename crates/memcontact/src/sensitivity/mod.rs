@@ -4,32 +4,32 @@
 //! Write the optimality system as `R(U, p) = 0` with
 //! `R = SU − D + E_P L (U − φ)⁺ − E_Q L_low (φ_low − U)⁺` on the free unknowns (P, Q the
 //! vertices penetrating the obstacle and the body below) and `Uᵢ = φᵢ` (or `φ_low,ᵢ`) on
-//! the held ones ([`states`]). Off the biactive set the solution map p ↦ U is smooth and
+//! the held ones. Off the biactive set the solution map p ↦ U is smooth and
 //!
 //! * **tangent**: `K δU = −∂ₚR − K_{F,H} δφ_H` on the free unknowns, `δU_H = δφ_H`, with the
-//!   Jacobian `K = S + E_P L E_P + E_Q L_low E_Q` ([`linear`]);
+//!   Jacobian `K = S + E_P L E_P + E_Q L_low E_Q`;
 //! * **adjoint**: `K λ = (∂Q/∂U)_F`, then `dQ/dp = ∂ₚQ − λᵀ∂ₚR + (∂Q/∂U − Kλ)_Hᵀ δφ_H`: one
 //!   solve per output gives its derivative in every parameter, and its influence map in
-//!   the stiffness at every vertex ([`influence`]);
-//! * **energy**: no solve, by the envelope theorem ([`outputs::At::envelope`]).
+//!   the stiffness at every vertex;
+//! * **energy**: no solve, by the envelope theorem.
 //!
 //! At biactive vertices both one-sided derivatives come from a small complementarity
-//! problem on them ([`lcp`]). The parameters ([`parameters`]) and the outputs ([`outputs`])
-//! are bound to the model once ([`Prepared`]), so that a fit evaluates them at every
-//! iterate without assembling again.
+//! problem on them (docs/theory.md#biactive). The parameters and the outputs are bound to
+//! the model once ([`Prepared`]), so that a fit evaluates them at every iterate without
+//! assembling again.
 
-pub mod influence;
-pub mod lcp;
-pub mod linear;
-pub mod outputs;
-pub mod parameters;
-pub mod states;
+pub(crate) mod influence;
+pub(crate) mod lcp;
+pub(crate) mod linear;
+pub(crate) mod outputs;
+pub(crate) mod parameters;
+pub(crate) mod states;
 #[cfg(test)]
 mod tests;
 
 use crate::case::{ParameterKey, ParameterKind, Sensor};
 use crate::certificate::Certificate;
-use crate::discretization::{BoundData, Discretization};
+use crate::discretization::BoundData;
 use crate::error::Result;
 use crate::mesh::Mesh;
 use crate::model::{FoundationMatrix, Model};
@@ -123,7 +123,7 @@ pub struct Sensitivities {
     /// when [`Prepared::keep_tangents`] asked for them and they were computed (tangent
     /// mode; one-sided: the mean of the two); empty otherwise. A fit predicts the next
     /// iterate's solution with them.
-    pub tangents: Vec<Vec<f64>>,
+    pub(crate) tangents: Vec<Vec<f64>>,
 }
 
 impl Sensitivities {
@@ -161,17 +161,17 @@ impl Sensitivities {
 #[derive(Debug, Clone)]
 pub struct Prepared {
     /// The parameters' derivative data.
-    pub parameters: Vec<DataDerivative>,
+    pub(crate) parameters: Vec<DataDerivative>,
     /// The outputs.
-    pub outputs: Vec<OutputSpec>,
+    pub(crate) outputs: Vec<OutputSpec>,
     /// The influence maps wanted.
-    pub influence: bool,
+    pub(crate) influence: bool,
     /// Keep the tangents δU in [`Sensitivities::tangents`] (and compute them by tangent
     /// solves even where adjoint solves would be fewer).
-    pub keep_tangents: bool,
+    pub(crate) keep_tangents: bool,
     /// The relative residual the iterative linear solves are driven to (default
     /// [`linear::ITERATIVE_TOLERANCE`]; factorised solves are exact to rounding).
-    pub linear_tolerance: f64,
+    pub(crate) linear_tolerance: f64,
     /// The rigid regions of the obstacle and of the body below (masked in the maps).
     rigid: (Vec<u32>, Vec<u32>),
     /// The sensors' names by output.
@@ -228,7 +228,7 @@ impl Prepared {
 
     /// The multigrid levels of the linear solves, built now when they are not yet (for
     /// `model` on its mesh `hierarchy`); `None` when the systems are factorised.
-    pub fn shared_levels(
+    pub(crate) fn shared_levels(
         &self,
         model: &Model,
         hierarchy: Option<&crate::mesh::refine::Hierarchy>,
@@ -593,21 +593,4 @@ fn adjoint(
         .map(|i| if held[i] { 0.0 } else { g[i] })
         .collect();
     jac.solve(&rhs, &format!("adjoint:{name}"))
-}
-
-/// The derivatives `request` asks of a solved discretisation (its answer `u`, certified by
-/// `certificate`, with energy `energy`): [`Prepared::new`] then [`Prepared::evaluate`].
-pub fn analyse(
-    problem: &Problem,
-    sensors: &[Sensor],
-    request: &Request,
-    discretization: &Discretization,
-    u: &[f64],
-    certificate: &Certificate,
-    energy: f64,
-) -> Result<Sensitivities> {
-    let mesh = discretization.mesh();
-    let model = &discretization.model;
-    let prepared = Prepared::new(problem, sensors, request, mesh, model)?;
-    prepared.evaluate(mesh, model, discretization.levels(), u, certificate, energy)
 }

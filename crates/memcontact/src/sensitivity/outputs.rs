@@ -1,6 +1,6 @@
 //! The quantities of interest Q, with their derivatives in U (`∂Q/∂U`, for the tangent and
 //! adjoint solves) and their explicit derivatives in a parameter (`∂Q/∂p` at fixed U)
-//! (docs/theory.md#sensitivities).
+//! (docs/theory.md#adjoint).
 //!
 //! * `energy`: J(U), differentiated by the envelope theorem (no solve, below).
 //! * `sensor:NAME`: u at a point, by P1 interpolation (its triangle's barycentric weights;
@@ -53,9 +53,13 @@ pub struct OutputSpec {
     pub kind: OutputKind,
 }
 
+/// Where a point is in a mesh: its triangle's vertices and its barycentric weights there
+/// (`None` outside the mesh).
+pub type Location = Option<([u32; 3], [f64; 3])>;
+
 /// The locations of `points` in `mesh`: each point's triangle and barycentric weights, or
 /// `None` outside the mesh.
-pub fn locate(mesh: &Mesh, points: &[[f64; 2]]) -> Result<Vec<Option<([u32; 3], [f64; 3])>>> {
+pub fn locate(mesh: &Mesh, points: &[[f64; 2]]) -> Result<Vec<Location>> {
     if points.is_empty() {
         return Ok(Vec::new());
     }
@@ -65,12 +69,6 @@ pub fn locate(mesh: &Mesh, points: &[[f64; 2]]) -> Result<Vec<Option<([u32; 3], 
         .iter()
         .map(|&p| locator.locate(p).map(|(k, l)| (mesh.triangles[k], l)))
         .collect())
-}
-
-/// Sensor `s` located on `mesh`, or an error naming it (`key`: `sensor.N`, or the
-/// measurements file's row).
-pub fn sensor_output(mesh: &Mesh, key: &str, s: &Sensor) -> Result<OutputSpec> {
-    Ok(sensor_outputs(mesh, &[(key.to_string(), s)])?.remove(0))
 }
 
 /// The sensors `keyed` (each with the key that names it in errors) located on `mesh` with
@@ -470,10 +468,12 @@ impl At<'_> {
     }
 
     /// dJ/dp by the envelope theorem: J is the minimum over V, so its derivative is the
-    /// partial derivative at U, `½ ds UᵀSU + ds Uᵀlift − Uᵀ(dD_f − d lift) + ½ p̂ᵀ dL p̂
-    /// + ½ q̂ᵀ dL_low q̂ − X₁ᵀdφ + X_lowᵀ dφ_low` (ds = 1/t for the tension; X the nodal
-    /// contact forces, so that a vertex held on a surface contributes its force times the
-    /// surface's motion). No solve.
+    /// partial derivative at U,
+    /// `½ ds UᵀSU + ds Uᵀlift − Uᵀ(dD_f − d lift) + ½ p̂ᵀ dL p̂ + ½ q̂ᵀ dL_low q̂`
+    /// `− X₁ᵀdφ + X_lowᵀ dφ_low`
+    /// (ds = 1/t for the tension; X the nodal contact forces, so that a vertex held on a
+    /// surface contributes its force times the surface's motion). No solve
+    /// (docs/theory.md#envelope).
     pub fn envelope(&self, d: &DataDerivative, dr: &[f64]) -> f64 {
         let m = self.model;
         let u = self.u;
@@ -542,9 +542,9 @@ impl At<'_> {
                 }
             }
         }
-        for i in 0..n {
-            if ps.held[i].is_some() {
-                out[i] = 0.0;
+        for (o, h) in out.iter_mut().zip(&ps.held) {
+            if h.is_some() {
+                *o = 0.0;
             }
         }
         out

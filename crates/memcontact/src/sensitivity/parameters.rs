@@ -1,7 +1,7 @@
 //! Parameters bound to the model: for a case key ([`ParameterKey`]), the derivative of the
 //! assembled data S, L, D, φₙ, the lifting and the outputs' vertex data in it
 //! ([`DataDerivative`]), and from those the partial derivative `∂R/∂p` of the optimality
-//! system and the values prescribed on the held vertices (docs/theory.md#sensitivities).
+//! system and the values prescribed on the held vertices (docs/theory.md#tangent).
 //!
 //! Every datum enters the discrete model linearly, so the derivative data are the model's
 //! data assembled with the derivative coefficient of the key: 1 on the region of a region
@@ -262,12 +262,6 @@ impl DataDerivative {
                     rigid_l || low.l.diag(i) > 0.0 || low.rigid.as_ref().is_some_and(|r| r[i]);
             }
         }
-    }
-
-    /// Whether the parameter moves the surface of a body or the boundary heights (so that
-    /// held vertices follow it).
-    pub fn moves_surfaces(&self) -> bool {
-        self.up.dphi.is_some() || self.low.dphi.is_some()
     }
 }
 

@@ -104,7 +104,7 @@ impl States {
             lp,
             lq,
         };
-        for i in 0..n {
+        for (i, &ui) in u.iter().enumerate().take(n) {
             let kii = model.s.get(i, i)
                 + if model.can_touch[i] {
                     model.l.diag(i)
@@ -119,7 +119,7 @@ impl States {
             // The body below first: its force enters the obstacle's balance.
             let mut low_force = 0.0;
             if let Some(low) = model.lower.as_ref().filter(|b| b.can_touch[i]) {
-                let gap = low.phi[i] - u[i];
+                let gap = low.phi[i] - ui;
                 let rigid = low.rigid_at(i);
                 if gap.abs() <= eps_u || (rigid && gap >= 0.0) {
                     let a = st.r[i];
@@ -135,13 +135,13 @@ impl States {
                 }
             }
             if model.can_touch[i] {
-                let gap = u[i] - model.phi[i];
+                let gap = ui - model.phi[i];
                 let rigid = model.rigid_at(i);
                 if gap.abs() <= eps_u || (rigid && gap >= 0.0) {
                     if st.held[i].is_some() || st.biactive.last().is_some_and(|b| b.i == i) {
                         // Squeezed between the two bodies: biactive whatever the forces.
                         st.held[i] = None;
-                        if !st.biactive.last().is_some_and(|b| b.i == i) {
+                        if st.biactive.last().is_none_or(|b| b.i != i) {
                             st.biactive.push(Biactive {
                                 i,
                                 side: Side::Upper,

@@ -1,6 +1,6 @@
 //! The derivatives against central finite differences of the outputs (same mesh, same
 //! active set, solver at 1e-13), the envelope identities, Taylor remainders, and the disc's
-//! closed form.
+//! closed form (docs/theory.md#sensitivity-checks).
 
 use super::*;
 use crate::case::{Case, ParameterKey};
@@ -360,8 +360,8 @@ fn taylor_remainders_fall_at_rate_two() {
         for (k, &e) in eps.iter().enumerate() {
             let (a, sa) = values(&moved(&case, key, key.value + e), &only);
             assert_eq!(sa, states, "{}: the states change at ε = {e:e}", key.key);
-            for o in 0..outputs.len() {
-                rem[o][k] = (a.values[o] - s.values[o] - e * s.get(o, p)).abs();
+            for (o, r) in rem.iter_mut().enumerate() {
+                r[k] = (a.values[o] - s.values[o] - e * s.get(o, p)).abs();
             }
         }
         for (o, name) in outputs.iter().enumerate() {

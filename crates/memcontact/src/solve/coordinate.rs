@@ -11,12 +11,9 @@ use crate::model::Model;
 /// Default limit on sweeps.
 pub(crate) const MAX_SWEEPS: usize = 1_000_000;
 
-/// Sweeps until the KKT residual is below the tolerance (checked every few sweeps).
-pub fn solve(model: &Model, settings: &Settings, observer: &mut dyn Observer) -> Result<Solution> {
-    solve_from(model, settings, None, observer)
-}
-
-/// [`solve`] from `start` (made feasible for a rigid obstacle) when given.
+/// Problem 2b by exact coordinatewise minimisation, from `start` (made feasible for a rigid
+/// obstacle) when given: sweeps until the KKT residual is below the tolerance (checked
+/// every few sweeps).
 pub fn solve_from(
     model: &Model,
     settings: &Settings,

@@ -12,19 +12,20 @@
 //! Every solve ends with the certificates of 2e and 2f; not reaching the tolerance is an
 //! error, never a silently returned iterate.
 
-pub mod active_set;
-pub mod coordinate;
-pub mod line_search;
-pub mod linear;
-pub mod multigrid;
-pub mod newton;
-pub mod qp;
-pub mod relax;
+pub(crate) mod active_set;
+pub(crate) mod coordinate;
+pub(crate) mod line_search;
+pub(crate) mod linear;
+pub(crate) mod multigrid;
+pub(crate) mod newton;
+pub(crate) mod qp;
+pub(crate) mod relax;
 
-use crate::certificate::Certificate;
+pub use crate::certificate::Certificate;
 use crate::error::{Error, Result};
 use crate::mesh::refine::Hierarchy;
 use crate::model::Model;
+pub use multigrid::Kind as HierarchyKind;
 use std::time::Instant;
 
 /// The solution methods.
@@ -220,6 +221,17 @@ pub struct Cancellable<'a> {
     pub inner: &'a mut dyn Observer,
     /// The token.
     pub cancel: &'a crate::parallel::Cancel,
+}
+
+impl<'a> Cancellable<'a> {
+    /// `observer`, stopped by `cancel` too: how every run wraps its caller's observer with
+    /// its settings' token.
+    pub fn new(observer: &'a mut dyn Observer, cancel: &'a crate::parallel::Cancel) -> Self {
+        Cancellable {
+            inner: observer,
+            cancel,
+        }
+    }
 }
 
 impl Observer for Cancellable<'_> {
@@ -762,6 +774,68 @@ pub fn check_solver_fits(method: Method, unknowns: usize) -> Result<()> {
         )));
     }
     Ok(())
+}
+
+/// Solves `model` with `settings` (on `hierarchy`'s levels, those `built` beforehand when
+/// given; from `start` when given) by the library's one policy ([`attempt_with_levels`]:
+/// the method the settings name, or `auto`'s choice with its fallback), after the memory
+/// check of its solver; an answer whose J or certificate is not finite is refused
+/// ([`check_solution`]). Every run solves through it: one step,
+/// the steps of a sweep, the adaptive loop, and each level of a convergence study.
+pub(crate) fn solve_model(
+    model: &Model,
+    hierarchy: Option<&Hierarchy>,
+    built: Option<&multigrid::Levels>,
+    settings: &Settings,
+    start: Option<&[f64]>,
+    observer: &mut dyn Observer,
+) -> Result<Attempt> {
+    let method = match settings.method {
+        Method::Auto => auto_choice(model, hierarchy).0,
+        m => m,
+    };
+    check_solver_fits(method, model.n())?;
+    let a = attempt_with_levels(model, hierarchy, built, settings, start, observer)?;
+    check_solution(
+        a.solution.energy,
+        a.solution.certificate.kkt(),
+        model.is_rigid(),
+    )?;
+    Ok(a)
+}
+
+/// Refuses a solve whose energy J(U) or certificate is not a finite number (`rigid`: an
+/// iterate outside `U ≤ φ` has J = +∞ by definition and is refused by its certificate
+/// instead).
+pub fn check_solution(energy: f64, kkt: f64, rigid: bool) -> Result<()> {
+    if energy.is_nan() || (energy.is_infinite() && !(rigid && energy > 0.0)) {
+        return Err(Error::Data(format!(
+            "the energy J(U) of the answer is {energy}: {}",
+            crate::model::OVERFLOW_HINT
+        )));
+    }
+    if kkt.is_nan() {
+        return Err(Error::Data(format!(
+            "the certificate of the answer is not a number: {}",
+            crate::model::OVERFLOW_HINT
+        )));
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod check_tests {
+    use super::check_solution;
+
+    #[test]
+    fn non_finite_answers_are_refused_naming_them() {
+        assert!(check_solution(1.0, 1e-12, false).is_ok());
+        assert!(check_solution(f64::INFINITY, 1.0, true).is_ok());
+        let e = check_solution(f64::NAN, 1e-12, false).unwrap_err();
+        assert!(e.to_string().contains("energy J(U)"), "{e}");
+        assert!(check_solution(f64::NEG_INFINITY, 1e-12, true).is_err());
+        assert!(check_solution(1.0, f64::NAN, false).is_err());
+    }
 }
 
 #[cfg(test)]

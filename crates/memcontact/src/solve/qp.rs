@@ -104,6 +104,7 @@ const REDUCED_TOL: f64 = 1e-8;
 /// What the QP solve did, beyond the [`Solution`]: the raw interior-point answer and its
 /// certificate next to the polished one.
 #[derive(Debug, Clone)]
+#[cfg_attr(not(test), allow(dead_code))] // the raw answer is read by the tests of the polish
 pub struct QpReport {
     /// The returned solution (the polished U when its certificate is better).
     pub solution: Solution,

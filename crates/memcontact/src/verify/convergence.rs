@@ -372,23 +372,17 @@ fn at_level(level: usize, e: Error) -> Error {
     }
 }
 
-/// Solves one level with `settings` on the finest mesh of `hierarchy`, by the library's
-/// one policy ([`solve::attempt`]: with [`Method::Auto`], multigrid when the hierarchy
-/// allows it and the active-set method when multigrid does not converge), after the
-/// memory check of its solver. A status the settings do not accept is an error, and so is
-/// an answer whose J or certificate is not finite ([`crate::outcome::checks::check_solution`]); a
-/// fallback is returned as a note.
+/// Solves one level with `settings` on the finest mesh of `hierarchy` through the runs'
+/// pipeline ([`solve::solve_model`]: the library's one policy, the memory check of its
+/// solver, the answer's J and certificate checked). A status the settings do not accept
+/// is an error here (a study measures accepted answers only); a fallback of `auto` is
+/// returned as a note.
 fn solve_level(
     model: &Model,
     hierarchy: &Hierarchy,
     settings: &Settings,
 ) -> Result<(Solution, Option<String>)> {
-    let method = match settings.method {
-        Method::Auto => solve::auto_method(model, Some(hierarchy)),
-        m => m,
-    };
-    crate::solve::check_solver_fits(method, model.n())?;
-    let a = solve::attempt(model, Some(hierarchy), settings, &mut Silent)?;
+    let a = solve::solve_model(model, Some(hierarchy), None, settings, None, &mut Silent)?;
     if !a.status.is_accepted(settings) {
         return Err(solve::not_converged(&a, settings));
     }
@@ -405,11 +399,6 @@ fn solve_level(
             a.solution.method.name()
         )
     });
-    crate::outcome::checks::check_solution(
-        a.solution.energy,
-        a.solution.certificate.kkt(),
-        model.is_rigid(),
-    )?;
     Ok((a.solution, note))
 }
 

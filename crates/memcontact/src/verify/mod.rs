@@ -4,6 +4,6 @@
 
 pub mod convergence;
 pub mod exact;
-pub mod exact_case;
+pub(crate) mod exact_case;
 pub mod norms;
 pub mod study;

@@ -10,8 +10,9 @@
 //! room for it (the CSV header lines are contracts), are bound to it by their hashes in
 //! the summary or manifest.
 
-mod adapt;
 mod manifest;
+mod pictures;
+mod redraw;
 mod result;
 mod sensitivity;
 mod study;
@@ -19,16 +20,21 @@ mod sweep;
 #[cfg(test)]
 mod tests;
 
-pub use adapt::{write_adapt_csv, AdaptHistory, AdaptSet, ADAPT_CSV};
 pub use manifest::{write_manifest, Manifest, MANIFEST};
+pub use memcontact_plot::{PlotKind, PlotOptions, Units as PlotUnits};
+pub use pictures::{
+    adapt_pictures, draw_all, pictures, plot_options, render_png, steps_kind, study_pictures,
+    sweep_picture, write_png, write_result, SweepWriter, CONVERGENCE_PICTURE, H_SWEEP_PICTURE,
+    MESH_PICTURE, SWEEP_PICTURE,
+};
+pub use redraw::{load as load_result, Loaded, LowerData, ResultData};
 pub use result::{
-    file_record, input_hash, new_run_id, write_fields, write_fields_with, write_files,
-    write_files_with, write_result_set, write_result_set_with, Extras, WriteOptions, LOWER_FIELDS,
-    NODAL_FIELDS,
+    file_record, input_hash, new_run_id, write_fields, write_files, write_result_set, WriteOptions,
+    LOWER_FIELDS, NODAL_FIELDS,
 };
 pub use sensitivity::{
-    write_fit_csv, write_fit_json, write_sensitivity_csv, FIT_CSV, FIT_JSON, SENSITIVITY_COLUMNS,
-    SENSITIVITY_CSV,
+    fit_picture, write_fit_csv, write_fit_json, write_sensitivity_csv, write_sensitivity_result,
+    FIT_CSV, FIT_JSON, FIT_PICTURE, SENSITIVITY_COLUMNS, SENSITIVITY_CSV,
 };
 pub use study::{
     convergence_columns, h_sweep_columns, write_study, write_study_csv, StudyColumn,

@@ -55,6 +55,28 @@ pub struct WriteOptions {
     pub cell_data: Vec<(String, Vec<f64>)>,
     /// The adaptive loop's totals for `summary.json` (with `[adapt]`).
     pub adapt: Option<crate::outcome::summary::AdaptTotals>,
+    /// Write the files of a solve the settings did not accept (marked `"accepted": false`
+    /// in `summary.json`); otherwise [`crate::run::run_to_files`] writes nothing for it.
+    pub unconverged: bool,
+}
+
+impl WriteOptions {
+    /// The options of a result set labelled `label` (its name in `summary.json`): binary
+    /// VTU, started now, a fresh run id, an existing result replaced but no other
+    /// directory, nothing written for an outcome the settings did not accept.
+    pub fn new(label: impl Into<String>) -> WriteOptions {
+        WriteOptions {
+            label: label.into(),
+            vtu: VtuFormat::default(),
+            force: false,
+            started: Instant::now(),
+            plot_options: None,
+            run_id: None,
+            cell_data: Vec::new(),
+            adapt: None,
+            unconverged: false,
+        }
+    }
 }
 
 /// A fresh random run identifier (32 hex digits).
@@ -157,7 +179,7 @@ pub fn write_fields(
 /// [`write_fields`] with further point fields of `solution.vtu` (`extra_points`, one value
 /// per vertex in the user's order: the sensitivity run's influence maps).
 #[allow(clippy::too_many_arguments)]
-pub fn write_fields_with(
+pub(crate) fn write_fields_with(
     dir: &Path,
     outcome: &Outcome,
     fields: &NodalFields,
@@ -261,15 +283,15 @@ pub fn write_files(
 /// What a run adds to the files of its solve: point fields of `solution.vtu` and keys of
 /// `summary.json` (a sensitivity run's influence maps and totals).
 #[derive(Debug, Clone, Default)]
-pub struct Extras {
+pub(crate) struct Extras {
     /// Further point fields of `solution.vtu`, one value per vertex in the user's order.
-    pub point_data: Vec<(String, Vec<f64>)>,
+    pub(crate) point_data: Vec<(String, Vec<f64>)>,
     /// The sensitivity totals of `summary.json`.
-    pub sensitivity: Option<crate::outcome::SensitivityTotals>,
+    pub(crate) sensitivity: Option<crate::outcome::SensitivityTotals>,
 }
 
 /// [`write_files`] with the [`Extras`] of a run.
-pub fn write_files_with(
+pub(crate) fn write_files_with(
     dir: &Path,
     outcome: &Outcome,
     case: &Case,
@@ -280,7 +302,7 @@ pub fn write_files_with(
     let t0 = Instant::now();
     let (fields, totals) = outcome.checked_fields()?;
     let r = &outcome.report;
-    crate::outcome::checks::check_solution(
+    crate::solve::check_solution(
         r.energy,
         r.certificate.kkt(),
         outcome.discretization.model.is_rigid(),
@@ -346,7 +368,7 @@ pub fn write_result_set(
 }
 
 /// [`write_result_set`] with the [`Extras`] of a run.
-pub fn write_result_set_with(
+pub(crate) fn write_result_set_with(
     target: &Path,
     outcome: &Outcome,
     case: &Case,

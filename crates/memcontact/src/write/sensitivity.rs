@@ -1,12 +1,22 @@
 //! The files of a sensitivity run and of a fit: `sensitivity.csv` (one row per output and
-//! parameter), `fit.json` (the fitted parameters and their statistics) and `fit.csv` (one
-//! row per iteration). Written atomically, numbers in their shortest round-trip form and
-//! NaN as an empty field, like the other CSV files ([`crate::io::csv`]).
+//! parameter), `fit.json` (the fitted parameters and their statistics), `fit.csv` (one
+//! row per iteration) and `fit.png` (drawn by the picture crate), and the result set that
+//! holds them with the solve's files ([`write_sensitivity_result`]). Written atomically,
+//! numbers in their shortest round-trip form and NaN as an empty field, like the other CSV
+//! files.
 
+use super::pictures::{pictures, write_png};
+use super::result::{write_result_set_with, Extras};
+use super::WriteOptions;
+use crate::case::Case;
 use crate::error::Result;
 use crate::fit::FitResult;
 use crate::io::numbers::push_shortest;
+use crate::mesh::Mesh;
+use crate::outcome::fields::NodalFields;
+use crate::outcome::{Outcome, SensitivityTotals, Summary};
 use crate::sensitivity::Sensitivities;
+use memcontact_plot::{render_fit_plot, FitPlot, FitSensor, PlotOptions, Units};
 use std::path::Path;
 
 /// The file name of the derivatives table.
@@ -196,4 +206,96 @@ pub fn write_fit_csv(path: &Path, fit: &FitResult) -> Result<()> {
         buf.push(b'\n');
     }
     crate::io::write_atomic(path, |w| w.write_all(&buf)).map(|_| ())
+}
+
+/// The file name of the fit's picture.
+pub const FIT_PICTURE: &str = "fit.png";
+
+/// Draws `fit.png` of `fit` into `path`: the measurements against the deflections computed
+/// at the fitted parameters, and the residuals at the sensors over the outline of `mesh`,
+/// titled `title`.
+pub fn fit_picture(
+    path: &Path,
+    fit: &FitResult,
+    mesh: &Mesh,
+    title: &str,
+    units: &Units,
+) -> Result<()> {
+    let sensors: Vec<FitSensor> = fit
+        .measurements
+        .iter()
+        .map(|m| FitSensor {
+            at: m.at,
+            measured: m.measured,
+            computed: m.computed,
+        })
+        .collect();
+    let note = format!(
+        "rms {:.3e}, {} iterations{}",
+        fit.rms,
+        fit.iterations,
+        if fit.converged {
+            ""
+        } else {
+            " (not converged)"
+        }
+    );
+    let canvas = render_fit_plot(&FitPlot {
+        title,
+        note: &note,
+        points: &mesh.points,
+        triangles: &mesh.triangles,
+        sensors: &sensors,
+        units,
+    })?;
+    write_png(path, &canvas)
+}
+
+/// Writes the result set of a run with `[sensitivity]` or `[fit]` into `target`
+/// atomically, as `memcontact solve` writes it: the solve's files and the pictures of
+/// `plots` (`summary.json` recording them, with the sensitivity's totals), the influence
+/// maps of `sensitivities` in `solution.vtu` and its `sensitivity.csv`, and the fit's
+/// `fit.json`, `fit.csv` and (when `plots` draws any picture) `fit.png`.
+/// `options.plot_options` is replaced by `plots`. Returns the summary written.
+pub fn write_sensitivity_result(
+    target: &Path,
+    outcome: &Outcome,
+    case: &Case,
+    options: &WriteOptions,
+    plots: &PlotOptions,
+    sensitivities: Option<&Sensitivities>,
+    fit: Option<&FitResult>,
+) -> Result<Summary> {
+    let options = WriteOptions {
+        plot_options: serde_json::to_value(plots).ok(),
+        ..options.clone()
+    };
+    let extras = Extras {
+        point_data: sensitivities
+            .map(|s| s.influence.clone())
+            .unwrap_or_default(),
+        sensitivity: sensitivities.map(SensitivityTotals::of),
+    };
+    let mesh = outcome.mesh();
+    let mut maps = pictures(&mesh, plots);
+    let title = format!("Fit: {}", plots.title.as_deref().unwrap_or(&options.label));
+    let mut extra = |dir: &Path, fields: &NodalFields| -> Result<Vec<String>> {
+        let mut names = maps(dir, fields)?;
+        if let Some(s) = sensitivities {
+            write_sensitivity_csv(&dir.join(SENSITIVITY_CSV), s)?;
+            names.push(SENSITIVITY_CSV.to_string());
+        }
+        if let Some(f) = fit {
+            write_fit_json(&dir.join(FIT_JSON), f)?;
+            write_fit_csv(&dir.join(FIT_CSV), f)?;
+            names.push(FIT_JSON.to_string());
+            names.push(FIT_CSV.to_string());
+            if !plots.plots.is_empty() {
+                fit_picture(&dir.join(FIT_PICTURE), f, &mesh, &title, &plots.units)?;
+                names.push(FIT_PICTURE.to_string());
+            }
+        }
+        Ok(names)
+    };
+    write_result_set_with(target, outcome, case, &options, &mut extra, &extras)
 }

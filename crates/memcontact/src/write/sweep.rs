@@ -77,6 +77,7 @@ impl SweepSet {
             run_id: Some(self.run_id.clone()),
             cell_data: Vec::new(),
             adapt: None,
+            unconverged: false,
             ..options.clone()
         };
         let summary = write_files(&dir, outcome, case, &options, extra)?;

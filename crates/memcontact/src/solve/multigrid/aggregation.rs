@@ -16,7 +16,7 @@
 //! the K-cycle of [`super::cycle::Multigrid::k_cycle`]. The aggregation is built once per
 //! solve from `S` plus the foundation's diagonal and reused by every Newton correction.
 
-use super::transfer::{galerkin_patterns, Transfer};
+use super::transfer::Transfer;
 use crate::sparse::{Csr, Pattern};
 use std::sync::Arc;
 
@@ -254,13 +254,9 @@ fn galerkin(a: &Csr, t: &Transfer) -> Csr {
     c
 }
 
-/// The Galerkin patterns of an aggregation hierarchy (see [`galerkin_patterns`]).
-pub fn patterns(transfers: &[Transfer], finest: Arc<Pattern>) -> Vec<Arc<Pattern>> {
-    galerkin_patterns(transfers, finest)
-}
-
 #[cfg(test)]
 mod tests {
+    use super::super::transfer::galerkin_patterns;
     use super::*;
 
     /// The 5-point Laplacian on an m × m grid.

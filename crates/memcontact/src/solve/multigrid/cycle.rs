@@ -209,13 +209,8 @@ impl<'a> Multigrid<'a> {
     }
 
     /// [`Multigrid::cycle`] from `x = 0`, whatever `x` holds on entry (the preconditioner
-    /// of [`Multigrid::fcg`]): the first smoothing sweep and the residual after it are then
-    /// one pass over A ([`gauss_seidel_from_zero`]).
-    pub fn cycle_from_zero<A: TopOperator>(&mut self, fine: &A, x: &mut [f64], b: &[f64]) {
-        self.cycle_from_zero_with_product(fine, x, b, None);
-    }
-
-    /// [`Multigrid::cycle_from_zero`], and `A x` after it into `product` when the last
+    /// of [`Multigrid::fcg`]: the first smoothing sweep and the residual after it are then
+    /// one pass over A), and `A x` after it into `product` when the last
     /// smoothing sweep can form it on the way ([`gauss_seidel_back_with_product`]): returns
     /// whether it did.
     pub fn cycle_from_zero_with_product<A: TopOperator>(
@@ -438,11 +433,6 @@ impl<'a> Multigrid<'a> {
         self.presmooth_and_restrict(k);
         self.krylov_correction(k - 1);
         self.prolongate_and_postsmooth(k, Some(product));
-    }
-
-    /// Number of levels used.
-    pub fn depth(&self) -> usize {
-        self.top + 1
     }
 
     /// Recomputes the coarse operators from the finest one, `fine` (on the pattern of the

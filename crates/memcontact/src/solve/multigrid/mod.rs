@@ -46,10 +46,8 @@ mod algebraic_tests;
 #[cfg(test)]
 pub(crate) mod tests;
 
-pub use cycle::Multigrid;
 #[cfg(feature = "kernel-timings")]
 pub use kernels::kernel_timings;
 pub use levels::{Kind, Levels};
-pub use poisson::{linear_solve, poisson_solve, LinearSolve};
-pub use tnnmg::{solve, solve_with, Coarsening, LevelReport, TnnmgOptions, TnnmgReport};
-pub use transfer::Transfer;
+pub use poisson::poisson_solve;
+pub use tnnmg::{solve, solve_with, Coarsening, TnnmgOptions};

@@ -4,6 +4,7 @@
 use super::levels::*;
 use super::smoother::*;
 use super::tnnmg::*;
+use super::transfer::Transfer;
 use super::*;
 use crate::field::FnCoefficient;
 use crate::mesh::refine::Hierarchy;

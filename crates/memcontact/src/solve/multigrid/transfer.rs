@@ -505,7 +505,9 @@ impl Transfer {
     }
 }
 
-/// The Galerkin patterns of a chain of transfers, coarsest first, ending with `finest`.
+/// The Galerkin patterns of a chain of transfers, coarsest first, ending with `finest`
+/// (the tests' check of the patterns the levels build as they go).
+#[cfg(test)]
 pub fn galerkin_patterns(transfers: &[Transfer], finest: Arc<Pattern>) -> Vec<Arc<Pattern>> {
     let mut pats = vec![finest];
     for t in transfers.iter().rev() {

@@ -1,4 +1,4 @@
-//! The disc's derivatives in the stiffness h (docs/theory.md#sensitivities), from its
+//! The disc's derivatives in the stiffness h (docs/theory.md#sensitivity-checks), from its
 //! closed form ([`DiskSolution`], contact disc `0 < a < R`), for the sensitivities'
 //! convergence tests.
 //!

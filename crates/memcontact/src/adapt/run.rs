@@ -1,0 +1,319 @@
+//! The adaptive loop itself ([`run_adapt`]), as the module's overview describes it.
+
+use super::row::AdaptRow;
+use super::{bisect, estimate::estimate, mark};
+use crate::case::{AdaptSpec, Case};
+use crate::discretization::{build_mesh, check_case_on_mesh, BoundData, Discretization};
+use crate::error::{Error, Invalid, Result};
+use crate::field::{Field, Stiffness};
+use crate::mesh::boundary::FixedBoundary;
+use crate::mesh::{Mesh, VertexTriangles};
+use crate::outcome::summary::AdaptTotals;
+use crate::outcome::Outcome;
+use crate::problem::Problem;
+use crate::solve::{Cancellable, Observer};
+use std::time::Instant;
+
+/// Why the adaptive loop stopped.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum AdaptStop {
+    /// The estimator met `[adapt] tolerance`.
+    Tolerance,
+    /// `[adapt] steps` were solved.
+    Steps,
+    /// The next mesh would have had more than `[adapt] max_vertices` vertices.
+    MaxVertices,
+    /// A step's solve was not accepted by the settings (its outcome is the last).
+    NotAccepted,
+    /// A step's estimator was not a finite number (the step before it is the last).
+    EstimatorNotFinite,
+    /// The next mesh would not fit in the memory available (the error says how much).
+    Memory,
+}
+
+impl AdaptStop {
+    /// The name in `summary.json`.
+    pub fn name(self) -> &'static str {
+        match self {
+            AdaptStop::Tolerance => "tolerance",
+            AdaptStop::Steps => "steps",
+            AdaptStop::MaxVertices => "max_vertices",
+            AdaptStop::NotAccepted => "not_accepted",
+            AdaptStop::EstimatorNotFinite => "estimator_not_finite",
+            AdaptStop::Memory => "memory",
+        }
+    }
+}
+
+/// What the adaptive loop produced.
+#[derive(Debug)]
+pub struct AdaptRun {
+    /// One row per step solved (the rows of `adapt.csv`).
+    pub rows: Vec<AdaptRow>,
+    /// The last step kept: its mesh is the final mesh.
+    pub outcome: Outcome,
+    /// η_T² of the last step kept, per triangle of its mesh in the user's order.
+    pub indicators: Vec<f64>,
+    /// Why the loop stopped.
+    pub stop: AdaptStop,
+    /// The error that stopped it (a solve not accepted, an estimator not finite, a mesh
+    /// beyond the memory available).
+    pub error: Option<Error>,
+    /// The keys of the data given per vertex that were interpolated onto new vertices.
+    pub interpolated: Vec<String>,
+    /// The case's problem with its data on the final mesh (per-vertex arrays
+    /// interpolated): what the last step solved.
+    pub problem: Problem,
+    /// Seconds of the whole loop.
+    pub seconds: f64,
+}
+
+/// What the loop tells its caller after every step: the step's row, its outcome and its
+/// η_T² in the user's triangle order. An error stops the loop with that error.
+pub type OnStep<'a> = dyn FnMut(&AdaptRow, &Outcome, &[f64]) -> Result<()> + 'a;
+
+impl AdaptRun {
+    /// The loop's totals for `summary.json`.
+    pub fn totals(&self) -> AdaptTotals {
+        AdaptTotals {
+            adapt_steps: self.rows.len(),
+            adapt_estimator: self.rows.last().map_or(f64::NAN, |r| r.estimator),
+            adapt_start_vertices: self.rows.first().map_or(0, |r| r.vertices),
+            adapt_iterations: self.rows.iter().map(|r| r.iterations).sum(),
+            adapt_seconds: self.seconds,
+            adapt_stop: self.stop.name().to_string(),
+            adapt_interpolated: self.interpolated.clone(),
+        }
+    }
+}
+
+/// Runs the adaptive loop of `case` (which needs an `[adapt]` section). `on_step` sees
+/// every step as soon as it is solved and estimated: its row, its outcome and its η_T² in
+/// the user's triangle order (to write or draw it). Bad input is an `Err`.
+pub fn run_adapt(
+    case: &Case,
+    observer: &mut dyn Observer,
+    on_step: &mut OnStep<'_>,
+) -> Result<AdaptRun> {
+    case.validate().map_err(Invalid::into_error)?;
+    let Some(spec) = case.adapt.clone() else {
+        return Err(Error::Case {
+            file: None,
+            line: None,
+            key: "adapt".into(),
+            message: "the case has no [adapt] section".into(),
+        });
+    };
+    let started = Instant::now();
+    let observer = &mut Cancellable::new(observer, &case.settings.cancel);
+    let (mut hierarchy, warnings) = build_mesh(&case.problem.mesh)?;
+    // The refinement edge of every triangle: its longest (once, on the start mesh).
+    let labelled = bisect::label_longest_edge(hierarchy.finest());
+    *hierarchy.levels.last_mut().expect("a level") = labelled;
+    check_adapt_on_mesh(&spec, hierarchy.finest())?;
+    let mut problem = case.problem.clone();
+    let mut interpolated = Vec::new();
+    let mut start: Option<Vec<f64>> = None;
+    let mut rows = Vec::new();
+    let mut kept: Option<(Outcome, Vec<f64>)> = None;
+    let mut step = 0;
+    let (stop, error) = loop {
+        case.settings.cancel.check()?;
+        let t0 = Instant::now();
+        observer.step_started(step, spec.steps, &format!("step {step}"));
+        let mut discretization = Discretization::assemble(&problem, hierarchy.clone(), observer)?;
+        if step == 0 {
+            discretization.warnings = warnings.clone();
+            check_case_on_mesh(case, discretization.mesh(), false)?;
+        }
+        let start_unknowns = start.as_ref().map(|values| {
+            let mesh = discretization.mesh();
+            let values = mesh.vertex_values_from_user(values);
+            discretization
+                .model
+                .dofs
+                .vertex
+                .iter()
+                .map(|&v| values[v as usize])
+                .collect::<Vec<f64>>()
+        });
+        let report =
+            discretization.solve_from(&case.settings, start_unknowns.as_deref(), observer)?;
+        let outcome = Outcome {
+            discretization,
+            report,
+        };
+        let indicators = match indicators(&problem, &outcome) {
+            Ok(ind) => ind,
+            Err(e @ Error::Data(_)) if kept.is_some() => {
+                break (AdaptStop::EstimatorNotFinite, Some(e));
+            }
+            Err(e) => return Err(e),
+        };
+        let total = indicators.iter().sum::<f64>().sqrt();
+        let row = AdaptRow::of(step, &outcome, total, t0.elapsed().as_secs_f64());
+        on_step(&row, &outcome, &indicators)?;
+        rows.push(row);
+        let accepted = outcome.report.accepted;
+        let error = outcome.report.error();
+        let (fields, _) = outcome.fields();
+        let u_user = fields.u.clone();
+        let contact_up: Vec<bool> = fields.state.iter().map(|&s| s >= 0).collect();
+        let contact_low: Option<Vec<bool>> = fields
+            .lower
+            .as_ref()
+            .map(|l| l.state.iter().map(|&s| s >= 0).collect());
+        drop(fields);
+        kept = Some((outcome, indicators));
+        if !accepted {
+            break (AdaptStop::NotAccepted, error);
+        }
+        if spec.tolerance.is_some_and(|tol| total <= tol) {
+            break (AdaptStop::Tolerance, None);
+        }
+        if step + 1 >= spec.steps {
+            break (AdaptStop::Steps, None);
+        }
+        // Mark, on the mesh in the user's numbering.
+        let mesh = hierarchy.finest();
+        let eta2 = &kept.as_ref().expect("kept").1;
+        let bulk = mark::dorfler(eta2, spec.theta)?;
+        let mut marked = bulk.clone();
+        let rings = spec.free_boundary_rings;
+        if rings > 0 {
+            let mut sets = vec![mark::free_boundary(mesh, &contact_up, rings)?];
+            if let Some(low) = &contact_low {
+                sets.push(mark::free_boundary(mesh, low, rings)?);
+            }
+            let refs: Vec<&[u32]> = sets.iter().map(Vec::as_slice).collect();
+            let free = mark::largest(mesh, &mark::union(&refs), &bulk, bulk.len());
+            marked = mark::union(&[&bulk, &free]);
+        }
+        let b = bisect::bisect(mesh, &marked)?;
+        if spec
+            .max_vertices
+            .is_some_and(|max| b.mesh.n_vertices() > max)
+        {
+            break (AdaptStop::MaxVertices, None);
+        }
+        if let Err(e) = crate::limits::check_mesh_fits(
+            crate::limits::MeshSize::of(&b.mesh),
+            0,
+            &format!("the adaptive loop's step {}", step + 1),
+        ) {
+            break (AdaptStop::Memory, Some(e));
+        }
+        start = Some(b.refinement.prolongate(&u_user));
+        interpolate_nodal(&mut problem, &b.refinement, &mut interpolated);
+        hierarchy.levels.push(b.mesh);
+        hierarchy.refinements.push(b.refinement);
+        step += 1;
+    };
+    let (outcome, indicators) = kept.expect("step 0 is kept or is an error");
+    Ok(AdaptRun {
+        rows,
+        outcome,
+        indicators,
+        stop,
+        error,
+        interpolated,
+        problem,
+        seconds: started.elapsed().as_secs_f64(),
+    })
+}
+
+/// The checks of `[adapt]` that need the start mesh: `max_vertices` at least its vertices,
+/// and a mesh of `max_vertices` vertices within the memory available. `check` and the
+/// loop call it.
+pub fn check_adapt_on_mesh(spec: &AdaptSpec, start: &Mesh) -> Result<()> {
+    let Some(max) = spec.max_vertices else {
+        return Ok(());
+    };
+    let start_vertices = start.n_vertices();
+    if max < start_vertices {
+        return Err(Error::Case {
+            file: None,
+            line: None,
+            key: "adapt.max_vertices".into(),
+            message: format!(
+                "is {max}, below the start mesh's {start_vertices} vertices: raise it, or \
+                 start from a coarser mesh"
+            ),
+        });
+    }
+    // A triangulation has about twice as many triangles as vertices.
+    let m = max as f64;
+    crate::limits::check_mesh_fits(
+        crate::limits::MeshSize::simply_connected(m, 2.0 * m),
+        0,
+        &format!("adapt.max_vertices = {max}"),
+    )
+}
+
+/// η_T² of a solved step, per triangle in the user's order.
+fn indicators(problem: &Problem, outcome: &Outcome) -> Result<Vec<f64>> {
+    let d = &outcome.discretization;
+    let mesh = d.mesh();
+    let bound = BoundData::new(problem, mesh)?;
+    let free = free_edges(mesh, &problem.boundary.free)?;
+    let ind = estimate(
+        mesh,
+        &d.model,
+        &bound.load,
+        &bound.shape,
+        &free,
+        &outcome.report.u,
+    )?;
+    Ok(match &mesh.numbering {
+        Some(n) => n.triangles.to_old(&ind.eta2),
+        None => ind.eta2,
+    })
+}
+
+/// The boundary edges with the natural condition: those of the regions `free` names.
+fn free_edges(mesh: &Mesh, free: &[String]) -> Result<Vec<[u32; 2]>> {
+    if free.is_empty() {
+        return Ok(Vec::new());
+    }
+    let adj = VertexTriangles::new(mesh);
+    let fixed = FixedBoundary::new(mesh, &adj, free)?;
+    let held: std::collections::HashSet<(u32, u32)> = fixed
+        .edges
+        .iter()
+        .map(|&([a, b], _)| (a.min(b), a.max(b)))
+        .collect();
+    Ok(mesh
+        .boundary_edges_with(&adj)
+        .into_iter()
+        .filter(|&[a, b]| !held.contains(&(a.min(b), a.max(b))))
+        .collect())
+}
+
+/// The data given per vertex, carried onto the new vertices of `refinement` by P1
+/// interpolation; `names` collects their keys.
+fn interpolate_nodal(
+    problem: &mut Problem,
+    refinement: &crate::mesh::refine::Refinement,
+    names: &mut Vec<String>,
+) {
+    let mut carry = |key: &str, f: &mut Field| {
+        if let Field::Nodal(values) = f {
+            *values = refinement.prolongate(values).into();
+            if !names.iter().any(|n| n == key) {
+                names.push(key.to_string());
+            }
+        }
+    };
+    carry("membrane.load", &mut problem.membrane.load);
+    carry("obstacle.shape", &mut problem.obstacle.shape);
+    if let Stiffness::Elastic(h) = &mut problem.obstacle.stiffness {
+        carry("obstacle.stiffness", h);
+    }
+    carry("boundary.height", &mut problem.boundary.height);
+    if let Some(low) = &mut problem.lower {
+        carry("lower.shape", &mut low.shape);
+        if let Stiffness::Elastic(h) = &mut low.stiffness {
+            carry("lower.stiffness", h);
+        }
+    }
+}
