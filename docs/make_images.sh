@@ -6,6 +6,7 @@
 #     (adaptivity.md);
 #   - geomembrane-deflection.png, geomembrane-liftoff.png: the pictures of a membrane
 #     between two bodies, `examples/geomembrane.toml` (outputs.md, "Pictures");
+#   - soils-fit.png: fit.png of the back-analysis `examples/soils.toml` (sensitivities.md);
 #   - python-deflection.png: the matplotlib picture of the Python guide (python.md), when
 #     the `memcontact` package and matplotlib can be imported by $PYTHON.
 # Usage: docs/make_images.sh   (MEMCONTACT: the binary; default: a release build made with
@@ -35,6 +36,9 @@ cp "$TMP/roof-corner/mesh.png" "$IMAGES/adapt-mesh.png"
 for p in deflection liftoff; do
     cp "$TMP/geomembrane/$p.png" "$IMAGES/geomembrane-$p.png"
 done
+
+"$MEMCONTACT" solve examples/soils.toml -o "$TMP/soils" -q >/dev/null
+cp "$TMP/soils/fit.png" "$IMAGES/soils-fit.png"
 
 
 PYTHON="${PYTHON:-python3}"

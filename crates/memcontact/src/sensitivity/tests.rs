@@ -485,6 +485,20 @@ fn disc_derivatives_converge_to_the_bessel_solution() {
     let richardson = (4.0 * fd(0.05) - fd(0.1)) / 3.0;
     println!("exact: dJ/dh = {dj:.12e}, du(0)/dh = {du0:.12e} (differences of the closed form {richardson:.12e})");
     assert!((richardson - du0).abs() <= 1e-8 * du0.abs());
+    // The values derived independently of this code (the same closed form, in extended
+    // precision).
+    #[allow(clippy::excessive_precision)] // the digits as derived
+    const DJ_DH: f64 = 3.00389749175527651e-5;
+    #[allow(clippy::excessive_precision)]
+    const DU0_DH: f64 = -9.447197135043153254e-5;
+    assert!(
+        (dj - DJ_DH).abs() <= 1e-10 * DJ_DH.abs(),
+        "{dj:e} against {DJ_DH:e}"
+    );
+    assert!(
+        (du0 - DU0_DH).abs() <= 1e-10 * DU0_DH.abs(),
+        "{du0:e} against {DU0_DH:e}"
+    );
     let mut errors = Vec::new();
     for refine in 0..4 {
         let text = format!(
