@@ -6,9 +6,9 @@
 #     (adaptivity.md);
 #   - geomembrane-deflection.png, geomembrane-liftoff.png: the pictures of a membrane
 #     between two bodies, `examples/geomembrane.toml` (outputs.md, "Pictures");
-#   - soils-fit.png: fit.png of the back-analysis `examples/soils.toml` (sensitivities.md);
-#   - python-deflection.png: the matplotlib picture of the Python guide (python.md), when
-#     the `memcontact` package and matplotlib can be imported by $PYTHON.
+#   - soils-fit.png: fit.png of the back-analysis `examples/soils.toml` (sensitivities.md).
+# The Python guide's pictures (images/python/) are drawn by its own session:
+# MEMCONTACT_DOCS_IMAGES=1 pytest crates/memcontact-py/tests/test_walkthrough.py.
 # Usage: docs/make_images.sh   (MEMCONTACT: the binary; default: a release build made with
 # cargo, a no-op when it is up to date)
 set -euo pipefail
@@ -41,27 +41,4 @@ done
 cp "$TMP/soils/fit.png" "$IMAGES/soils-fit.png"
 
 
-PYTHON="${PYTHON:-python3}"
-# A path to an interpreter (a virtual environment's) holds from the scratch directory too.
-case "$PYTHON" in */*) PYTHON="$(cd "$(dirname "$PYTHON")" && pwd)/$(basename "$PYTHON")" ;; esac
-if "$PYTHON" -c 'import memcontact, matplotlib' 2>/dev/null; then
-    cp -r examples "$TMP/examples"
-    (cd "$TMP" && MPLBACKEND=Agg "$PYTHON" - <<'PY'
-import matplotlib.pyplot as plt
-import memcontact as mc
-
-mesh = mc.disk(radius=1.0, size=0.03)
-r = mc.solve_mesh(mesh, tension=1.0, load=8.0, shape="1 - 0.3*x", stiffness=100.0)
-x, y = mesh.vertices.T
-plt.tripcolor(x, y, mesh.triangles, r.u, shading="gouraud")
-plt.colorbar(label="u")
-plt.tricontour(x, y, mesh.triangles, r.u - r.phi, levels=[0], colors="k")  # contact edge
-plt.gca().set_aspect("equal")
-plt.savefig("python-deflection.png", dpi=80)
-PY
-    )
-    cp "$TMP/python-deflection.png" "$IMAGES/python-deflection.png"
-else
-    echo "make_images.sh: $PYTHON cannot import memcontact and matplotlib; python-deflection.png left as it is" >&2
-fi
 ls -l "$IMAGES"

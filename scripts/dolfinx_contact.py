@@ -1,6 +1,6 @@
 #!/usr/bin/python3
 """The standard benchmark (docs/benchmarks.md) in DOLFINx, as the peer beside which
-memcontact's figures in "At scale, and beside DOLFINx" (docs/benchmarks.md) were measured.
+memcontact's figures in "Beside DOLFINx" (docs/benchmarks.md#dolfinx) were measured.
 
 Problem: u = 0 on the whole boundary, t = 1, f = 20, h = 1000 with the lumped foundation
 (L_ii = int h g_i, zero on the boundary), phi = 0.5 + 0.1 sin(2 pi x) cos(2 pi y) at the

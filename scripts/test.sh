@@ -1,12 +1,20 @@
 #!/usr/bin/env bash
-# Runs every test: the Rust workspace, then the Python package built with maturin in a
-# fresh virtual environment (target/test-venv) and its pytest suite (which runs the
-# documentation's cases and snippets: tests/test_docs.py), then the documentation site,
-# built with mkdocs --strict in the same environment.
+# Runs every test: the Rust API reference (rustdoc, warnings as errors), the Rust workspace,
+# then the Python package built with maturin in a fresh virtual environment
+# (target/test-venv) and its pytest suite (which runs the documentation's cases and
+# snippets: tests/test_docs.py), then the documentation site, built with mkdocs --strict in
+# the same environment.
 # Needs the Rust toolchain and Python >= 3.9 with pip (PYTHON selects the interpreter).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 cargo --version
+# The Rust API reference: no broken intra-doc link, no public page linking to a private
+# item. The command-line tool's pages first (they share the library's name); then every
+# crate (the library with the `bench` feature the tool enables); then the library alone,
+# as a user's `cargo doc` shows it, whose pages are the ones left in target/doc/memcontact.
+RUSTDOCFLAGS="-D warnings" cargo doc --quiet --no-deps -p memcontact-cli --bin memcontact
+RUSTDOCFLAGS="-D warnings" cargo doc --quiet --no-deps --workspace
+RUSTDOCFLAGS="-D warnings" cargo doc --quiet --no-deps -p memcontact
 cargo test --workspace --release
 # The Python tests compare against the command-line tool.
 cargo build --release -p memcontact-cli

@@ -31,6 +31,9 @@ impl From<Compare> for memcontact::verify::study::Compare {
 }
 
 /// Arguments of `memcontact convergence`.
+// The doc comments below are the command's help text (plain text: `<variant>` is a
+// placeholder, not an HTML tag).
+#[allow(rustdoc::invalid_html_tags)]
 #[derive(Debug, clap::Args)]
 pub struct Args {
     /// The case file (TOML); its `[exact]` section names the exact solution (without one,

@@ -48,6 +48,9 @@ struct Cli {
     command: Command,
 }
 
+// The doc comments below are the command's help text (plain text: `[sweep]` is a case-file
+// section, not an intra-doc link).
+#[allow(rustdoc::broken_intra_doc_links)]
 #[derive(Subcommand)]
 enum Command {
     /// Solve a case and write solution.vtu, nodes.csv, the pictures and summary.json.

@@ -8,6 +8,9 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 /// Arguments of `memcontact plot`.
+// The doc comments below are the command's help text (plain text: `[output]` is a case-file
+// section, not an intra-doc link).
+#[allow(rustdoc::broken_intra_doc_links)]
 #[derive(clap::Args)]
 pub struct Args {
     /// The result directory (written by `memcontact solve`), or a sweep's directory (then

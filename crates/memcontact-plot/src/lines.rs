@@ -38,9 +38,9 @@ pub struct Series {
 pub struct LinePlot {
     /// The title.
     pub title: String,
-    /// The x-axis title, units included (e.g. "load factor").
+    /// The x-axis title, units included (e.g. `load factor`).
     pub x_label: String,
-    /// The y-axis title, units included (e.g. "max deflection [m]").
+    /// The y-axis title, units included (e.g. `max deflection [m]`).
     pub y_label: String,
     /// The curves.
     pub series: Vec<Series>,

@@ -569,7 +569,8 @@ impl PyResult_ {
         to_py(py, &summary)
     }
 
-    /// The assembled discrete problem over the unknowns (SPEC §2, §5), for scipy.
+    /// The assembled discrete problem over the unknowns (docs/theory.md#discrete-model,
+    /// docs/theory.md#extensions), for scipy.
     ///
     /// Unknown `k` is vertex `unknowns[k]` (increasing): `U = result.u[m["unknowns"]]`.
     /// U minimises `½ VᵀSV − VᵀD + ½ pᵀLp` (`p = (V − φ)⁺`; with a body below

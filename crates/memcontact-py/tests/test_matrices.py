@@ -1,7 +1,8 @@
 """Result.matrices(): S, L, D and φ over the unknowns, against an independent P1 assembly
 in NumPy (on a mesh whose numbering the solver renumbers), and the certificate of Problem
-2f (with the body below, SPEC §5's one-sided derivatives; rigid: the obstacle problem's
-conditions) recomputed in scipy from them and the result's u, for both foundations."""
+2f (with the body below, the one-sided derivatives of docs/theory.md#second-body; rigid:
+the obstacle problem's conditions) recomputed in scipy from them and the result's u, for
+both foundations."""
 
 import numpy as np
 import pytest
@@ -132,7 +133,8 @@ def test_scipy_reproduces_the_certificate(examples, foundation):
 
 @pytest.mark.parametrize("foundation", ["consistent", "lumped"])
 def test_scipy_reproduces_the_two_body_conditions(examples, foundation):
-    """SPEC §5: at every unknown, zero lies between the one-sided derivatives of J."""
+    """At every unknown, zero lies between the one-sided derivatives of J
+    (docs/theory.md#second-body)."""
     r = mc.solve(mc.load_case(examples / "liner-slope.toml",
                               {"obstacle.foundation": foundation,
                                "lower.foundation": foundation}))

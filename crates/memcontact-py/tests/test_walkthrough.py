@@ -1,4 +1,4 @@
-"""The notebook walkthrough (walkthrough.md, the docs' Python guide) runs as written: its
+"""The notebook session of the docs' Python guide (docs/python.md) runs as written: its
 `>>>` cells through doctest, what they print compared with the page. The pictures the
 page shows are the figures its cells draw, in order (and the PNG of its last cell); with
 MEMCONTACT_DOCS_IMAGES=1 they are written to docs/images/python/ (else to a temporary
@@ -16,7 +16,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 
 from conftest import REPO  # noqa: E402
 
-PAGE = REPO / "crates" / "memcontact-py" / "walkthrough.md"
+PAGE = REPO / "docs" / "python.md"
 
 
 def test_walkthrough_runs_as_written(monkeypatch, tmp_path):
@@ -34,7 +34,7 @@ def test_walkthrough_runs_as_written(monkeypatch, tmp_path):
     runner.run(test, clear_globs=False)
     result = runner.summarize(verbose=False)
     assert result.attempted > 30
-    assert result.failed == 0, f"{result.failed} cells of walkthrough.md print otherwise"
+    assert result.failed == 0, f"{result.failed} cells of docs/python.md print otherwise"
     # The pictures: the figures drawn, in order, then the renderer's PNG.
     images = re.findall(r"\]\(images/python/([\w-]+\.png)\)", text)
     figures = plt.get_fignums()

@@ -2,7 +2,7 @@
 //! `cargo bench`) that times them one by one: the P1 assembly kernels, the model's
 //! assembly from raw data, the multigrid solver with its options and the timings of its
 //! kernels, and the vertex numbering. Behind the `bench` feature; not a stable API (the
-//! runs of [`crate::run`] are the library's interface).
+//! runs of [`mod@crate::run`] are the library's interface).
 
 pub use crate::fem::{assemble_stiffness_and_mass, assemble_vector, unknowns_pattern};
 pub use crate::mesh::reorder::edge_span;

@@ -17,16 +17,16 @@
 //! These are the componentwise conditions of 2f; with `X₁ = D − SU`, `U₂ = p`,
 //! `X₂ = L̃U₂ − X₁` they are those of 2e (`X ≥ 0`, `X̂₁ = 0` off M, both complementarities).
 //!
-//! Beyond the paper (SPEC §5) the same pass takes a body below and rigid regions: with
-//! `q = (φ_low − U)⁺`, zero must lie between `left = r + (Lp)·[U > φ] − (L_low q)·[U ≤
-//! φ_low]` and `right = r + (Lp)·[U ≥ φ] − (L_low q)·[U < φ_low]`, and 2e splits the net
-//! force between the two bodies ([`ContactForces`]). Without a body below and rigid
-//! regions these are exactly the conditions above; the pass then runs its original
-//! instantiation, at its original cost. Boundary heights enter through `D` (the lifting).
-//! The largest violation, a force, is divided by the **force scale of the iterate**
-//! `max(‖D‖∞, ‖SU‖∞, ‖Lp‖∞)`: the load and the elastic and foundation forces actually
-//! present, never forces the iterate does not exert, so that no iterate passes unless it
-//! balances the forces it carries.
+//! Beyond the paper (docs/theory.md#second-body, docs/theory.md#mixed-bodies) the same pass
+//! takes a body below and rigid regions: with `q = (φ_low − U)⁺`, zero must lie between
+//! `left = r + (Lp)·[U > φ] − (L_low q)·[U ≤ φ_low]` and `right = r + (Lp)·[U ≥ φ] − (L_low
+//! q)·[U < φ_low]`, and 2e splits the net force between the two bodies ([`ContactForces`]).
+//! Without a body below and rigid regions these are exactly the conditions above; the pass
+//! then runs its original instantiation, at its original cost. Boundary heights enter
+//! through `D` (the lifting). The largest violation, a force, is divided by the **force
+//! scale of the iterate** `max(‖D‖∞, ‖SU‖∞, ‖Lp‖∞)`: the load and the elastic and
+//! foundation forces actually present, never forces the iterate does not exert, so that no
+//! iterate passes unless it balances the forces it carries.
 //!
 //! The **rounding floor** is what double precision can resolve: each residual component
 //! is a sum whose terms have the size `Σⱼ|S_ij||U_j| + |D_i| + Σⱼ L_ij (|U_j| + |φ_j|)`;
@@ -84,12 +84,14 @@ impl Certificate {
         self.residual_2f.max(self.residual_2e)
     }
 
-    /// The residual is within [`AT_FLOOR`] times the rounding floor.
+    /// The residual is within twice the rounding floor (`AT_FLOOR`): iterating further only
+    /// moves the rounding errors around.
     pub fn at_floor(&self) -> bool {
         self.kkt() <= AT_FLOOR * self.rounding_floor
     }
 
-    /// Within [`NEAR_FLOOR`] times the rounding floor.
+    /// Within eight times the rounding floor (`NEAR_FLOOR`): a solve whose residual stops
+    /// decreasing there has reached what the arithmetic allows.
     pub fn near_floor(&self) -> bool {
         self.kkt() <= NEAR_FLOOR * self.rounding_floor
     }
@@ -202,7 +204,8 @@ pub fn evaluate(model: &Model, v: &[f64]) -> Evaluation {
 }
 
 /// [`evaluate`] with the upper body's `(Lp)_i` computed by a closure per kind of L (the
-/// inner loop is compiled once per kind). `EXT`: a body below or rigid regions (SPEC §5).
+/// inner loop is compiled once per kind). `EXT`: a body below or rigid regions
+/// (docs/theory.md#extensions).
 fn evaluate_bodies<const EXT: bool>(model: &Model, v: &[f64]) -> Evaluation {
     match &model.l {
         FoundationMatrix::Consistent(l) => evaluate_with::<EXT>(model, v, |_, s, e| {
@@ -281,15 +284,15 @@ impl Side {
     };
 }
 
-/// The optimality conditions at a vertex that a body can touch (SPEC §5): the violations
-/// `(2f, 2e)` as forces. 2f: zero lies between the left and right derivatives of J along
-/// the coordinate, `left = r + (Lp)·[U > φ] − (L_low q)·[U ≤ φ_low]`,
-/// `right = r + (Lp)·[U ≥ φ] − (L_low q)·[U < φ_low]` (±∞ on the far side of a rigid
-/// body at its surface; a rigid body violated counts the force `S_ii` times the
-/// violation). 2e: the contact forces `X = X_up` (pushing down) and `X_low` (pushing up)
-/// with `r + X − X_low = 0`, each ≥ 0, zero where its body is clear, and, for an elastic
-/// body, at most its force `(Lp)_i` and equal to it where it penetrates. Without a body
-/// below these are the paper's 2f and 2e with `X₁ = −r`, `X₂ = Lp + r`.
+/// The optimality conditions at a vertex that a body can touch
+/// (docs/theory.md#second-body): the violations `(2f, 2e)` as forces. 2f: zero lies between
+/// the left and right derivatives of J along the coordinate, `left = r + (Lp)·[U > φ] −
+/// (L_low q)·[U ≤ φ_low]`, `right = r + (Lp)·[U ≥ φ] − (L_low q)·[U < φ_low]` (±∞ on the
+/// far side of a rigid body at its surface; a rigid body violated counts the force `S_ii`
+/// times the violation). 2e: the contact forces `X = X_up` (pushing down) and `X_low`
+/// (pushing up) with `r + X − X_low = 0`, each ≥ 0, zero where its body is clear, and, for
+/// an elastic body, at most its force `(Lp)_i` and equal to it where it penetrates. Without
+/// a body below these are the paper's 2f and 2e with `X₁ = −r`, `X₂ = Lp + r`.
 #[inline(always)]
 fn conditions(r: f64, sii: f64, vi: f64, up: Side, low: Side) -> (f64, f64) {
     let up_el = up.active && !up.rigid;
@@ -574,7 +577,8 @@ fn evaluate_with<const EXT: bool>(
 
 impl Model {
     /// The optimality certificates of a candidate U (Problems 2e and 2f, scaled by the
-    /// forces of U): see [`evaluate`].
+    /// forces of U, with the energy and the rounding floor): see
+    /// docs/theory.md#certificates.
     pub fn certificate(&self, u: &[f64]) -> Certificate {
         evaluate(self, u).certificate
     }

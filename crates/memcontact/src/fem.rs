@@ -1,5 +1,5 @@
 //! P1 finite elements: element geometry, local matrices and the global assembly of the
-//! paper's S, L and D (SPEC §2) over the interior vertices.
+//! paper's S, L and D (docs/theory.md#matrices) over the interior vertices.
 //!
 //! Assembly is row-wise: every unknown gathers the contributions of the triangles around
 //! it. Rows are independent, so they are built in parallel and the result does not depend
@@ -57,6 +57,7 @@ impl Element {
 
     /// `∫_T c λ_a λ_b` (exact for constant c on the region, degree-5 quadrature otherwise):
     /// entry (a, b) of [`Element::weighted_mass_matrix`].
+    #[cfg(any(test, feature = "bench"))]
     #[inline]
     pub fn weighted_mass(&self, c: &dyn Coefficient, region: u32, a: usize, b: usize) -> f64 {
         self.weighted_mass_matrix(c, region)[sym_index(a, b)]
@@ -113,6 +114,7 @@ impl Element {
     }
 
     /// `∫_T c λ_a`: corner a of [`Element::weighted_load_row`].
+    #[cfg(any(test, feature = "bench"))]
     #[inline]
     pub fn weighted_load(&self, c: &dyn Coefficient, region: u32, a: usize) -> f64 {
         self.weighted_load_row(c, region)[a]
@@ -262,10 +264,11 @@ fn position(cols: &[u32], j: u32) -> usize {
 }
 
 /// Assembles the stiffness matrix `S_ij = t ∫ ∇g_i·∇g_j` and, when `h` is given, the
-/// consistent foundation matrix `L_ij = ∫ h g_i g_j` on `pattern`, in one pass over the rows
-/// (SPEC §2). Entry `(i, j)` sums the element integrals of the triangles around `a_i`
-/// (`∫_T ∇λ_a·∇λ_b` from the edges opposite corners a and b, one division per triangle).
-/// Blocks of rows are assembled in parallel; the result does not depend on the thread count.
+/// consistent foundation matrix `L_ij = ∫ h g_i g_j` on `pattern`, in one pass over the
+/// rows (docs/theory.md#matrices). Entry `(i, j)` sums the element integrals of the
+/// triangles around `a_i` (`∫_T ∇λ_a·∇λ_b` from the edges opposite corners a and b, one
+/// division per triangle). Blocks of rows are assembled in parallel; the result does not
+/// depend on the thread count.
 pub fn assemble_stiffness_and_mass(
     mesh: &Mesh,
     dofs: &DofMap,
@@ -529,6 +532,7 @@ impl<'a> Loads<'a> {
 
 /// Fills a vector over unknowns: entry `i` sums `local(element, region, a)` over the
 /// triangles around `a_i` (`a` the local index of `a_i`).
+#[cfg(any(test, feature = "bench"))]
 pub fn assemble_vector(
     mesh: &Mesh,
     dofs: &DofMap,
@@ -552,9 +556,9 @@ pub fn assemble_vector(
         .collect()
 }
 
-/// The lifting of boundary data (SPEC §5): `(S_fix G)_i = t Σ_j ∫ ∇g_i·∇g_j G_j` over the
-/// fixed vertices j (those without an unknown), for every unknown i. `g` holds G over all
-/// vertices (its values at unknowns are not used).
+/// The lifting of boundary data (docs/theory.md#boundary-data): `(S_fix G)_i = t Σ_j ∫
+/// ∇g_i·∇g_j G_j` over the fixed vertices j (those without an unknown), for every unknown
+/// i. `g` holds G over all vertices (its values at unknowns are not used).
 pub fn assemble_lift(
     mesh: &Mesh,
     dofs: &DofMap,

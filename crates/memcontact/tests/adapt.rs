@@ -1,8 +1,9 @@
-//! The adaptive loop (SPEC §6) against mathematics: the exact free boundary of PETSc's ex9
-//! ball, the optimal rate of the energy error on an L-shaped domain (against a reference J
-//! extrapolated from uniform refinements), the estimator's reliability and efficiency on
-//! manufactured solutions (a free edge and a body below among them), a rigid region, and
-//! the loop's own guarantees (nested meshes, certified steps, bounded iterations).
+//! The adaptive loop (docs/theory.md#adaptivity) against mathematics: the exact free
+//! boundary of PETSc's ex9 ball, the optimal rate of the energy error on an L-shaped domain
+//! (against a reference J extrapolated from uniform refinements), the estimator's
+//! reliability and efficiency on manufactured solutions (a free edge and a body below among
+//! them), a rigid region, and the loop's own guarantees (nested meshes, certified steps,
+//! bounded iterations).
 
 use memcontact::adapt::AdaptRow;
 use memcontact::case::Case;
@@ -80,7 +81,8 @@ fn check_loop_guarantees(steps: &Steps) {
     );
 }
 
-/// PETSc SNES ex9 in this project's sign convention (SPEC §5): the exact solution.
+/// PETSc SNES ex9 in this project's sign convention (docs/theory.md#obstacle-benchmarks):
+/// the exact solution.
 fn ex9_exact(p: [f64; 2]) -> f64 {
     let a = 0.697965148223374_f64;
     let big_a = a * a / (1.0 - a * a).sqrt();
@@ -282,8 +284,9 @@ fn l_shape_energy_error_falls_at_the_optimal_rate() {
     assert!(hi / lo <= 4.0, "η/e from {lo:.2} to {hi:.2}");
 }
 
-/// The manufactured case of SPEC §4 on the unit square: u = sin(πx) sin(πy), t = 1.5,
-/// φ and h varying, the load f = −tΔu + h (u − φ)⁺ written as an expression.
+/// A manufactured case (docs/theory.md#manufactured-solutions) on the unit square: u =
+/// sin(πx) sin(πy), t = 1.5, φ and h varying, the load f = −tΔu + h (u − φ)⁺ written as an
+/// expression.
 fn manufactured_case(nx: usize, adapt_section: &str) -> String {
     format!(
         r#"
@@ -357,8 +360,9 @@ fn manufactured_estimator_is_reliable_and_efficient() {
     check_estimator_and_rate(manufactured_case, &exact, 1.5);
 }
 
-/// The manufactured cosine (SPEC §4) with a free top edge (t ∂u/∂n = 0 there), the other
-/// sides held at g = u, an elastic obstacle above and an elastic body below.
+/// The manufactured cosine (docs/theory.md#manufactured-solutions) with a free top edge (t
+/// ∂u/∂n = 0 there), the other sides held at g = u, an elastic obstacle above and an
+/// elastic body below.
 fn free_edge_case(nx: usize, adapt_section: &str) -> String {
     let u = "0.1*(cos(pi*x)*cos(pi*y) + 0.5*cos(2*pi*y))";
     format!(

@@ -318,9 +318,10 @@ fn generators_name_their_sides_and_refinement_keeps_them() {
     }
 }
 
-/// The formulations of SPEC §4 and §5 on one case: active set (2f), the QP with the extra
-/// variables (2c), coordinate descent (2b) and multigrid agree to 1e-8 with certificates
-/// ≤ 1e-9. Returns the active-set report and the largest difference.
+/// The formulations (docs/theory.md#formulations-agree) with the extensions
+/// (docs/theory.md#extensions) on one case: active set (2f), the QP with the extra
+/// variables (2c), coordinate descent (2b) and multigrid agree to 1e-8 with certificates ≤
+/// 1e-9. Returns the active-set report and the largest difference.
 fn agree(name: &str, text: &str) -> (Discretization, memcontact::Report, f64) {
     let d = disc(text);
     let (ua, ra) = solve(&d, Method::ActiveSet, 1e-11);

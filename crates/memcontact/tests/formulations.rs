@@ -1,4 +1,4 @@
-//! The paper's formulations agree (SPEC §4, "Formulations agree"): on square and disc
+//! The paper's formulations agree (docs/theory.md#formulations-agree): on square and disc
 //! meshes, with constant and varying data, touching vertices, a rigid obstacle and a
 //! partial foundation, the solutions of 2f (active set), 2c (QP, Clarabel) and 2b
 //! (coordinate descent) coincide, and every answer satisfies the 2e and 2f certificates.

@@ -3,10 +3,11 @@
 //! φ(x, y) = 0.5 + 0.1 sin(2πx) cos(2πy), a structured N × N mesh with every square cut
 //! along the diagonal from `(x_i, y_j)` to `(x_{i+1}, y_{j+1})` (the rectangle generator
 //! builds the multigrid hierarchy itself), nodal φ, tolerance 1e-10 on the scaled KKT
-//! residual, solved by TNNMG ([`memcontact::solve::multigrid`]).
+//! residual, solved by TNNMG ([`memcontact::bench::solve_with`]).
 //!
 //! Every row also times one linear Poisson solve `S x = D` on the same mesh by the same
-//! multigrid V-cycle (from zero, to the same relative tolerance), as the yardstick. `memcontact bench` prints the rows.
+//! multigrid V-cycle (from zero, to the same relative tolerance), as the yardstick.
+//! `memcontact bench` prints the rows.
 
 use super::proc::{peak_memory, reset_peak_memory};
 use memcontact::bench::{self as multigrid, BodyStiffness, Model, ProblemData, TnnmgOptions};

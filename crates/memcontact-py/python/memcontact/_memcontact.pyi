@@ -483,8 +483,9 @@ class Result:
         """
         ...
     def matrices(self) -> Dict[str, Any]:
-        """The assembled discrete problem over the unknowns (SPEC §2, §5), so that scipy
-        can check Problems 2e/2f or post-process the answer.
+        """The assembled discrete problem over the unknowns (docs/theory.md#discrete-model,
+        docs/theory.md#extensions), so that scipy can check Problems 2e/2f or post-process
+        the answer.
 
         The unknowns are numbered in the order of the user's vertices: unknown ``k`` is
         vertex ``unknowns[k]``, so ``U = result.u[m["unknowns"]]``. U minimises

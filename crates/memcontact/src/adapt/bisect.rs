@@ -1,5 +1,5 @@
-//! Newest-vertex bisection (SPEC §6, "Refinement"): local refinement that keeps the mesh
-//! conforming, nested and shape-regular, for the adaptive loop.
+//! Newest-vertex bisection (docs/theory.md#refinement): local refinement that keeps the
+//! mesh conforming, nested and shape-regular, for the adaptive loop.
 //!
 //! **The refinement edge is stored in the vertex order.** Triangle `[a, b, c]`
 //! (counter-clockwise, as everywhere) has refinement edge `(a, b)`, and `c` is its newest
@@ -89,8 +89,9 @@ pub fn longest_edge_first(points: &[Point], t: [u32; 3]) -> [u32; 3] {
 
 /// `mesh` with every triangle rotated so that its refinement edge (the first two vertices)
 /// is its longest edge ([`longest_edge_first`]): the labelling of the start mesh of an
-/// adaptive run (SPEC §6). Orientation, triangle order, regions, boundary regions, curve
-/// and numbering are kept (a rotation changes no triangle's index and no vertex).
+/// adaptive run (docs/theory.md#refinement). Orientation, triangle order, regions, boundary
+/// regions, curve and numbering are kept (a rotation changes no triangle's index and no
+/// vertex).
 pub fn label_longest_edge(mesh: &Mesh) -> Mesh {
     let triangles = mesh
         .triangles
@@ -242,10 +243,11 @@ fn on_circle(c: &Circle, p: Point) -> bool {
     (crate::mesh::dist(p, c.center) - c.radius).abs() <= 1e-9 * c.radius
 }
 
-/// Newest-vertex bisection of `mesh` (SPEC §6): every triangle of `marked` (indices, in
-/// any order, repeats allowed) is bisected at least once, and its neighbours as often as
-/// conformity needs (see the module's notes on the closure). The mesh's labels are its
-/// vertex order (refinement edge first); label a start mesh with [`label_longest_edge`].
+/// Newest-vertex bisection of `mesh` (docs/theory.md#refinement): every triangle of
+/// `marked` (indices, in any order, repeats allowed) is bisected at least once, and its
+/// neighbours as often as conformity needs (see the module's notes on the closure). The
+/// mesh's labels are its vertex order (refinement edge first); label a start mesh with
+/// [`label_longest_edge`].
 ///
 /// Region tags follow the parent triangle, region names are copied; a tagged boundary
 /// edge that is split becomes two edges with its tag. New vertices are edge midpoints,

@@ -1,5 +1,5 @@
-//! A posteriori error indicators of a discrete solution (SPEC §6), one per triangle, in the
-//! units of the energy norm `‖v‖²_a = t ∫ |∇v|²` squared:
+//! A posteriori error indicators of a discrete solution (docs/theory.md#estimators), one
+//! per triangle, in the units of the energy norm `‖v‖²_a = t ∫ |∇v|²` squared:
 //!
 //! `η_T² = (1/t) [ h_T² ‖f − ρ_h‖²_T + ½ Σ_{E ⊂ ∂T inside} h_E ‖[t ∂u_h/∂n]‖²_E
 //!          + Σ_{E ⊂ ∂T free} h_E ‖t ∂u_h/∂n‖²_E ] + ∫_T ρ_rigid⁺ |φ − u_h|`.

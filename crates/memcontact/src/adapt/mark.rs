@@ -1,6 +1,6 @@
-//! Marking for adaptive refinement (SPEC §6): Dörfler's bulk criterion on error
-//! indicators, the triangles across the discrete free boundary, and unions of marked
-//! sets. Marked sets are sorted triangle indices without repeats, the input of
+//! Marking for adaptive refinement (docs/adaptivity.md#marking): Dörfler's bulk criterion
+//! on error indicators, the triangles across the discrete free boundary, and unions of
+//! marked sets. Marked sets are sorted triangle indices without repeats, the input of
 //! [`super::bisect::bisect`]. Nothing here knows the solver: indicators and contact flags
 //! are plain slices.
 
@@ -92,7 +92,7 @@ fn sum(items: &[(f64, u32)]) -> f64 {
     }
 }
 
-/// Free-boundary marking (SPEC §6, "The free boundary"): the triangles that have both a
+/// Free-boundary marking (docs/theory.md#free-boundary): the triangles that have both a
 /// vertex in contact and one not (`contact[v]`, one flag per vertex), which hold the
 /// discrete free boundary, plus `rings` rings of neighbours around them (a ring adds every
 /// triangle that shares a vertex with the set; `rings = 0` gives the crossing triangles

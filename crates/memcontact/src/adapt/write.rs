@@ -60,7 +60,9 @@ pub struct AdaptSet {
 }
 
 impl AdaptSet {
-    /// Starts the set for directory `target` (see [`ResultSet::begin`]).
+    /// Starts the set for directory `target`: checks what is there (another directory's
+    /// contents are refused unless `force`), removes staging directories of runs that are
+    /// gone, and creates a fresh staging directory.
     pub fn begin(target: &Path, force: bool) -> Result<AdaptSet> {
         Ok(AdaptSet {
             set: ResultSet::begin(target, force)?,

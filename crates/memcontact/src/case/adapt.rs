@@ -1,5 +1,6 @@
-//! `[adapt]`: adaptive refinement (SPEC §6): the loop solve → estimate → mark → refine →
-//! solve, its stopping rules and its marking.
+//! `[adapt]`: adaptive refinement (docs/case-file/adapt.md; the theory:
+//! docs/theory.md#adaptivity): the loop solve → estimate → mark → refine → solve, its
+//! stopping rules and its marking.
 
 use crate::error::Invalid;
 use serde::{Deserialize, Serialize};

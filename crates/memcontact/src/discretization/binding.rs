@@ -102,7 +102,7 @@ impl BoundData {
         }
     }
 
-    /// The model's view of the data beyond the paper's frame (SPEC §5).
+    /// The model's view of the data beyond the paper's frame (docs/theory.md#extensions).
     pub fn extensions<'a>(&'a self, problem: &Problem) -> Extensions<'a> {
         Extensions {
             boundary: self

@@ -79,8 +79,8 @@ impl Discretization {
 
     /// Assembles the problem's data on a given mesh hierarchy (the finest level is solved
     /// on; its coarser levels serve multigrid). `problem.mesh` is not used. Levels whose
-    /// numbering is scattered are first renumbered for locality
-    /// ([`crate::mesh::reorder`]); outputs come back in the user's numbering.
+    /// numbering is scattered are first renumbered for locality (vertices along a
+    /// Hilbert curve); outputs come back in the user's numbering.
     pub fn assemble(
         problem: &Problem,
         hierarchy: Hierarchy,
@@ -98,7 +98,7 @@ impl Discretization {
     /// solve will use are built and the refinement relations released too. The coarser
     /// levels stay in [`Discretization::hierarchy`] as empty meshes, so that its depth is
     /// still reported. Call [`Discretization::release_solver_data`] after the solve.
-    pub fn for_one_solve(
+    pub(crate) fn for_one_solve(
         problem: &Problem,
         settings: &Settings,
         observer: &mut dyn Observer,
@@ -162,7 +162,7 @@ impl Discretization {
     /// made by [`Discretization::for_one_solve`] has been solved and its outcome is about
     /// to be written. The outcome's fields, totals and report are kept; a later solve is
     /// refused with an error.
-    pub fn release_solver_data(&mut self) {
+    pub(crate) fn release_solver_data(&mut self) {
         self.built = None;
         self.model.s = Csr {
             pattern: Arc::new(crate::sparse::Pattern {
@@ -181,7 +181,7 @@ impl Discretization {
     /// same, for the fields and the writers; a mesh read from a file or given as data is
     /// kept). Returns whether it released them. Assembly, the checks on the mesh and the
     /// multigrid levels must be done: nothing reads the mesh until it is restored.
-    pub fn release_mesh(&mut self, spec: &MeshSpec) -> bool {
+    pub(crate) fn release_mesh(&mut self, spec: &MeshSpec) -> bool {
         let generated = matches!(
             spec.source,
             MeshSource::Rectangle { .. } | MeshSource::Disk { .. } | MeshSource::Polygon { .. }
@@ -203,7 +203,7 @@ impl Discretization {
     /// its vertices, triangles and regions back; its seconds are added to the `mesh`
     /// phase. A mesh that does not come back the same is an error. Nothing to do when
     /// nothing was released.
-    pub fn restore_mesh(&mut self, observer: &mut dyn Observer) -> Result<()> {
+    pub(crate) fn restore_mesh(&mut self, observer: &mut dyn Observer) -> Result<()> {
         let Some((spec, hash)) = self.mesh_released.take() else {
             return Ok(());
         };
@@ -232,23 +232,18 @@ impl Discretization {
         Ok(())
     }
 
-    /// Whether the finest mesh is released ([`Discretization::release_mesh`]).
-    pub fn is_mesh_released(&self) -> bool {
-        self.mesh_released.is_some()
-    }
-
     /// Releases the multigrid levels built beforehand (a solve builds its own again).
     pub(crate) fn release_levels(&mut self) {
         self.built = None;
     }
 
     /// Whether [`Discretization::release_solver_data`] was called.
-    pub fn is_released(&self) -> bool {
+    pub(crate) fn is_released(&self) -> bool {
         self.released
     }
 
     /// The geometric multigrid levels built beforehand, if any.
-    pub fn built_levels(&self) -> Option<&Levels> {
+    pub(crate) fn built_levels(&self) -> Option<&Levels> {
         self.built.as_deref()
     }
 
@@ -411,7 +406,8 @@ fn geometry_hash(mesh: &Mesh) -> u64 {
 
 impl Discretization {
     /// The estimated memory of the run on this mesh besides a solver's factorisation
-    /// (bytes): [`super::meshing::bytes_per_vertex`] of its problem and kind of run.
+    /// (bytes): the vertices of the finest mesh times the bytes per vertex of its problem
+    /// and kind of run (the constants of [`crate::limits`]).
     pub fn run_bytes(&self) -> f64 {
         self.per_vertex * self.mesh().n_vertices() as f64
     }

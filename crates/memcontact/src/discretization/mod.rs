@@ -1,6 +1,6 @@
-//! The discretisation of a problem (SPEC §2): mesh levels, the renumbering for locality,
-//! the data bound to the mesh, and the model S, L, D, φₙ, M assembled once. Solves and
-//! sweeps reuse it.
+//! The discretisation of a problem (docs/theory.md#discrete-model): mesh levels, the
+//! renumbering for locality, the data bound to the mesh, and the model S, L, D, φₙ, M
+//! assembled once. Solves and sweeps reuse it.
 
 mod binding;
 pub(crate) mod case_checks;

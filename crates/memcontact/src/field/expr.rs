@@ -1,5 +1,5 @@
 //! Compiled scalar expressions of the position `(x, y)`: the formulas that describe the
-//! problem data f, φ and h (SPEC §1) when they are not constants.
+//! problem data f, φ and h (docs/theory.md#physics) when they are not constants.
 //!
 //! An [`Expr`] is parsed once, constant-folded, and compiled into a flat stack-machine
 //! program; [`Expr::eval`] then runs that program without allocating (for expressions of

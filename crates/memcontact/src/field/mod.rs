@@ -1,5 +1,5 @@
-//! Scalar problem data of SPEC §1: the load `f`, the obstacle surface `φ` and the
-//! foundation stiffness `h` (with the rigid limit `h → ∞`).
+//! Scalar problem data of the physical problem (docs/theory.md#physics): the load `f`, the
+//! obstacle surface `φ` and the foundation stiffness `h` (with the rigid limit `h → ∞`).
 //!
 //! A [`Field`] is what a case file says: a number, an [`Expr`] of `x, y`, or a table of
 //! values per named mesh region. [`Field::bind`] resolves it against a mesh's regions once

@@ -41,8 +41,9 @@ impl Field {
         Field::Constant(value)
     }
 
-    /// Parses a number or an expression of `x, y` (see [`crate::field::expr`]); an expression that
-    /// does not depend on the position becomes a [`Field::Constant`] (`"2*pi"`, `"-3"`).
+    /// Parses a number or an expression of `x, y` (an [`Expr`], in the grammar of the case
+    /// file: docs/case-file/index.md#expressions); an expression that does not depend on
+    /// the position becomes a [`Field::Constant`] (`"2*pi"`, `"-3"`).
     pub fn parse(text: &str) -> Result<Field> {
         let e = Expr::parse(text)?;
         Ok(match e.constant_value() {
@@ -92,8 +93,8 @@ impl std::str::FromStr for Field {
 }
 
 /// The foundation stiffness h: an elastic (Winkler) obstacle with `h ≥ 0`, the rigid
-/// obstacle `h = ∞` of the classical obstacle problem `u ≤ φ` (SPEC §1, limits), or a body
-/// rigid in some regions and elastic in others.
+/// obstacle `h = ∞` of the classical obstacle problem `u ≤ φ` (docs/theory.md#limits), or a
+/// body rigid in some regions and elastic in others.
 ///
 /// Deserialises like a [`Field`], from the string `"rigid"` (any case), and from a region
 /// table whose values may be `"rigid"`: `{ plinth = "rigid", default = 200 }`.

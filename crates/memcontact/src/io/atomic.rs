@@ -44,7 +44,7 @@ impl<W: Write> Write for Hashing<W> {
 }
 
 /// Writes `path` atomically: `fill` writes into a temporary file in the same directory
-/// (through staging buffers and a writer thread, [`Staged`]), which is synced and renamed
+/// (through staging buffers and a writer thread), which is synced and renamed
 /// over `path` only if `fill` and every write succeed. Returns the size and digest of what
 /// was written.
 pub fn write_atomic(

@@ -12,8 +12,8 @@ use std::collections::{BTreeMap, HashMap};
 pub const UNTAGGED: u32 = 0;
 
 /// Boundary regions of a mesh: plain arrays, so that a permutation of the vertices carries
-/// them (map the vertex indices of `edges`). Boundary edges not listed belong to the region
-/// [`UNTAGGED`].
+/// them (map the vertex indices of `edges`). Boundary edges not listed belong to the
+/// untagged region, tag 0 (named `"default"` unless `names` names it).
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct BoundaryRegions {
     /// Boundary edges `[a, b]` (vertex indices, either order) that carry a tag.
@@ -30,7 +30,7 @@ impl BoundaryRegions {
         self.edges.is_empty()
     }
 
-    /// The name of tag `tag`: its own, [`UNTAGGED_NAME`] for the edges no region covers,
+    /// The name of tag `tag`: its own, `"default"` for the edges no region covers (tag 0),
     /// or the tag as text.
     pub fn name(&self, tag: u32) -> String {
         match self.names.get(&tag) {
@@ -40,7 +40,7 @@ impl BoundaryRegions {
         }
     }
 
-    /// The names of the tags, with [`UNTAGGED_NAME`] for [`UNTAGGED`] unless it has a name
+    /// The names of the tags, with `"default"` for tag 0 (untagged) unless it has a name
     /// of its own (for messages).
     pub fn labels(&self) -> BTreeMap<u32, String> {
         let mut names = self.names.clone();
@@ -50,7 +50,7 @@ impl BoundaryRegions {
         names
     }
 
-    /// The tags named `key` (a name, [`UNTAGGED_NAME`] for the edges no region covers, or
+    /// The tags named `key` (a name, `"default"` for the edges no region covers, or
     /// a tag written as a number), among `present`.
     pub fn resolve(&self, key: &str, present: &[u32]) -> Vec<u32> {
         let mut by_name: Vec<u32> = self
@@ -218,7 +218,7 @@ impl Mesh {
         slots.iter().map(|s| s.map_or(0, |k| counts[k])).collect()
     }
 
-    /// Every boundary edge with its region tag ([`UNTAGGED`] where none is given).
+    /// Every boundary edge with its region tag (0 where none is given).
     pub fn tagged_boundary(&self, adj: &VertexTriangles) -> TaggedBoundary {
         let edges = self.boundary_edges_with(adj);
         let tags = if self.boundary.is_empty() {
@@ -277,7 +277,7 @@ impl Mesh {
     }
 
     /// Every boundary region present with its number of edges and its length, in tag
-    /// order (the edges no region covers under [`UNTAGGED`]).
+    /// order (the edges no region covers under tag 0).
     pub fn boundary_regions_summary(&self, tagged: &TaggedBoundary) -> Vec<BoundaryRegionSize> {
         let mut sizes: BTreeMap<u32, (usize, f64)> = BTreeMap::new();
         for (&[a, b], &tag) in tagged.edges.iter().zip(&tagged.tags) {
@@ -370,10 +370,11 @@ impl FixedBoundary {
 }
 
 impl DofMap {
-    /// Numbers the vertices that are not fixed, in vertex order (SPEC §5: the unknowns
-    /// are all vertices not on Γ_D, free-boundary vertices included). Blocks of vertices
-    /// are counted, then numbered, on all threads (the arrays are mostly fresh memory,
-    /// whose first writes are page faults).
+    /// Numbers the vertices that are not fixed, in vertex order
+    /// (docs/theory.md#boundary-data: the unknowns are all vertices not on Γ_D,
+    /// free-boundary vertices included). Blocks of vertices are counted, then numbered, on
+    /// all threads (the arrays are mostly fresh memory, whose first writes are page
+    /// faults).
     pub fn from_fixed(fixed: &[bool]) -> DofMap {
         use rayon::prelude::*;
         const BLOCK: usize = 1 << 14;

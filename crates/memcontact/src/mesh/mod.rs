@@ -1,5 +1,6 @@
 //! Triangular meshes: the type, its checks and quality report, the boundary and the map
-//! between vertices and unknowns (SPEC §2: the unknowns are the interior vertices).
+//! between vertices and unknowns (docs/theory.md#triangulation: the unknowns are the
+//! interior vertices).
 
 pub(crate) mod boundary;
 pub mod generate;
@@ -60,7 +61,7 @@ impl Circle {
     }
 }
 
-/// Geometric quality figures of a mesh (SPEC §2: `l_n`, `s_n`).
+/// Geometric quality figures of a mesh (docs/theory.md#triangulation: `l_n`, `s_n`).
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
 pub struct MeshQuality {
     /// Number of vertices.
@@ -402,7 +403,7 @@ impl Mesh {
     /// so an edge `v → b` is shared exactly when `b → v` exists: v is interior when the
     /// vertices following it in its triangles are the vertices preceding it (its fan
     /// closes). One parallel pass over the vertices, without branches on the mesh's data
-    /// for the usual fans of up to [`SMALL_FAN`] triangles.
+    /// for the usual fans of up to 16 triangles.
     pub fn boundary_vertices_with(&self, adj: &VertexTriangles) -> Vec<bool> {
         use rayon::prelude::*;
         const NEXT: [usize; 3] = [1, 2, 0];
@@ -582,9 +583,9 @@ impl VertexTriangles {
     }
 }
 
-/// The map between mesh vertices and unknowns: the unknowns are the interior vertices
-/// `a_1, ..., a_m` (SPEC §2). Vectors over unknowns and over vertices are different things;
-/// convert only through this type.
+/// The map between mesh vertices and unknowns: the unknowns are the interior vertices `a_1,
+/// ..., a_m` (docs/theory.md#triangulation). Vectors over unknowns and over vertices are
+/// different things; convert only through this type.
 #[derive(Debug, Clone)]
 pub struct DofMap {
     /// `vertex[i]`: the mesh vertex of unknown `i`.

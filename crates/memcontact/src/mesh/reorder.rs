@@ -363,7 +363,8 @@ pub fn renumbering_for_locality(mesh: &Mesh) -> Option<Reordering> {
 }
 
 impl Hierarchy {
-    /// Every level renumbered for locality ([`renumbering_for_locality`]), with the
+    /// Every level renumbered for locality (vertices along the Hilbert curve, triangles by
+    /// their first vertex on it; a level whose order is already local is kept), with the
     /// refinement relations renumbered to match; returns the renumberings, coarsest level
     /// first (`None` for a level kept in its order).
     pub fn reordered(self) -> (Hierarchy, Vec<Option<Arc<Reordering>>>) {

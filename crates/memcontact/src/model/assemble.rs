@@ -1,5 +1,6 @@
-//! Assembly of the model (SPEC §2; §5 for boundary heights, free edges, mixed and second
-//! bodies) with the data checks that only assembly can make.
+//! Assembly of the model (docs/theory.md#discrete-model; docs/theory.md#extensions for
+//! boundary heights, free edges, mixed and second bodies) with the data checks that only
+//! assembly can make.
 
 use super::body::{Body, FoundationMatrix, VertexValues};
 use super::boundary::boundary_heights;
@@ -18,18 +19,19 @@ use rayon::prelude::*;
 use std::sync::Arc;
 
 impl Model {
-    /// Assembles S, L, D, φₙ and M on `mesh` (SPEC §2), validating the data: t > 0,
-    /// h ≥ 0, every value finite.
+    /// Assembles S, L, D, φₙ and M on `mesh` (docs/theory.md#discrete-model), validating
+    /// the data: t > 0, h ≥ 0, every value finite.
     pub fn assemble(mesh: &Mesh, data: &ProblemData) -> Result<Model> {
         Model::assemble_with(mesh, data, &Extensions::default())
     }
 
-    /// [`Model::assemble`] with the data beyond the paper's frame (SPEC §5): boundary
-    /// heights and free edges (the unknowns are then the vertices not on Γ_D and `d`
-    /// carries the lifting `−S_fix G`), rigid regions of the obstacle, a body below.
-    /// Refused here, before any solve: a boundary region that does not exist, a height
-    /// that is not finite, a membrane that nothing holds (no fixed boundary and no body
-    /// that can stop it), both bodies rigid with φ_low > φ at some unknown.
+    /// [`Model::assemble`] with the data beyond the paper's frame
+    /// (docs/theory.md#extensions): boundary heights and free edges (the unknowns are then
+    /// the vertices not on Γ_D and `d` carries the lifting `−S_fix G`), rigid regions of
+    /// the obstacle, a body below. Refused here, before any solve: a boundary region that
+    /// does not exist, a height that is not finite, a membrane that nothing holds (no fixed
+    /// boundary and no body that can stop it), both bodies rigid with φ_low > φ at some
+    /// unknown.
     pub fn assemble_with(mesh: &Mesh, data: &ProblemData, ext: &Extensions) -> Result<Model> {
         let (adj, boundary) = mesh.patches();
         Model::assemble_on(mesh, &adj, &boundary, data, ext)
@@ -189,7 +191,7 @@ pub(super) const NAMES_LOWER: BodyNames = BodyNames {
 };
 
 /// A body's elastic stiffness with its rigid regions masked to 0 (the elastic term is
-/// integrated over the elastic triangles only, SPEC §5 "Mixed bodies").
+/// integrated over the elastic triangles only, docs/theory.md#mixed-bodies).
 pub(super) struct Masked<'a> {
     inner: Option<&'a dyn Coefficient>,
     rigid: &'a [u32],
@@ -235,10 +237,11 @@ impl Coefficient for Masked<'_> {
     }
 }
 
-/// Assembles one body (SPEC §2 for the obstacle, §5 for the body below and for mixed
-/// bodies): its foundation matrix (`l_consistent` when the caller assembled it), its
-/// sampled surface, the unknowns it can touch and those it holds rigidly, with the data
-/// checks (h ≥ 0 and finite, φ finite).
+/// Assembles one body (docs/theory.md#matrices for the obstacle, docs/theory.md#second-body
+/// for the body below, docs/theory.md#mixed-bodies for rigid regions): its foundation
+/// matrix (`l_consistent` when the caller assembled it), its sampled surface, the unknowns
+/// it can touch and those it holds rigidly, with the data checks (h ≥ 0 and finite, φ
+/// finite).
 pub(super) fn assemble_body(
     mesh: &Mesh,
     adj: &VertexTriangles,

@@ -6,7 +6,7 @@ use crate::mesh::DofMap;
 use crate::sparse::Csr;
 use rayon::prelude::*;
 
-/// A second body (SPEC §5, the body below): its foundation term
+/// A second body (the body below, docs/theory.md#second-body): its foundation term
 /// `J₃(V) = ½ qᵀ L_low q`, `q = (φ_low − V)⁺`, or the constraint `U ≥ φ_low` where rigid.
 #[derive(Debug, Clone)]
 pub struct Body {

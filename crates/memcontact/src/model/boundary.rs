@@ -1,4 +1,4 @@
-//! The heights g on the fixed part of the boundary (SPEC §5).
+//! The heights g on the fixed part of the boundary (docs/theory.md#boundary-data).
 
 use super::data::bad_value;
 use super::data::Extensions;
@@ -9,7 +9,7 @@ use crate::mesh::boundary::FixedBoundary;
 use crate::mesh::Mesh;
 
 /// Which vertices are fixed and their heights g (0 elsewhere), as the assembly with `ext`
-/// takes them (SPEC §5).
+/// takes them (docs/theory.md#boundary-data).
 pub fn fixed_heights(
     mesh: &Mesh,
     adj: &VertexTriangles,
@@ -35,10 +35,10 @@ pub fn fixed_heights_on(
     }
 }
 
-/// The heights g at the fixed vertices (SPEC §5), 0 elsewhere: at a vertex, g with the tag
-/// of each fixed boundary edge through it, averaged over those edges (they differ only
-/// where a table gives two sides different heights). A height that is not finite is an
-/// error naming the point.
+/// The heights g at the fixed vertices (docs/theory.md#boundary-data), 0 elsewhere: at a
+/// vertex, g with the tag of each fixed boundary edge through it, averaged over those edges
+/// (they differ only where a table gives two sides different heights). A height that is not
+/// finite is an error naming the point.
 pub(super) fn boundary_heights(
     mesh: &Mesh,
     fixed: &FixedBoundary,

@@ -203,17 +203,17 @@ fn matrix_finite(l: &FoundationMatrix) -> bool {
     }
 }
 
-/// What overflowed, in terms of the data, for the messages of [`crate::outcome::checks::check_solution`] and
-/// [`crate::outcome::checks::check_results`].
+/// What overflowed, in terms of the data, for the messages of
+/// [`crate::solve::check_solution`] and of the checks of a run's fields and totals.
 pub const OVERFLOW_HINT: &str = "the data's scales (tension t, load f, stiffness h, shape φ, \
                              mesh size) overflow double precision; rescale the problem \
                              (units)";
 
 impl Model {
-    /// Refuses a membrane that nothing holds (SPEC §5): every connected group of unknowns
-    /// that no fixed vertex touches must be held by the bodies: by one from each side, or
-    /// by one body toward which the net load on the group pushes. Otherwise J has no
-    /// minimiser (or no unique one) and S is singular on the group.
+    /// Refuses a membrane that nothing holds (docs/theory.md#boundary-data): every
+    /// connected group of unknowns that no fixed vertex touches must be held by the bodies:
+    /// by one from each side, or by one body toward which the net load on the group pushes.
+    /// Otherwise J has no minimiser (or no unique one) and S is singular on the group.
     pub(super) fn check_held(&self, mesh: &Mesh) -> Result<()> {
         let n = self.n();
         // Union-find over the couplings of S.
@@ -295,7 +295,7 @@ impl Model {
     }
 
     /// Refuses two rigid bodies that overlap at an unknown (φ_low > φ there: no admissible
-    /// deflection, SPEC §5), naming the vertices.
+    /// deflection, docs/theory.md#second-body), naming the vertices.
     pub(super) fn check_squeeze(&self, mesh: &Mesh) -> Result<()> {
         let Some(low) = &self.lower else {
             return Ok(());

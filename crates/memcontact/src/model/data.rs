@@ -1,5 +1,6 @@
-//! What assembly takes: the problem's data bound to a mesh, as views (SPEC §2 and the
-//! extensions of §5), and the choices of foundation matrix and sampling.
+//! What assembly takes: the problem's data bound to a mesh, as views
+//! (docs/theory.md#discrete-model and the extensions of docs/theory.md#extensions), and the
+//! choices of foundation matrix and sampling.
 
 use crate::error::{Error, Result};
 use crate::field::Coefficient;
@@ -10,7 +11,8 @@ use crate::field::Coefficient;
 pub enum Foundation {
     /// The paper's consistent matrix `L_ij = ∫ h g_i g_j` (J₂ is not differentiable).
     Consistent,
-    /// The diagonal `l_i = ∫ h g_i` (SPEC §3): J is C¹ with a semismooth gradient.
+    /// The diagonal `l_i = ∫ h g_i` (docs/theory.md#lumped): J is C¹ with a semismooth
+    /// gradient.
     Lumped,
 }
 
@@ -37,7 +39,7 @@ impl Foundation {
     }
 }
 
-/// How the obstacle φ is sampled at the vertices (SPEC §2, "Obstacle sampling").
+/// How the obstacle φ is sampled at the vertices (docs/theory.md#obstacle-sampling).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Sampling {
     /// `φ_i = φ(a_i)`: the usual practice for continuous φ.
@@ -76,9 +78,10 @@ pub struct ProblemData<'a> {
     pub sampling: Sampling,
 }
 
-/// The data beyond the paper's frame (SPEC §5): boundary heights and free edges, rigid
-/// regions of the obstacle (mixed bodies) and a second body below. The default is the
-/// paper's frame: the whole boundary fixed at 0, one body, rigid everywhere or nowhere.
+/// The data beyond the paper's frame (docs/theory.md#extensions): boundary heights and free
+/// edges, rigid regions of the obstacle (mixed bodies) and a second body below. The default
+/// is the paper's frame: the whole boundary fixed at 0, one body, rigid everywhere or
+/// nowhere.
 #[derive(Clone, Copy, Default)]
 pub struct Extensions<'a> {
     /// Which boundary regions are free and the height g on the others (`None`: the whole
@@ -90,7 +93,8 @@ pub struct Extensions<'a> {
     pub lower: Option<BodyData<'a>>,
 }
 
-/// The boundary data of SPEC §5: `u = g` on the fixed part Γ_D, free elsewhere.
+/// The boundary data (docs/theory.md#boundary-data): `u = g` on the fixed part Γ_D, free
+/// elsewhere.
 #[derive(Clone, Copy)]
 pub struct BoundaryData<'a> {
     /// The boundary regions left free (names, or tags as text).

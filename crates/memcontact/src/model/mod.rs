@@ -1,7 +1,7 @@
-//! The discrete model of SPEC §2 (the paper's §2): the stiffness matrix S, the h-weighted
-//! foundation matrix L (consistent, or its lumped variant), the load D, the sampled
-//! obstacle φₙ and the set M of vertices that can touch; the energy J of Problem 2b and the
-//! certificates of Problems 2e and 2f.
+//! The discrete model of the paper's §2 (docs/theory.md#discrete-model): the stiffness
+//! matrix S, the h-weighted foundation matrix L (consistent, or its lumped variant), the
+//! load D, the sampled obstacle φₙ and the set M of vertices that can touch; the energy J
+//! of Problem 2b and the certificates of Problems 2e and 2f.
 
 mod assemble;
 mod body;

@@ -6,7 +6,7 @@ use crate::mesh::DofMap;
 use crate::sparse::{norm_inf, Csr};
 use rayon::prelude::*;
 
-/// The assembled discrete model (SPEC §2).
+/// The assembled discrete model (docs/theory.md#discrete-model).
 #[derive(Debug, Clone)]
 pub struct Model {
     /// Unknowns ↔ vertices.
@@ -36,15 +36,16 @@ pub struct Model {
     /// The mollifier radius used, when φ was mollified.
     pub epsilon: Option<f64>,
     /// Unknowns the obstacle holds rigidly (`U ≤ φ`) when it is rigid in some regions only
-    /// (mixed bodies, SPEC §5); `None` when it is rigid everywhere (`l` says so) or nowhere.
+    /// (mixed bodies, docs/theory.md#mixed-bodies); `None` when it is rigid everywhere (`l`
+    /// says so) or nowhere.
     pub rigid: Option<Vec<bool>>,
-    /// The body below the membrane (SPEC §5).
+    /// The body below the membrane (docs/theory.md#second-body).
     pub lower: Option<Body>,
     /// u where it is prescribed (the heights g on Γ_D), 0 at the other vertices; over all
     /// vertices (empty when g = 0 everywhere, and for models that only a solver uses).
     pub boundary_values: Vec<f64>,
     /// The lifting `S_fix G` over the unknowns (empty when G = 0): `d` is the assembled
-    /// load minus it (SPEC §5).
+    /// load minus it (docs/theory.md#boundary-data).
     pub lift: Vec<f64>,
 }
 
@@ -114,8 +115,8 @@ impl Model {
     }
 
     /// The energy of Problem 2b, `J(V) = ½ VᵀSV − VᵀD + ½ pᵀ L p` (`+ ½ qᵀ L_low q` with a
-    /// body below, SPEC §5); `+∞` outside the constraints of rigid bodies (`V ≤ φ` where
-    /// the obstacle is rigid, `V ≥ φ_low` where the body below is).
+    /// body below, docs/theory.md#second-body); `+∞` outside the constraints of rigid
+    /// bodies (`V ≤ φ` where the obstacle is rigid, `V ≥ φ_low` where the body below is).
     pub fn energy(&self, v: &[f64]) -> f64 {
         let j1 = 0.5 * self.s.quad_form(v) - crate::sparse::dot(v, &self.d);
         let j = match &self.l {
@@ -266,7 +267,7 @@ impl Model {
     /// A force scale of the data, `max(‖D‖∞, ‖Sφ‖∞, ‖L|φ|‖∞)` (and the same of the body
     /// below): the size of the forces the problem can involve, for scaling a formulation
     /// (the QP). Certificates are scaled by the forces of the iterate instead
-    /// ([`crate::certificate`]).
+    /// (docs/theory.md#certificates).
     pub fn force_scale(&self) -> f64 {
         let body_scale = |l: &FoundationMatrix, phi: &[f64]| {
             let sphi = norm_inf(&self.s.mul(phi));

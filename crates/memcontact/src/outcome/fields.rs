@@ -1,4 +1,4 @@
-//! Physical results derived from a solution (SPEC §3, "Physical outputs"): deflection,
+//! Physical results derived from a solution (docs/theory.md#physical-outputs): deflection,
 //! sampled obstacle, penetration, contact pressure, nodal contact forces X₁, vertex states,
 //! and the totals an engineer checks (load, reaction, contact area, largest deflection).
 
@@ -31,7 +31,7 @@ pub struct NodalFields {
     pub lower: Option<LowerFields>,
 }
 
-/// The body below's fields over all vertices (SPEC §5).
+/// The body below's fields over all vertices (docs/theory.md#second-body).
 #[derive(Debug, Clone)]
 pub struct LowerFields {
     /// Its sampled surface φ_low.
@@ -81,7 +81,7 @@ pub struct Totals {
     pub lower: Option<LowerTotals>,
 }
 
-/// The body below's totals (SPEC §5).
+/// The body below's totals (docs/theory.md#second-body).
 #[derive(Debug, Clone, Copy, serde::Serialize)]
 pub struct LowerTotals {
     /// Unknowns it can touch.

@@ -41,8 +41,8 @@ impl Outcome {
         self.solver_fields().1
     }
 
-    /// [`Outcome::fields`], checked to be finite ([`crate::outcome::checks::check_results`]): the
-    /// fields that result files hold.
+    /// [`Outcome::fields`], checked to be finite (a field or a total that is not is refused,
+    /// naming the quantity and, for a field, the vertex): the fields that result files hold.
     pub fn checked_fields(&self) -> Result<(Cow<'_, NodalFields>, Totals)> {
         let (fields, totals) = self.solver_fields();
         crate::outcome::checks::check_results(self.discretization.mesh(), &fields, &totals)?;

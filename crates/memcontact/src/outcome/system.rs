@@ -1,7 +1,7 @@
-//! [`System`]: the assembled discrete problem of an outcome (SPEC §2: S, L, D, φₙ and the
-//! unknowns; §5: the body below) over its unknowns, in the user's vertex numbering, for
-//! callers that check or post-process the answer themselves (the Python module's
-//! `Result.matrices()`).
+//! [`System`]: the assembled discrete problem of an outcome (docs/theory.md#discrete-model:
+//! S, L, D, φₙ and the unknowns; docs/theory.md#second-body: the body below) over its
+//! unknowns, in the user's vertex numbering, for callers that check or post-process the
+//! answer themselves (the Python module's `Result.matrices()`).
 
 use super::solved::Outcome;
 use crate::model::FoundationMatrix;
@@ -37,10 +37,10 @@ pub struct SystemBody {
     pub rigid: Vec<bool>,
 }
 
-/// The discrete problem of an outcome over its `m` unknowns (SPEC §2, §5), numbered in the
-/// order of the user's vertices: unknown `k` is the user's vertex `unknowns[k]`
-/// (increasing), whatever the renumbering for locality the solver worked in. U minimises
-/// `J(V) = ½ VᵀSV − VᵀD + ½ pᵀLp (+ ½ qᵀ L_low q)`.
+/// The discrete problem of an outcome over its `m` unknowns (docs/theory.md#discrete-model,
+/// docs/theory.md#extensions), numbered in the order of the user's vertices: unknown `k` is
+/// the user's vertex `unknowns[k]` (increasing), whatever the renumbering for locality the
+/// solver worked in. U minimises `J(V) = ½ VᵀSV − VᵀD + ½ pᵀLp (+ ½ qᵀ L_low q)`.
 #[derive(Debug, Clone, PartialEq)]
 pub struct System {
     /// The user's vertex of each unknown, increasing.
@@ -51,7 +51,7 @@ pub struct System {
     pub d: Vec<f64>,
     /// The obstacle above: L, φ, M and its rigid unknowns.
     pub obstacle: SystemBody,
-    /// The body below (SPEC §5), when there is one.
+    /// The body below (docs/theory.md#second-body), when there is one.
     pub lower: Option<SystemBody>,
 }
 

@@ -46,7 +46,8 @@ impl Discretization {
     /// Solves the discrete problem with `settings`, starting from `start` (U over the
     /// unknowns, e.g. the answer of a neighbouring load step) when given. Refused first
     /// when the solver would not fit in memory, and afterwards when J, the certificate,
-    /// the fields or the totals of the answer are not finite ([`crate::outcome::checks`]).
+    /// the fields or the totals of the answer are not finite
+    /// ([`crate::solve::check_solution`], [`Outcome::checked_fields`]).
     pub fn solve_from(
         &self,
         settings: &Settings,
@@ -63,7 +64,7 @@ impl Discretization {
     /// ([`Discretization::release_mesh`]): the mesh is built again after the solver is done
     /// and before the fields are derived on it (its seconds count in the `mesh` phase, not
     /// in `solve`).
-    pub fn solve_once(
+    pub(crate) fn solve_once(
         &mut self,
         settings: &Settings,
         observer: &mut dyn Observer,

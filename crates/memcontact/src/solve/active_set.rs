@@ -14,9 +14,10 @@
 //! 4. an exact line search on J ([`super::line_search`]), convex and piecewise quadratic
 //!    along the line.
 //!
-//! J decreases monotonically; the sweep alone is a globally convergent method (SPEC §3),
-//! so the iteration converges from any start, and once the states are right the Newton
-//! step lands on U exactly (finite termination in exact arithmetic).
+//! J decreases monotonically; the sweep alone is a globally convergent method
+//! (docs/theory.md#coordinatewise-optimality), so the iteration converges from any start,
+//! and once the states are right the Newton step lands on U exactly (finite termination in
+//! exact arithmetic).
 
 use super::line_search::{apply_step, exact_step, line_data};
 use super::newton::{newton_system, unit_diagonal_on_truncated, NewtonStates};

@@ -1,7 +1,7 @@
 //! Problem 2b by exact coordinatewise minimisation of J: nonsmooth Gauss-Seidel sweeps
-//! (SPEC §3: coordinatewise optimality is global optimality, so the sweeps converge to U).
-//! Simple and robust, but the number of sweeps grows like the square of the mesh size:
-//! meant for verification on small meshes.
+//! (docs/theory.md#coordinatewise-optimality: coordinatewise optimality is global
+//! optimality, so the sweeps converge to U). Simple and robust, but the number of sweeps
+//! grows like the square of the mesh size: meant for verification on small meshes.
 
 use super::relax::sweep_forward;
 use super::{IterationRecord, Method, Observer, PhaseTimer, Settings, Solution};

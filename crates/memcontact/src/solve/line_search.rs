@@ -14,10 +14,10 @@
 //! J'(α+)`); otherwise a bracketed Newton step on the monotone derivative moves on.
 //! [`apply_step`] takes the step and snaps the coordinates whose breakpoint it is onto φ.
 //!
-//! A body below (SPEC §5) adds the same terms for `J₃ = ½ qᵀ L_low q`, `q = (φ_low − V)⁺`:
-//! it is J₂ of the mirrored problem (gap `φ_low − V`, direction `−δ`), so one function
-//! computes the pieces of either body. Where a body is rigid the step is limited so that
-//! `V + αδ` keeps its constraint.
+//! A body below (docs/theory.md#second-body) adds the same terms for `J₃ = ½ qᵀ L_low q`,
+//! `q = (φ_low − V)⁺`: it is J₂ of the mirrored problem (gap `φ_low − V`, direction `−δ`),
+//! so one function computes the pieces of either body. Where a body is rigid the step is
+//! limited so that `V + αδ` keeps its constraint.
 
 use crate::model::{FoundationMatrix, Model};
 use crate::sparse::{par_rows, VECTOR_ROWS};
@@ -126,9 +126,9 @@ fn side_code(w: f64, d: f64, alpha: f64) -> u8 {
     }
 }
 
-/// One body along the line: its foundation term, the unknowns whose elastic term is
-/// present (`touch` and not held rigidly), and its gap `w_j + α d_j`: `w = V − φ`,
-/// `d = δ` above, `w = φ_low − V`, `d = −δ` below (SPEC §5: J₃ is J₂ of the mirrored
+/// One body along the line: its foundation term, the unknowns whose elastic term is present
+/// (`touch` and not held rigidly), and its gap `w_j + α d_j`: `w = V − φ`, `d = δ` above,
+/// `w = φ_low − V`, `d = −δ` below (docs/theory.md#second-body: J₃ is J₂ of the mirrored
 /// problem).
 struct LineBody<'a, E, W, D> {
     l: &'a FoundationMatrix,

@@ -6,7 +6,7 @@
 //! | [`Method::Linear`] | h ≡ 0: one sparse Cholesky solve of `S U = D` |
 //! | [`Method::ActiveSet`] | Problem 2f: semismooth (truncated) Newton with three vertex states |
 //! | [`Method::Qp`] | Problem 2c handed to the Clarabel interior-point solver (multipliers of 2d/2e) |
-//! | [`Method::Coordinate`] | Problem 2b: exact coordinatewise minimisation of J (SPEC §3) |
+//! | [`Method::Coordinate`] | Problem 2b: exact coordinatewise minimisation of J (docs/theory.md#coordinatewise-optimality) |
 //! | [`Method::Multigrid`] | Problem 2b: truncated nonsmooth Newton multigrid |
 //!
 //! Every solve ends with the certificates of 2e and 2f; not reaching the tolerance is an

@@ -8,9 +8,9 @@
 //! Hessian of the piece is `S + E_P L E_P` on the free vertices, its gradient
 //! `g = SV − D + E_P L p` (`p = (V − φ)⁺`), zero on truncated vertices.
 //!
-//! With a body below (SPEC §5) the vertices sunk into it (Q, elastic there) add
-//! `E_Q L_low E_Q` to the Hessian and `− E_Q L_low q` (`q = (φ_low − V)⁺`) to the gradient;
-//! vertices on either body's surface, or held by a rigid one, are truncated.
+//! With a body below (docs/theory.md#second-body) the vertices sunk into it (Q, elastic
+//! there) add `E_Q L_low E_Q` to the Hessian and `− E_Q L_low q` (`q = (φ_low − V)⁺`) to
+//! the gradient; vertices on either body's surface, or held by a rigid one, are truncated.
 
 use crate::model::{FoundationMatrix, Model};
 use crate::sparse::row_chunks;
@@ -76,7 +76,7 @@ impl NewtonStates {
             par_rows(&mut self.penetrating, |i, p| *p = fill(i).1);
             return;
         }
-        // Both bodies and rigid regions (SPEC §5).
+        // Both bodies and rigid regions (docs/theory.md#extensions).
         let up_held = |i: usize| model.can_touch[i] && v[i] == model.phi[i];
         let low_held = |i: usize| {
             model

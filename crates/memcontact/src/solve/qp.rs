@@ -19,13 +19,13 @@
 //! For the rigid obstacle there is no `V₂`: `min ½V₁ᵀSV₁ − V₁ᵀD` subject to `Ṽ₁ ≤ φ̃`,
 //! and `z = X₁`.
 //!
-//! **Beyond the paper (SPEC §5).** Where the obstacle is rigid in some regions only, the
-//! vertices it holds rigidly have the constraint `V₁ᵢ ≤ φᵢ` and no `V₂ᵢ`. A body below adds
-//! the variables `V₃` with `½ V₃ᵀ L̃_low V₃` in the objective and the rows
-//! `φ̃_low − Ṽ₁ − V₃ ≤ 0`, `−V₃ ≤ 0` (`−Ṽ₁ ≤ −φ̃_low` where it is rigid); their duals are the
-//! body's contact forces (pushing up) and the multipliers of `V₃ ≥ 0`. A vertex both rigid
-//! bodies hold at one height (`φ_low = φ`) gets one equality row (a zero cone) instead of
-//! two opposite inequalities, which would leave an interior point no room.
+//! **Beyond the paper (docs/theory.md#extensions).** Where the obstacle is rigid in some
+//! regions only, the vertices it holds rigidly have the constraint `V₁ᵢ ≤ φᵢ` and no `V₂ᵢ`.
+//! A body below adds the variables `V₃` with `½ V₃ᵀ L̃_low V₃` in the objective and the
+//! rows `φ̃_low − Ṽ₁ − V₃ ≤ 0`, `−V₃ ≤ 0` (`−Ṽ₁ ≤ −φ̃_low` where it is rigid); their duals
+//! are the body's contact forces (pushing up) and the multipliers of `V₃ ≥ 0`. A vertex
+//! both rigid bodies hold at one height (`φ_low = φ`) gets one equality row (a zero cone)
+//! instead of two opposite inequalities, which would leave an interior point no room.
 //!
 //! **Scaling.** With a length `ℓ` (the largest |φ| on M, or the displacement one unit of
 //! force scale produces) and the force scale `F` of the certificates, the solver sees
@@ -308,7 +308,8 @@ struct Qp2c {
     pinned: Vec<usize>,
     /// The obstacle's constraints.
     up: BodyRows,
-    /// The body below's constraints (SPEC §5: variables V₃), when there is one.
+    /// The body below's constraints (docs/theory.md#second-body: variables V₃), when there
+    /// is one.
     low: Option<BodyRows>,
     /// Number of unknowns m.
     n: usize,
@@ -326,7 +327,7 @@ impl Qp2c {
     /// Builds P (upper triangle of `diag(S, L̃, L̃_low)`), q, A and b from the model's CSR
     /// data (S and L are symmetric, so their CSR rows are their CSC columns). The rows are
     /// the obstacle's `Ṽ₁ − V₂ ≤ φ̃` (no V₂ where it is rigid) and `−V₂ ≤ 0`, then the body
-    /// below's `−Ṽ₁ − V₃ ≤ −φ̃_low` and `−V₃ ≤ 0` (SPEC §5).
+    /// below's `−Ṽ₁ − V₃ ≤ −φ̃_low` and `−V₃ ≤ 0` (docs/theory.md#second-body).
     fn build(model: &Model) -> Qp2c {
         let n = model.n();
         let pinned: Vec<usize> = match &model.lower {
@@ -743,9 +744,9 @@ fn update_states(model: &Model, st: &NewtonStates, u: &[f64]) -> NewtonStates {
     next
 }
 
-/// [`update_states`] with a body below and rigid regions (SPEC §5): the same primal-dual
-/// rules for each body, with the contact force of a held vertex the net force less the
-/// other body's elastic force where that one penetrates.
+/// [`update_states`] with a body below and rigid regions (docs/theory.md#extensions): the
+/// same primal-dual rules for each body, with the contact force of a held vertex the net
+/// force less the other body's elastic force where that one penetrates.
 fn update_states_two(model: &Model, st: &NewtonStates, u: &[f64]) -> NewtonStates {
     let n = model.n();
     let r = model.residual(u);

@@ -1,5 +1,6 @@
-//! Exact minimisation of J in one coordinate (SPEC §3) and the nonsmooth Gauss-Seidel sweep
-//! built on it. With the other coordinates fixed, J as a function of `V_i = x` is
+//! Exact minimisation of J in one coordinate (docs/theory.md#coordinatewise-optimality) and
+//! the nonsmooth Gauss-Seidel sweep built on it. With the other coordinates fixed, J as a
+//! function of `V_i = x` is
 //!
 //! `½ S_ii x² − b x + ½ L_ii p² + c p + const`, `p = (x − φ_i)⁺`,
 //!
@@ -7,11 +8,11 @@
 //! quadratic with one kink at φ_i. Its minimiser is in closed form, and lands *exactly* on
 //! φ_i (the touching state) when `S_ii φ_i − b ≤ 0 ≤ S_ii φ_i − b + c`.
 //!
-//! With a body below (SPEC §5) the term `½ L_low,ii q² + c_low q`, `q = (φ_low,i − x)⁺`,
-//! adds a second kink at φ_low,i; where a body is rigid at vertex i its term is the
-//! constraint `x ≤ φ_i` (or `x ≥ φ_low,i`) instead. [`minimise_two_kinks`] is the closed
-//! form of that case; without a body below and without rigid regions the sweep uses
-//! [`minimise_1d`], so the paper's model runs exactly as before.
+//! With a body below (docs/theory.md#second-body) the term `½ L_low,ii q² + c_low q`, `q =
+//! (φ_low,i − x)⁺`, adds a second kink at φ_low,i; where a body is rigid at vertex i its
+//! term is the constraint `x ≤ φ_i` (or `x ≥ φ_low,i`) instead. [`minimise_two_kinks`] is
+//! the closed form of that case; without a body below and without rigid regions the sweep
+//! uses [`minimise_1d`], so the paper's model runs exactly as before.
 
 use crate::model::{FoundationMatrix, Model};
 
@@ -208,9 +209,9 @@ pub fn minimise_two_kinks(s: f64, b: f64, up: Kink, low: Kink) -> f64 {
     x
 }
 
-/// The one-variable problem of coordinate `i` with both bodies (SPEC §5): returns
-/// `(S_ii, b, upper, lower)`; `v` and `base` as for [`local_problem`]. S and consistent
-/// foundation matrices share the pattern.
+/// The one-variable problem of coordinate `i` with both bodies
+/// (docs/theory.md#second-body): returns `(S_ii, b, upper, lower)`; `v` and `base` as for
+/// [`local_problem`]. S and consistent foundation matrices share the pattern.
 #[inline]
 pub fn local_problem_two(
     model: &Model,
@@ -274,7 +275,8 @@ pub fn local_problem_two(
     (sii, model.d[i] - sv, up, low)
 }
 
-/// [`relax`] with both bodies and rigid regions (SPEC §5).
+/// [`relax`] with both bodies and rigid regions (docs/theory.md#second-body,
+/// docs/theory.md#mixed-bodies).
 #[inline]
 pub fn relax_two(model: &Model, v: &mut [f64], base: usize, i: usize) -> bool {
     let (sii, b, up, low) = local_problem_two(model, v, base, i);

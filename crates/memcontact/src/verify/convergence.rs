@@ -1,5 +1,6 @@
 //! Convergence studies: the paper's main result, `u_n → u` in H¹ as the mesh is refined,
-//! measured (SPEC §4: O(l_n) in the H¹ seminorm, about O(l_n²) in L²).
+//! measured (docs/theory.md#manufactured-solutions: O(l_n) in the H¹ seminorm, about
+//! O(l_n²) in L²).
 //!
 //! [`run`] solves one problem on a base mesh and on `K` successive uniform refinements of
 //! it (the levels of a [`Hierarchy`], refined once more per level), and measures every
@@ -24,9 +25,9 @@
 //! enough. The mollifier radius of [`crate::model::Sampling::Mollified`] with the paper's
 //! `ε_n` is recomputed by the assembly on every level.
 //!
-//! [`rigid_limit_sweep`] measures the other limit of SPEC §1: on a fixed mesh, the distance
-//! between the discrete solutions for a growing constant stiffness `h` and the discrete
-//! rigid-obstacle solution.
+//! [`rigid_limit_sweep`] measures the other limit (docs/theory.md#limits): on a fixed mesh,
+//! the distance between the discrete solutions for a growing constant stiffness `h` and the
+//! discrete rigid-obstacle solution.
 //!
 //! Nothing here prints or writes files: the command-line tool formats the results.
 
@@ -41,12 +42,13 @@ use crate::verify::exact::ExactSolution;
 use crate::verify::norms::{error_norms, rates, ErrorNorms};
 use std::time::Instant;
 
-/// The load of a manufactured solution (SPEC §4): `f = −t Δu + h (u − φ)⁺`, from the exact
-/// Laplacian of `exact` and the problem's own `h` and `φ` evaluated at the same point and
-/// region (so `h` and `φ` may be expressions or region tables); with a body below (SPEC §5)
-/// its reaction `− h_low (φ_low − u)⁺` too. It is [`crate::verify::exact::manufactured_load`] as an
-/// assembly coefficient: NaN outside Ω (which the model's data checks then report), never
-/// an evaluation of the exact solution there.
+/// The load of a manufactured solution (docs/theory.md#manufactured-solutions): `f = −t
+/// Δu + h (u − φ)⁺`, from the exact Laplacian of `exact` and the problem's own `h` and `φ`
+/// evaluated at the same point and region (so `h` and `φ` may be expressions or region
+/// tables); with a body below (docs/theory.md#second-body) its reaction `− h_low (φ_low −
+/// u)⁺` too. It is [`crate::verify::exact::manufactured_load`] as an assembly coefficient:
+/// NaN outside Ω (which the model's data checks then report), never an evaluation of the
+/// exact solution there.
 pub struct ManufacturedLoad<'a> {
     /// The manufactured solution u.
     pub exact: &'a dyn ExactSolution,
@@ -207,7 +209,7 @@ pub fn run(
 }
 
 /// [`run`] with the data beyond the paper's frame (boundary heights and free edges, rigid
-/// regions, a body below; SPEC §5): the same on every level, like `data`.
+/// regions, a body below; docs/theory.md#extensions): the same on every level, like `data`.
 pub fn run_with(
     mut hierarchy: Hierarchy,
     data: &ProblemData,
@@ -540,10 +542,10 @@ pub struct RigidLimit {
     pub rigid_iterations: usize,
 }
 
-/// The rigid limit (SPEC §1, `h → ∞`), measured on the finest mesh of `hierarchy`: solves
-/// `data` with the obstacle made rigid, then with each constant stiffness of `stiffnesses`
-/// (replacing `data.stiffness`; the foundation variant and sampling are kept), and returns
-/// the distances between the discrete solutions.
+/// The rigid limit (docs/theory.md#limits, `h → ∞`), measured on the finest mesh of
+/// `hierarchy`: solves `data` with the obstacle made rigid, then with each constant
+/// stiffness of `stiffnesses` (replacing `data.stiffness`; the foundation variant and
+/// sampling are kept), and returns the distances between the discrete solutions.
 ///
 /// Errors: a stiffness that is not finite and `> 0`; an assembly or solve failure.
 pub fn rigid_limit_sweep(

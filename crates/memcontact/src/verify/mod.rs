@@ -1,6 +1,7 @@
-//! Verification beside the pipeline: exact solutions (SPEC §4 and §5), the error norms of a
-//! P1 function against them, convergence studies over refined meshes, and the study of a
-//! case (its `[exact]` section, the comparisons, the rigid limit).
+//! Verification beside the pipeline: exact solutions (docs/theory.md#verification,
+//! docs/theory.md#obstacle-benchmarks), the error norms of a P1 function against them,
+//! convergence studies over refined meshes, and the study of a case (its `[exact]` section,
+//! the comparisons, the rigid limit).
 
 pub mod convergence;
 pub mod exact;

@@ -1,5 +1,6 @@
-//! Discretisation errors of a P1 function against an exact solution (SPEC §4: the discrete
-//! solution must converge at O(l_n) in the H¹ seminorm and about O(l_n²) in L²).
+//! Discretisation errors of a P1 function against an exact solution
+//! (docs/theory.md#manufactured-solutions: the discrete solution must converge at O(l_n) in
+//! the H¹ seminorm and about O(l_n²) in L²).
 //!
 //! `u_h = Σ U_i g_i` lives on the polygon `Ω_n` (the union of the triangles); the exact `u`
 //! lives on Ω. Three parts are measured:
@@ -252,7 +253,8 @@ fn disk_gap(mesh: &Mesh, exact: &dyn ExactSolution, c: [f64; 2], r: f64) -> Resu
 }
 
 /// Observed convergence rates `log(e_{k-1}/e_k) / log(l_{k-1}/l_k)` of a sequence of errors
-/// `errors[k]` on meshes of size `l_n[k]` (SPEC §4: about 1 in H¹, 2 in L²).
+/// `errors[k]` on meshes of size `l_n[k]` (docs/theory.md#manufactured-solutions: about 1
+/// in H¹, 2 in L²).
 ///
 /// The result has one entry per pair `(l_n[k], errors[k])` (the shorter length of the two
 /// slices); entry 0 is `None`, and so is any entry where an error or a size is not finite

@@ -1,4 +1,5 @@
-//! The result files of a run, written as one atomic result set ([`crate::io::result_set::ResultSet`]):
+//! The result files of a run, written as one atomic result set (written beside
+//! the target and moved into place in one step, so it never holds half of two runs):
 //! `solution.vtu` (ParaView), `nodes.csv` (one row per vertex), any extra files of the
 //! caller (pictures), and `summary.json` (the [`crate::outcome::Summary`], with the run id, the input's hash
 //! and the size and hash of every other file, so a mixed directory is detectable). A sweep

@@ -151,7 +151,7 @@ pub fn render_png(
 pub const MESH_PICTURE: &str = "mesh.png";
 
 /// The pictures of an adaptive run's final step (the `extra` files of
-/// [`super::AdaptSet::finish`]): those of `options`, and, when it draws any,
+/// [`crate::adapt::AdaptSet::finish`]): those of `options`, and, when it draws any,
 /// `mesh.png`, the final mesh's edges with the outline of the contact zone (of each
 /// body's, with a body below).
 pub fn adapt_pictures<'a>(

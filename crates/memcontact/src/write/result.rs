@@ -201,7 +201,8 @@ pub(crate) fn write_fields_with(
         ("contact_force", DataArray::F64(&fields.contact_force)),
         ("state", DataArray::I32(&state)),
     ];
-    // The body below's fields follow the paper's (SPEC §5), when there is one.
+    // The body below's fields follow the paper's (docs/theory.md#second-body), when there
+    // is one.
     let lower = fields.lower.as_ref();
     let state_low: Vec<i32> =
         lower.map_or(Vec::new(), |l| l.state.iter().map(|&s| s as i32).collect());
@@ -355,8 +356,9 @@ pub(crate) fn write_files_with(
     Ok(summary)
 }
 
-/// Writes the result set of `outcome` into `target` atomically ([`ResultSet`]): the files
-/// of [`write_files`], moved into place together. Returns the summary written.
+/// Writes the result set of `outcome` into `target` atomically: the files
+/// of [`write_files`], written into a staging directory beside it and moved into place
+/// together (the target holds the complete previous result or the complete new one). Returns the summary written.
 pub fn write_result_set(
     target: &Path,
     outcome: &Outcome,

@@ -16,7 +16,7 @@ pub fn step_label(label: &str, step: &StepSpec) -> String {
     format!("{label} [{}]", step.name)
 }
 
-/// The result set of a sweep or of load cases, written as one atomic [`ResultSet`]: a
+/// The result set of a sweep or of load cases, written as one atomic result set: a
 /// directory per step (`step-000`, … or the load case's name) holding that step's files
 /// ([`write_files`]), then `sweep.csv` (one row per step) and whatever the caller adds
 /// beside it (the force-deflection picture), and `manifest.json` last: every step's files
@@ -32,7 +32,9 @@ pub struct SweepSet {
 }
 
 impl SweepSet {
-    /// Starts the set for directory `target` (see [`ResultSet::begin`]).
+    /// Starts the set for directory `target`: checks what is there (another directory's
+    /// contents are refused unless `force`), removes staging directories of runs that are
+    /// gone, and creates a fresh staging directory.
     pub fn begin(target: &Path, force: bool) -> Result<SweepSet> {
         Ok(SweepSet {
             set: ResultSet::begin(target, force)?,

@@ -16,7 +16,7 @@ use std::sync::Arc;
 pub enum Kind {
     /// Nested meshes of uniform refinement (the exact P1 prolongation).
     Geometric,
-    /// Aggregation of the matrix's unknowns ([`super::aggregation`]).
+    /// Aggregation of the matrix's unknowns (double pairwise aggregation, as in AGMG).
     Algebraic,
 }
 

@@ -6,8 +6,9 @@
 //! One iteration, from an iterate V:
 //! 1. **nonsmooth Gauss-Seidel** pre-smoothing: ν₁ sweeps of exact one-variable
 //!    minimisation of J ([`super::relax`]). Alone, this is a globally convergent method
-//!    (SPEC §3: coordinatewise optimality is global optimality, even with the consistent
-//!    L), and it puts vertices exactly on φ_i where their local minimum is the kink;
+//!    (docs/theory.md#coordinatewise-optimality: coordinatewise optimality is global
+//!    optimality, even with the consistent L), and it puts vertices exactly on φ_i where
+//!    their local minimum is the kink;
 //! 2. the **truncated Newton system** of the smooth piece of J selected by the vertex
 //!    states at the smoothed iterate ([`crate::solve::newton::NewtonStates`]): `(S + E_P L E_P) δ = −∇J` with the
 //!    touching vertices (`V_i = φ_i`) truncated (their rows and columns zero, δ_i = 0),
@@ -36,6 +37,8 @@ pub mod cycle;
 mod kernels;
 pub mod levels;
 pub mod operator;
+// The linear multigrid solve, the yardstick of the benchmark.
+#[cfg(any(test, feature = "bench"))]
 pub mod poisson;
 pub mod smoother;
 pub mod tnnmg;
@@ -49,5 +52,8 @@ pub(crate) mod tests;
 #[cfg(feature = "kernel-timings")]
 pub use kernels::kernel_timings;
 pub use levels::{Kind, Levels};
+#[cfg(any(test, feature = "bench"))]
 pub use poisson::poisson_solve;
-pub use tnnmg::{solve, solve_with, Coarsening, TnnmgOptions};
+pub use tnnmg::{solve, Coarsening};
+#[cfg(feature = "bench")]
+pub use tnnmg::{solve_with, TnnmgOptions};

@@ -131,7 +131,8 @@ fn galerkin_operator_is_the_coarse_stiffness() {
             assert!((c.get(i, j) - mid.s.get(i, j)).abs() < 1e-12, "({i}, {j})");
         }
     }
-    // The same for the consistent L, and the lumped l (SPEC §3: l_i = ∫ h g_i).
+    // The same for the consistent L, and the lumped l (l_i = ∫ h g_i,
+    // docs/theory.md#lumped).
     let FoundationMatrix::Consistent(lf) = &fine.l else {
         panic!()
     };
@@ -153,6 +154,7 @@ fn poisson_v_cycles_converge_independently_of_the_mesh() {
         let h = square_hierarchy(4, levels);
         let model = bench_model(h.finest(), Some(0.0), Foundation::Lumped);
         let out = poisson_solve(&model.s, &model.d, &h, &model.dofs, 1e-10, None, 50).unwrap();
+        assert!(out.relative_residual <= 1e-10, "{}", out.relative_residual);
         let mut exact = model.d.clone();
         Cholesky::new(&model.s).unwrap().solve_in_place(&mut exact);
         assert!(

@@ -40,7 +40,7 @@ pub struct TnnmgOptions {
     /// many flexible CG steps preconditioned by the cycle per Newton correction. The
     /// correction is inexact Newton: its linear residual is driven below the square of the
     /// current scaled KKT residual, or a quarter of the tolerance once that square comes
-    /// near it (see [`forcing`]). 0: `cycles` plain cycles, always.
+    /// near it (the inexact Newton forcing term). 0: `cycles` plain cycles, always.
     pub krylov_steps: usize,
     /// (pre, post) Gauss-Seidel steps per level inside a V-cycle.
     pub smoothing: (usize, usize),
@@ -94,6 +94,7 @@ impl Default for TnnmgOptions {
 impl TnnmgOptions {
     /// These options with algebraic hierarchies coarsened down to about `coarsest`
     /// unknowns.
+    #[cfg(any(test, feature = "bench"))]
     pub fn with_coarsest(self, coarsest: usize) -> TnnmgOptions {
         TnnmgOptions { coarsest, ..self }
     }
@@ -127,15 +128,17 @@ pub enum Coarsening<'a> {
     /// Nested meshes of uniform refinement; the last must be the mesh the model was
     /// assembled on (anything else is an error).
     Geometric(&'a Hierarchy),
-    /// Geometric levels built beforehand ([`Levels::new`]) for the model's unknowns and
+    /// Geometric levels built beforehand (`Levels::new`) for the model's unknowns and
     /// matrix pattern.
     Built(&'a Levels),
-    /// An aggregation hierarchy built from the model's matrices ([`aggregation`]).
+    /// An aggregation hierarchy built from the model's matrices (double pairwise
+    /// aggregation, as in AGMG).
     Algebraic,
 }
 
 impl Coarsening<'_> {
     /// Geometric or algebraic.
+    #[cfg(feature = "bench")]
     pub fn kind(&self) -> Kind {
         match self {
             Coarsening::Geometric(_) => Kind::Geometric,
@@ -198,8 +201,10 @@ pub(crate) fn setup_matrix(model: &Model) -> Csr {
     }
 }
 
-/// [`solve`] with explicit options, also returning the per-level report (one entry per
-/// level solved: all of them with nested iteration).
+/// Solves Problem 2b by TNNMG ([`crate::Method::Multigrid`]) with explicit options, also
+/// returning the per-level report (one entry per level solved: all of them with nested
+/// iteration). With a `start` the iteration begins there on the finest level, without
+/// nested iteration.
 pub fn solve_with(
     model: &Model,
     coarsening: Coarsening,

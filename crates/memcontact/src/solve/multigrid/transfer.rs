@@ -1,5 +1,6 @@
-//! Grid transfer between consecutive levels of a [`crate::mesh::refine::Hierarchy`], over the *unknowns* (the
-//! interior vertices, SPEC §2), and the Galerkin coarse operator `A_c = Pᵀ A P`.
+//! Grid transfer between consecutive levels of a [`crate::mesh::refine::Hierarchy`], over
+//! the *unknowns* (the interior vertices, docs/theory.md#triangulation), and the Galerkin
+//! coarse operator `A_c = Pᵀ A P`.
 //!
 //! The mesh refinement says that fine vertex `v` carries `½(c[a] + c[b])` of a coarse P1
 //! function (`a = b` when `v` sits on a coarse vertex). Restricted to unknowns, parents on

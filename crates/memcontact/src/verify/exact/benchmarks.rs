@@ -1,18 +1,19 @@
-//! The obstacle benchmarks of PETSc SNES ex9 and MFEM ex36 (SPEC §5).
+//! The obstacle benchmarks of PETSc SNES ex9 and MFEM ex36
+//! (docs/theory.md#obstacle-benchmarks).
 
 use super::solution::ExactSolution;
 use std::f64::consts::PI;
 
-/// PETSc SNES ex9's contact radius `a` (SPEC §5): where `√(1 − a²)` meets `−A ln a + B`
-/// with matching slopes.
+/// PETSc SNES ex9's contact radius `a` (docs/theory.md#obstacle-benchmarks): where `√(1 −
+/// a²)` meets `−A ln a + B` with matching slopes.
 pub const EX9_RADIUS: f64 = 0.697965148223374;
 
 /// The radius where PETSc SNES ex9's obstacle turns from the sphere to its tangent line.
 pub const EX9_KNEE: f64 = 0.9;
 
-/// The classical radial obstacle benchmarks (SPEC §5): a rigid spherical cap with a
-/// conical skirt, `f = 0`, t = 1, the membrane lying on the cap for `r ≤ a` and harmonic
-/// beyond.
+/// The classical radial obstacle benchmarks (docs/theory.md#obstacle-benchmarks): a rigid
+/// spherical cap with a conical skirt, `f = 0`, t = 1, the membrane lying on the cap for `r
+/// ≤ a` and harmonic beyond.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum BenchmarkKind {
     /// PETSc SNES ex9: Ω = (−2, 2)², `ψ = √(1 − r²)` for `r ≤ 0.9` and its tangent line

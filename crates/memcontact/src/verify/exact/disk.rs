@@ -1,4 +1,5 @@
-//! The axisymmetric disc (SPEC §4): elastic and rigid, every contact regime.
+//! The axisymmetric disc (docs/theory.md#axisymmetric-disc): elastic and rigid, every
+//! contact regime.
 
 use super::bessel::{brent, ratio_i2_i0, ratios};
 use super::solution::ExactSolution;
@@ -21,7 +22,8 @@ pub enum DiskRegime {
 }
 
 /// The axisymmetric solution of Problem 1 on the disc `|x - c| < R` with constant `t > 0`,
-/// `f`, `h ≥ 0` (or `h = ∞`, the rigid obstacle) and `φ` (SPEC §4).
+/// `f`, `h ≥ 0` (or `h = ∞`, the rigid obstacle) and `φ`
+/// (docs/theory.md#axisymmetric-disc).
 ///
 /// With `r = |x - c|`, `k = √(h/t)`, `ψ = 4tφ/f` and the free deflection
 /// `u₀(r) = f (R² - r²)/(4t)`, the regime is decided from the data:

@@ -1,4 +1,5 @@
-//! Manufactured solutions: smooth functions with their exact derivatives (SPEC §4).
+//! Manufactured solutions: smooth functions with their exact derivatives
+//! (docs/theory.md#manufactured-solutions).
 
 use super::solution::ExactSolution;
 use crate::error::{Error, Result};
@@ -10,8 +11,9 @@ pub(super) enum Shape {
     Disk { center: [f64; 2], radius: f64 },
 }
 
-/// Manufactured solutions (SPEC §4): smooth functions vanishing on ∂Ω, with exact gradient
-/// and Laplacian. The caller sets `f = -t Δu + h (u - φ)⁺` (see [`super::manufactured_load`]).
+/// Manufactured solutions (docs/theory.md#manufactured-solutions): smooth functions
+/// vanishing on ∂Ω, with exact gradient and Laplacian. The caller sets `f = -t Δu + h (u -
+/// φ)⁺` (see [`super::manufactured_load`]).
 #[derive(Debug, Clone, Copy)]
 pub struct Manufactured {
     pub(super) shape: Shape,

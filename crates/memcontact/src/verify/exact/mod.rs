@@ -1,13 +1,14 @@
-//! Closed-form solutions of Problem 1 (SPEC §1 and §4), for verification.
+//! Closed-form solutions of Problem 1 (docs/theory.md#problem-1,
+//! docs/theory.md#verification), for verification.
 //!
 //! Problem 1 is `-t Δu + h (u - φ)⁺ = f` in Ω, `u = 0` on ∂Ω. Two families are provided:
 //!
-//! * [`DiskSolution`]: the axisymmetric solution on a disc with constant data `t`, `f`, `h`,
-//!   `φ` (SPEC §4, "Axisymmetric disc"), for the elastic obstacle (`0 ≤ h < ∞`) and for the
-//!   rigid limit `h = ∞` (the classical obstacle problem `u ≤ φ`);
+//! * [`DiskSolution`]: the axisymmetric solution on a disc with constant data `t`, `f`,
+//!   `h`, `φ` (docs/theory.md#axisymmetric-disc), for the elastic obstacle (`0 ≤ h < ∞`)
+//!   and for the rigid limit `h = ∞` (the classical obstacle problem `u ≤ φ`);
 //! * [`Manufactured`]: smooth functions vanishing on ∂Ω with exact gradient and Laplacian,
-//!   from which the caller builds the load `f = -t Δu + h (u - φ)⁺` (SPEC §4,
-//!   "Manufactured solutions"); [`manufactured_load`] does it at a point.
+//!   from which the caller builds the load `f = -t Δu + h (u - φ)⁺`
+//!   (docs/theory.md#manufactured-solutions); [`manufactured_load`] does it at a point.
 //!
 //! Every solution knows its domain Ω ([`ExactSolution::contains`]); evaluating outside Ω is
 //! the caller's error and must be checked by the caller (the error norms of
