@@ -5,7 +5,8 @@
 #   - adapt-mesh.png: the final mesh of `examples/roof-corner.toml`'s adaptive loop
 #     (adaptivity.md);
 #   - geomembrane-deflection.png, geomembrane-liftoff.png: the pictures of a membrane
-#     between two bodies, `examples/geomembrane.toml` (outputs.md, "Pictures").
+#     between two bodies, `examples/geomembrane.toml` (outputs.md, "Pictures");
+#   - soils-fit.png: fit.png of the back-analysis `examples/soils.toml` (sensitivities.md).
 # The Python guide's pictures (images/python/) are drawn by its own session:
 # MEMCONTACT_DOCS_IMAGES=1 pytest crates/memcontact-py/tests/test_walkthrough.py.
 # Usage: docs/make_images.sh   (MEMCONTACT: the binary; default: a release build made with
@@ -35,6 +36,9 @@ cp "$TMP/roof-corner/mesh.png" "$IMAGES/adapt-mesh.png"
 for p in deflection liftoff; do
     cp "$TMP/geomembrane/$p.png" "$IMAGES/geomembrane-$p.png"
 done
+
+"$MEMCONTACT" solve examples/soils.toml -o "$TMP/soils" -q >/dev/null
+cp "$TMP/soils/fit.png" "$IMAGES/soils-fit.png"
 
 
 ls -l "$IMAGES"

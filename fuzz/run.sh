@@ -6,7 +6,8 @@
 #
 # Targets: case (case-file parser and validation), expr (expression compiler and
 # evaluator), gmsh (the MSH reader on raw bytes), gmsh_flavours (the MSH sections under
-# each of the six headers), mesh (Mesh::new and what follows an accepted mesh).
+# each of the six headers), mesh (Mesh::new and what follows an accepted mesh),
+# measurements (the [fit] measurements CSV reader).
 # The corpus (fuzz/corpus/TARGET) is seeded from examples/, the test fixtures and
 # fuzz/seeds/; crashes land in fuzz/artifacts/TARGET. Installs cargo-fuzz when missing.
 # RUSTC_BOOTSTRAP=1 lets the stable compiler take the sanitizer flags cargo-fuzz passes.
@@ -20,7 +21,7 @@ export RUSTC_BOOTSTRAP=1
 if ! cargo fuzz --version >/dev/null 2>&1; then
     cargo install --locked cargo-fuzz
 fi
-TARGETS=(case expr gmsh gmsh_flavours mesh)
+TARGETS=(case expr gmsh gmsh_flavours mesh measurements)
 if [ "$target" = all ]; then
     for t in "${TARGETS[@]}"; do "$self" "$t" "$seconds" "$@"; done
     exit 0
@@ -31,7 +32,9 @@ seed() {
     mkdir -p "$dir"
     case "$1" in
         case)
-            cp ../examples/*.toml "$dir"/ ;;
+            cp ../examples/*.toml seeds/case/*.toml "$dir"/ ;;
+        measurements)
+            cp seeds/measurements/*.csv "$dir"/ ;;
         expr)
             # Each seed: 16 bytes of the point (x = 0.25, y = 0.75), then the expression.
             python3 - "$dir" ../examples/*.toml seeds/expr/*.txt <<'PY'

@@ -23,6 +23,9 @@ pub fn solve(case_path: &Path, flags: &SolveFlags) -> Result<()> {
     if case.adapt.is_some() {
         return crate::adapt_cmd::adapt(&label, &case, flags, progress, started);
     }
+    if case.sensitivity.is_some() || case.fit.is_some() {
+        return crate::sensitivity_cmd::solve(&label, &case, flags, progress, started);
+    }
     let options = WriteOptions {
         label,
         vtu: case.output.vtu,
@@ -236,6 +239,31 @@ pub fn check(case_path: &Path, sets: &[String]) -> Result<()> {
             a.tolerance
                 .map(|t| format!(", until the estimator is at most {t:e}"))
                 .unwrap_or_default()
+        );
+    }
+    if let Some(s) = &case.sensitivity {
+        println!(
+            "  sensitivity  {} × {}: outputs {}; parameters {}",
+            s.outputs.len(),
+            s.parameters.len(),
+            s.outputs.join(", "),
+            s.parameters.join(", ")
+        );
+    }
+    if let Some(f) = &case.fit {
+        let keys: Vec<&str> = f.parameters.0.keys().map(String::as_str).collect();
+        println!(
+            "  fit          {} parameters ({}), {}, at most {} iterations",
+            keys.len(),
+            keys.join(", "),
+            match &f.measurements {
+                Some(p) => format!("measurements from {}", p.display()),
+                None => format!(
+                    "{} sensors measured",
+                    case.sensors.iter().filter(|s| s.measured.is_some()).count()
+                ),
+            },
+            f.max_iterations
         );
     }
     let (method, choice) = &checked.auto;

@@ -119,6 +119,11 @@ const EXAMPLES: &[Example] = &[
             ("liner-slope.geo", include_str!("../../../examples/liner-slope.geo")),
         ],
     },
+    Example {
+        name: "soils",
+        about: "three soils under a slab fitted to 18 settlement plates ([fit]), with the plates' sensitivities ([sensitivity])",
+        files: &[("soils.toml", include_str!("../../../examples/soils.toml"))],
+    },
 ];
 
 /// Lists the examples, or writes example `name` into `dir`.

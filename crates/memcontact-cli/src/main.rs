@@ -11,6 +11,7 @@ mod examples;
 mod plot_cmd;
 mod progress;
 mod report;
+mod sensitivity_cmd;
 mod signals;
 mod solve_flags;
 
@@ -145,6 +146,11 @@ enum Command {
         /// seconds of each part alone: where the time of writing goes.
         #[arg(long)]
         write_parts: bool,
+        /// With --mesh: the cost of sensitivities in units of one solve (the energy in
+        /// every region's stiffness, one output's adjoint, a fit of the regions'
+        /// stiffnesses) on the standard data with a stiffness per region.
+        #[arg(long, requires = "mesh")]
+        sensitivity: bool,
     },
     /// Redraw the pictures of a result directory (deflection.png, pressure.png,
     /// liftoff.png, profile.png) from its solution.vtu and summary.json, without solving
@@ -233,8 +239,11 @@ fn main() -> ExitCode {
             repeat,
             pictures,
             write_parts,
+            sensitivity,
         } => {
-            if case.is_some() || mesh.is_some() {
+            if let (true, Some(m)) = (sensitivity, &mesh) {
+                memcontact_cli::bench::sensitivity::run(m, &sets, repeat)
+            } else if case.is_some() || mesh.is_some() {
                 memcontact_cli::bench::run_case_bench(&memcontact_cli::bench::CaseBench {
                     case,
                     mesh,

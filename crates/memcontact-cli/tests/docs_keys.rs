@@ -11,7 +11,7 @@ use common::{run, text, tmp_in};
 
 /// Every section of a case file, its page under `docs/case-file/`, and how its heading
 /// names it.
-const SECTIONS: [(&str, &str, &str); 12] = [
+const SECTIONS: [(&str, &str, &str); 15] = [
     ("mesh", "mesh.md", "`[mesh]`"),
     ("membrane", "membrane.md", "`[membrane]`"),
     ("obstacle", "obstacle.md", "`[obstacle]`"),
@@ -23,6 +23,9 @@ const SECTIONS: [(&str, &str, &str); 12] = [
     ("sweep", "sweep.md", "`[sweep]`"),
     ("load_case", "load-case.md", "`[[load_case]]`"),
     ("adapt", "adapt.md", "`[adapt]`"),
+    ("sensor", "sensor.md", "`[[sensor]]`"),
+    ("sensitivity", "sensitivity.md", "`[sensitivity]`"),
+    ("fit", "fit.md", "`[fit]`"),
     ("exact", "exact.md", "`[exact]`"),
 ];
 
@@ -152,6 +155,24 @@ fn samples(section: &str) -> Vec<Vec<(&'static str, &'static str)>> {
             ("free_boundary_rings", "2"),
             ("tolerance", "1e-3"),
         ]],
+        "sensor" => vec![vec![
+            ("name", "\"P1\""),
+            ("at", "[0.5, 0.5]"),
+            ("measured", "0.25"),
+            ("sigma", "0.01"),
+        ]],
+        "sensitivity" => vec![vec![
+            ("outputs", "[\"energy\", \"max_deflection\", \"total_contact_force\"]"),
+            ("parameters", "[\"membrane.tension\", \"obstacle.stiffness\"]"),
+            ("influence", "false"),
+        ]],
+        "fit" => vec![vec![
+            ("parameters", "{ \"obstacle.stiffness\" = [10.0, 1000.0] }"),
+            ("measurements", "\"points.csv\""),
+            ("max_iterations", "10"),
+            ("tolerance", "1e-6"),
+            ("prior", "0.01"),
+        ]],
         "exact" => vec![
             vec![
                 ("kind", "\"manufactured\""),
@@ -187,7 +208,7 @@ fn case_with(section: &str, keys: &[(&str, &str)]) -> String {
                 case.replace_range(start..end, &format!("[{section}]\n{body}"));
             }
         }
-        "load_case" => case.push_str(&format!("[[load_case]]\n{body}")),
+        "load_case" | "sensor" => case.push_str(&format!("[[{section}]]\n{body}")),
         _ => case.push_str(&format!("[{section}]\n{body}")),
     }
     case
@@ -198,6 +219,12 @@ fn every_key_the_docs_list_is_accepted_by_check_and_documented() {
     let dir = tmp_in("docs_keys", "keys");
     // Relative mesh files (the `file` sample) resolve beside the case.
     std::fs::copy(common::examples().join("disk.msh"), dir.join("disk.msh")).unwrap();
+    // And the measurements of the `[fit]` sample.
+    std::fs::write(
+        dir.join("points.csv"),
+        "name,x,y,u\nA,0.3,0.3,0.2\nB,0.5,0.5,0.3\nC,0.7,0.6,0.2\n",
+    )
+    .unwrap();
     for (section, page, title) in SECTIONS {
         let mut documented = documented_keys(page, title);
         documented.sort_unstable();

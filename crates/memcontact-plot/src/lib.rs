@@ -30,6 +30,7 @@
 pub mod axes;
 pub mod canvas;
 pub mod colormap;
+pub mod fit_plot;
 pub mod lines;
 pub mod loglog;
 mod maps;
@@ -41,6 +42,7 @@ pub mod ticks;
 
 pub use axes::{hatch_color, HATCH_SPACING};
 pub use canvas::{Canvas, PixelRect};
+pub use fit_plot::{render_fit_plot, FitPlot, FitSensor, FIT_HEIGHT, FIT_WIDTH};
 pub use lines::{render_line_plot, LinePlot, Series};
 pub use loglog::loglog_plot;
 pub use maps::{

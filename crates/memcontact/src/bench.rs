@@ -8,6 +8,7 @@ pub use crate::fem::{assemble_stiffness_and_mass, assemble_vector, unknowns_patt
 pub use crate::mesh::reorder::edge_span;
 pub use crate::mesh::{DofMap, VertexTriangles};
 pub use crate::model::{BodyStiffness, Model, ProblemData};
+pub use crate::sensitivity::outputs::locate;
 pub use crate::solve::multigrid::{
     kernel_timings, poisson_solve, solve_with, Coarsening, TnnmgOptions,
 };

@@ -46,9 +46,12 @@
 //!   step), [`run::run_to_files`] (the same, written as `memcontact solve` writes it),
 //!   [`run::run_sweep`] (load steps or load cases in turn), [`run::run_adapt`] (the
 //!   adaptive loop of [`adapt`]), [`run::run_study`] (a convergence study, with the exact
-//!   solutions and norms of [`verify`]) and [`run::check`] (everything a run would refuse,
-//!   without solving). The command-line tool and the Python module call these and the
-//!   writers of [`mod@write`]; they run nothing themselves.
+//!   solutions and norms of [`verify`]), [`run::run_sensitivity`] (derivatives of a case's
+//!   outputs in its parameters, through the contact, with [`sensitivity`]),
+//!   [`run::run_fit`] (parameters fitted to measured deflections, with [`fit`]) and
+//!   [`run::check`] (everything a run would refuse, without solving). The command-line
+//!   tool and the Python module call these and the writers of [`mod@write`]; they run
+//!   nothing themselves.
 //! - The data: [`case`] (the case file), [`problem`], [`field`] (numbers, expressions,
 //!   region tables), [`mesh`] (meshes, generators, uniform refinement), [`io`] (Gmsh and
 //!   VTU files).
@@ -66,6 +69,7 @@ pub mod discretization;
 pub mod error;
 pub(crate) mod fem;
 pub mod field;
+pub mod fit;
 pub mod io;
 pub mod limits;
 pub mod mesh;
@@ -75,6 +79,7 @@ pub mod parallel;
 pub mod problem;
 pub(crate) mod quadrature;
 pub mod run;
+pub mod sensitivity;
 pub mod solve;
 pub(crate) mod sparse;
 pub mod verify;

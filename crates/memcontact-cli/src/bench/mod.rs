@@ -8,6 +8,7 @@
 //!   the peak memory and the certificate.
 
 pub mod proc;
+pub mod sensitivity;
 pub mod standard;
 
 use anyhow::{bail, Context, Result};

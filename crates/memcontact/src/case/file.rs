@@ -5,6 +5,7 @@ use super::adapt::AdaptSpec;
 use super::exact::ExactSpec;
 use super::output::{OutputOptions, Units};
 use super::overrides::{apply_overrides, key_span, line_of, plain_types, strip_json_position};
+use super::sensitivity::{FitSpec, SensitivitySpec, Sensor};
 use super::sweep::{step_list, validate_steps, LoadCase, StepSpec, SweepSpec};
 use crate::error::{Error, Invalid, Result};
 use crate::problem::{Boundary, Membrane, MeshSpec, Obstacle, Problem};
@@ -35,6 +36,12 @@ pub struct Case {
     pub load_cases: Vec<LoadCase>,
     /// `[adapt]`: adaptive refinement of the mesh.
     pub adapt: Option<AdaptSpec>,
+    /// `[[sensor]]`: points where the deflection is read (and measured).
+    pub sensors: Vec<Sensor>,
+    /// `[sensitivity]`: derivatives of outputs in case keys.
+    pub sensitivity: Option<SensitivitySpec>,
+    /// `[fit]`: case keys fitted to measured deflections.
+    pub fit: Option<FitSpec>,
 }
 
 /// The serde shape of [`Case`]: one field per section.
@@ -62,6 +69,12 @@ struct CaseFile {
     load_cases: Vec<LoadCase>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     adapt: Option<AdaptSpec>,
+    #[serde(default, rename = "sensor", skip_serializing_if = "Vec::is_empty")]
+    sensors: Vec<Sensor>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    sensitivity: Option<SensitivitySpec>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    fit: Option<FitSpec>,
 }
 
 impl From<CaseFile> for Case {
@@ -81,6 +94,9 @@ impl From<CaseFile> for Case {
             sweep: c.sweep,
             load_cases: c.load_cases,
             adapt: c.adapt,
+            sensors: c.sensors,
+            sensitivity: c.sensitivity,
+            fit: c.fit,
         }
     }
 }
@@ -100,13 +116,16 @@ impl From<Case> for CaseFile {
             sweep: c.sweep,
             load_cases: c.load_cases,
             adapt: c.adapt,
+            sensors: c.sensors,
+            sensitivity: c.sensitivity,
+            fit: c.fit,
         }
     }
 }
 
 impl Case {
     /// A case of `problem` alone: the default `[solver]`, `[output]` and `[units]`, no
-    /// steps, no adaptive loop, no exact solution.
+    /// steps, no adaptive loop, no exact solution, no sensors, sensitivities or fit.
     pub fn new(problem: Problem) -> Case {
         Case {
             problem,
@@ -117,6 +136,9 @@ impl Case {
             sweep: None,
             load_cases: Vec::new(),
             adapt: None,
+            sensors: Vec::new(),
+            sensitivity: None,
+            fit: None,
         }
     }
 
@@ -143,6 +165,7 @@ impl Case {
                 ));
             }
         }
+        super::sensitivity::validate_case(self)?;
         if let Some(ExactSpec::Manufactured { amplitude, .. }) = &self.exact {
             if !(amplitude.is_finite() && *amplitude != 0.0) {
                 return Err(Invalid::new(
@@ -179,6 +202,9 @@ impl Case {
         })?;
         if let Some(base) = file.and_then(Path::parent) {
             case.problem.mesh.resolve(base);
+            if let Some(fit) = &mut case.fit {
+                fit.resolve(base);
+            }
         }
         case.validate().map_err(|inv| {
             let span = key_span(text, &inv.key);

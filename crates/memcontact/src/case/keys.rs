@@ -187,6 +187,39 @@ pub const SECTIONS: &[SectionDoc] = &[
         ],
     },
     SectionDoc {
+        name: "sensor",
+        array: true,
+        summary: "points where the deflection is read (and, for a fit, measured)",
+        keys: &[
+            key("name", "= \"...\"", "letters, digits, _ - .: the output sensor:NAME"),
+            key("at", "= [x, y]", "inside the mesh: u there by P1 interpolation"),
+            key("measured", "= u_m", "length: the measured deflection there, for [fit]"),
+            key("sigma", "= 1", "length: the measurement's standard deviation σ > 0"),
+        ],
+    },
+    SectionDoc {
+        name: "sensitivity",
+        array: false,
+        summary: "derivatives of outputs in case keys (sensitivity.csv, influence maps)",
+        keys: &[
+            key("outputs", "= [\"energy\"]", "max_deflection, total_contact_force, sensors, ..."),
+            key("parameters", "= [\"key\", ...]", "case keys (membrane.tension, obstacle.stiffness.soil)"),
+            key("influence", "= true", "dJ_dh, dsensor_NAME_dh in solution.vtu"),
+        ],
+    },
+    SectionDoc {
+        name: "fit",
+        array: false,
+        summary: "case keys fitted to measured deflections (fit.json, fit.csv, fit.png)",
+        keys: &[
+            key("parameters", "= { \"key\" = [min, max] }", "the keys fitted, in bounds (start: the case's)"),
+            key("measurements", "= \"points.csv\"", "name,x,y,u[,sigma] (default: sensors' measured)"),
+            key("max_iterations", "= 30", "Levenberg-Marquardt iterations"),
+            key("tolerance", "= 1e-8", "on the step (in ln p) and the gradient"),
+            key("prior", "= α", "weight of a pull toward the start, ½ α ‖ln p − ln p₀‖²"),
+        ],
+    },
+    SectionDoc {
         name: "exact",
         array: false,
         summary: "the closed-form solution, for convergence studies",

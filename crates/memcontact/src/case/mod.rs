@@ -4,7 +4,8 @@
 //!
 //! A [`Case`] is a [`crate::problem::Problem`], the solver [`crate::solve::Settings`], the
 //! [`OutputOptions`], the [`ExactSpec`] of a closed-form solution for convergence studies,
-//! and the steps of a load sweep or of load combinations.
+//! the steps of a load sweep or of load combinations, and the [`Sensor`]s, the
+//! [`SensitivitySpec`] and the [`FitSpec`] of a sensitivity run or a fit.
 
 mod adapt;
 mod exact;
@@ -12,6 +13,7 @@ mod file;
 pub mod keys;
 mod output;
 mod overrides;
+pub(crate) mod sensitivity;
 mod sweep;
 #[cfg(test)]
 mod tests;
@@ -22,6 +24,9 @@ pub use exact::{BenchmarkBody, ExactSpec, ManufacturedDomain, ManufacturedForm};
 pub use file::{read_case_text, steps, Case};
 pub use output::{OutputOptions, PictureKind, Units, VtuFormat};
 pub use overrides::apply_overrides;
+pub use sensitivity::{
+    FitParameters, FitSpec, ParameterKey, ParameterKind, ParameterTarget, SensitivitySpec, Sensor,
+};
 pub use sweep::{
     step_list, validate_steps, LoadCase, StepSpec, SweepParameter, SweepSpec, MAX_STEPS,
 };

@@ -30,7 +30,33 @@ pub fn apply_overrides(
             .parse()
             .unwrap_or_else(|_| toml_edit::Value::from(value));
         let mut table = doc.as_table_mut();
-        for p in &parts[..parts.len() - 1] {
+        let mut k = 0;
+        while k + 1 < parts.len() {
+            let p = parts[k];
+            // `name.N.key`: entry N of an array of tables (`[[name]]`).
+            if table.get(p).is_some_and(|i| i.is_array_of_tables()) {
+                let aot = table
+                    .get_mut(p)
+                    .and_then(|i| i.as_array_of_tables_mut())
+                    .expect("an array of tables");
+                let n = aot.len();
+                let index = parts[k + 1]
+                    .parse::<usize>()
+                    .ok()
+                    .filter(|_| k + 2 < parts.len());
+                table = index.and_then(|i| aot.get_mut(i)).ok_or_else(|| {
+                    (
+                        key.to_string(),
+                        format!(
+                            "\"{p}\" is a list of {n} tables: name an entry's key by its index, \
+                             e.g. {p}.0.name"
+                        ),
+                    )
+                })?;
+                k += 2;
+                continue;
+            }
+            k += 1;
             let entry = table
                 .entry(p)
                 .or_insert_with(|| toml_edit::Item::Table(toml_edit::Table::new()));

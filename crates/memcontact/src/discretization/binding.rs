@@ -126,7 +126,7 @@ impl BoundData {
 
 /// Binds the boundary heights to the boundary regions of `mesh` that are fixed (a table
 /// needs a value for each of them, or a default), or, for nodal values, to its vertices.
-fn bind_height(boundary: &crate::problem::Boundary, mesh: &Mesh) -> Result<BoundField> {
+pub(crate) fn bind_height(boundary: &crate::problem::Boundary, mesh: &Mesh) -> Result<BoundField> {
     let name = "boundary.height";
     if let crate::field::Field::Nodal(_) = &boundary.height {
         return boundary.height.bind_to_mesh(name, mesh);

@@ -247,6 +247,12 @@ impl Discretization {
         self.built.as_deref()
     }
 
+    /// Gives the solves multigrid levels built beforehand for the model's pattern (the
+    /// aggregation hierarchy a fit builds once and keeps for every iterate's solve).
+    pub(crate) fn share_levels(&mut self, levels: Arc<Levels>) {
+        self.built = Some(levels);
+    }
+
     /// [`Discretization::assemble`] on a hierarchy already renumbered (in `t_reorder`
     /// seconds).
     fn assemble_reordered(

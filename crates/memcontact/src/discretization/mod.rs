@@ -9,7 +9,7 @@ mod meshing;
 #[cfg(test)]
 mod ordering_tests;
 
-pub(crate) use binding::{assemble_model, bind_and_check, BoundData};
+pub(crate) use binding::{assemble_model, bind_and_check, bind_height, BoundData};
 pub(crate) use case_checks::check_case_on_mesh;
 pub use discrete::{Discretization, Phase};
 pub(crate) use meshing::build_mesh;

@@ -160,8 +160,25 @@ impl NodalP1 {
     /// The interpolant at `p`: the value given at a vertex, the P1 interpolant of the
     /// triangle holding `p` elsewhere, NaN outside the mesh.
     pub fn eval(&self, p: Point) -> f64 {
-        // The first triangle holding p, else the one p is closest to being in (p on an
-        // edge, within rounding: either side gives the same value).
+        let Some((k, l)) = self.locate(p) else {
+            return f64::NAN;
+        };
+        let t = self.triangles[k];
+        // At a vertex, the value given there, exactly.
+        for &v in &t {
+            if self.points[v as usize] == p {
+                return self.values[v as usize];
+            }
+        }
+        l[0] * self.values[t[0] as usize]
+            + l[1] * self.values[t[1] as usize]
+            + l[2] * self.values[t[2] as usize]
+    }
+
+    /// The triangle holding `p` and its barycentric coordinates there: the first triangle
+    /// holding p, else the one p is closest to being in (p on an edge, within rounding);
+    /// `None` outside the mesh.
+    pub fn locate(&self, p: Point) -> Option<(usize, [f64; 3])> {
         let mut best = (f64::NEG_INFINITY, [0.0; 3], 0usize);
         for &k in self.grid.candidates(p) {
             let l = self.barycentric(k as usize, p);
@@ -173,19 +190,7 @@ impl NodalP1 {
                 }
             }
         }
-        if best.0 < -1e-9 {
-            return f64::NAN;
-        }
-        let (l, t) = (best.1, self.triangles[best.2]);
-        // At a vertex, the value given there, exactly.
-        for &v in &t {
-            if self.points[v as usize] == p {
-                return self.values[v as usize];
-            }
-        }
-        l[0] * self.values[t[0] as usize]
-            + l[1] * self.values[t[1] as usize]
-            + l[2] * self.values[t[2] as usize]
+        (best.0 >= -1e-9).then_some((best.2, best.1))
     }
 }
 

@@ -198,7 +198,7 @@ pub(super) struct Masked<'a> {
 }
 
 impl<'a> Masked<'a> {
-    fn new(body: BodyData<'a>) -> Masked<'a> {
+    pub(super) fn new(body: BodyData<'a>) -> Masked<'a> {
         Masked {
             inner: match body.stiffness {
                 BodyStiffness::Elastic(h) => Some(h),
@@ -210,7 +210,7 @@ impl<'a> Masked<'a> {
 
     /// The coefficient to integrate (`None`: rigid everywhere). Without rigid regions it is
     /// the body's own coefficient, so that the paper's model is assembled as before.
-    fn elastic(&self) -> Option<&dyn Coefficient> {
+    pub(super) fn elastic(&self) -> Option<&dyn Coefficient> {
         let inner = self.inner?;
         if self.rigid.is_empty() {
             Some(inner)

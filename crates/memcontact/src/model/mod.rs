@@ -8,6 +8,7 @@ mod body;
 mod boundary;
 mod checks;
 mod data;
+mod derivative;
 mod sampling;
 mod system;
 #[cfg(test)]
@@ -23,5 +24,6 @@ pub use checks::{
 pub use data::{
     BodyData, BodyStiffness, BoundaryData, Extensions, Foundation, ProblemData, Sampling,
 };
+pub(crate) use derivative::DerivativeAssembly;
 pub use sampling::paper_epsilon;
 pub use system::Model;

@@ -5,6 +5,7 @@
 pub(crate) mod checks;
 pub mod fields;
 mod report;
+mod sensitivity;
 mod solved;
 pub mod summary;
 pub mod sweep;
@@ -12,6 +13,7 @@ mod system;
 
 pub use fields::{LowerFields, LowerTotals, NodalFields, Totals};
 pub use report::Report;
+pub use sensitivity::SensitivityTotals;
 pub use solved::Outcome;
 pub use summary::{FileRecord, Summary};
 pub use sweep::StepRow;

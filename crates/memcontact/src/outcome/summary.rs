@@ -193,6 +193,9 @@ pub struct Summary {
     /// The adaptive loop's totals (with `[adapt]`).
     #[serde(default, flatten, skip_serializing_if = "Option::is_none")]
     pub adapt: Option<AdaptTotals>,
+    /// The sensitivity run's totals (with `[sensitivity]`).
+    #[serde(default, flatten, skip_serializing_if = "Option::is_none")]
+    pub sensitivity: Option<super::SensitivityTotals>,
 }
 
 /// The totals of an adaptive loop, in `summary.json` beside the final step's values.
@@ -316,6 +319,7 @@ impl Summary {
             max_pressure_low: totals.lower.map(|t| t.max_pressure_low),
             liftoff_area_low: totals.lower.map(|t| t.liftoff_area_low),
             adapt: None,
+            sensitivity: None,
         }
         .with_boundary(outcome, quality)
     }

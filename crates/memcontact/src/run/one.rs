@@ -250,16 +250,20 @@ pub struct Checked {
 
 /// Checks a case as `memcontact check` does: everything the run would refuse, without
 /// solving. The case is validated; the mesh built and the model assembled as the run
-/// builds them (lean for one solve; everything kept for a sweep, load cases or the
-/// adaptive loop), so that the memory estimate is the one the run checks; the load cases'
-/// data are assembled on the mesh, the profile line and the adaptive loop's limits checked
-/// against it; and a solve that would not fit in the memory available is refused.
+/// builds them (lean for one solve; everything kept for a sweep, load cases, the adaptive
+/// loop, sensitivities or a fit), so that the memory estimate is the one the run checks;
+/// the load cases' data are assembled on the mesh, the profile line, the adaptive loop's
+/// limits, the sensors, the outputs and parameters of `[sensitivity]` and the
+/// measurements of `[fit]` checked against it; and a solve that would not fit in the
+/// memory available is refused.
 pub fn check(case: &Case, observer: &mut dyn Observer) -> Result<Checked> {
     case.validate().map_err(Invalid::into_error)?;
     // The memory available is read before the check's own mesh and model take theirs.
     let memory_available = crate::limits::available_memory();
     let observer = &mut Cancellable::new(observer, &case.settings.cancel);
-    let discretization = if case.is_sweep() || case.adapt.is_some() {
+    let keeps_everything =
+        case.is_sweep() || case.adapt.is_some() || case.sensitivity.is_some() || case.fit.is_some();
+    let discretization = if keeps_everything {
         Discretization::new(&case.problem, observer)?
     } else {
         Discretization::for_one_solve(&case.problem, &case.settings, observer)?
@@ -269,6 +273,7 @@ pub fn check(case: &Case, observer: &mut dyn Observer) -> Result<Checked> {
     if let Some(a) = &case.adapt {
         crate::adapt::check_adapt_on_mesh(a, discretization.mesh())?;
     }
+    super::sensitivity::check_sensitivity_on_mesh(case, &discretization)?;
     Ok(Checked {
         auto: discretization.auto_choice(),
         memory_needed: discretization.memory_estimate(&case.settings),
@@ -278,11 +283,14 @@ pub fn check(case: &Case, observer: &mut dyn Observer) -> Result<Checked> {
 }
 
 /// What the one-step runs ([`run`], [`run_to_files`]) refuse before any work: a case
-/// with steps, an invalid case, a case with `[adapt]`.
+/// with steps, an invalid case, a case with `[adapt]` or `[fit]` (a case with
+/// `[sensitivity]` is solved, without its derivatives: [`super::run_sensitivity`] computes
+/// them).
 fn check_one_step(case: &Case) -> Result<()> {
     refuse_steps(case)?;
     case.validate().map_err(Invalid::into_error)?;
-    refuse_adapt(case)
+    refuse_adapt(case)?;
+    refuse_fit(case)
 }
 
 /// A case with steps is refused by the one-step runs.
@@ -310,6 +318,20 @@ fn refuse_adapt(case: &Case) -> Result<()> {
             line: None,
             key: "adapt".into(),
             message: "the case refines its mesh adaptively: run its adaptive loop".into(),
+        });
+    }
+    Ok(())
+}
+
+/// A case with `[fit]` is refused by the one-step runs: its answer is at the fitted
+/// parameters, not the case's own.
+fn refuse_fit(case: &Case) -> Result<()> {
+    if case.fit.is_some() {
+        return Err(Error::Case {
+            file: None,
+            line: None,
+            key: "fit".into(),
+            message: "the case fits parameters to measurements: run its fit".into(),
         });
     }
     Ok(())

@@ -485,12 +485,18 @@ fn run_method(
         Method::Coordinate => coordinate::solve_from(model, settings, start, observer),
         Method::Multigrid => {
             let coarsening = match (settings.hierarchy, hierarchy) {
-                (HierarchyChoice::Algebraic, _) | (HierarchyChoice::Auto, None) => {
-                    multigrid::Coarsening::Algebraic
-                }
+                (HierarchyChoice::Algebraic, _) | (HierarchyChoice::Auto, None) => match built {
+                    // Algebraic levels built beforehand for this pattern (a fit's iterates).
+                    Some(levels) if levels.kind == multigrid::Kind::Algebraic => {
+                        multigrid::Coarsening::Built(levels)
+                    }
+                    _ => multigrid::Coarsening::Algebraic,
+                },
                 (_, Some(h)) => match built {
-                    Some(levels) => multigrid::Coarsening::Built(levels),
-                    None => multigrid::Coarsening::Geometric(h),
+                    Some(levels) if levels.kind == multigrid::Kind::Geometric => {
+                        multigrid::Coarsening::Built(levels)
+                    }
+                    _ => multigrid::Coarsening::Geometric(h),
                 },
                 (HierarchyChoice::Geometric, None) => {
                     return Err(Error::Solver {

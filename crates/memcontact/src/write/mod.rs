@@ -15,6 +15,7 @@ mod manifest;
 mod pictures;
 mod redraw;
 mod result;
+mod sensitivity;
 mod study;
 mod sweep;
 #[cfg(test)]
@@ -33,6 +34,10 @@ pub use redraw::{load as load_result, Loaded, LowerData, ResultData};
 pub use result::{
     file_record, input_hash, new_run_id, write_fields, write_files, write_result_set, WriteOptions,
     LOWER_FIELDS, NODAL_FIELDS,
+};
+pub use sensitivity::{
+    fit_picture, write_fit_csv, write_fit_json, write_sensitivity_csv, write_sensitivity_result,
+    FIT_CSV, FIT_JSON, FIT_PICTURE, SENSITIVITY_COLUMNS, SENSITIVITY_CSV,
 };
 pub use study::{
     convergence_columns, h_sweep_columns, write_study, write_study_csv, StudyColumn,

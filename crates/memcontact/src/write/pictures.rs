@@ -153,7 +153,7 @@ pub fn write_parts_seconds(
         Ok(())
     };
     timed("solution.vtu", &mut || {
-        write_solution_vtu(dir, &mesh, &fields, case.output.vtu, "0", &[]).map(|_| ())
+        write_solution_vtu(dir, &mesh, &fields, case.output.vtu, "0", &[], &[]).map(|_| ())
     })?;
     if case.output.writes_csv() {
         timed("nodes.csv", &mut || {

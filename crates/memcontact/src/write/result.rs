@@ -174,11 +174,27 @@ pub fn write_fields(
     run_id: &str,
     cell_data: &[(String, Vec<f64>)],
 ) -> Result<Vec<(String, FileRecord)>> {
+    write_fields_with(dir, outcome, fields, vtu, csv, run_id, cell_data, &[])
+}
+
+/// [`write_fields`] with further point fields of `solution.vtu` (`extra_points`, one value
+/// per vertex in the user's order: the sensitivity run's influence maps).
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn write_fields_with(
+    dir: &Path,
+    outcome: &Outcome,
+    fields: &NodalFields,
+    vtu: VtuFormat,
+    csv: bool,
+    run_id: &str,
+    cell_data: &[(String, Vec<f64>)],
+    extra_points: &[(String, Vec<f64>)],
+) -> Result<Vec<(String, FileRecord)>> {
     let mesh = outcome.mesh();
     // The two files are written side by side: one thread's formatting overlaps the other's
     // writes.
     let (vtu_written, csv_written) = rayon::join(
-        || write_solution_vtu(dir, &mesh, fields, vtu, run_id, cell_data),
+        || write_solution_vtu(dir, &mesh, fields, vtu, run_id, cell_data, extra_points),
         || csv.then(|| write_nodes_csv(dir, &mesh, fields)),
     );
     let mut files = vec![vtu_written?];
@@ -232,6 +248,7 @@ pub(super) fn write_solution_vtu(
     vtu: VtuFormat,
     run_id: &str,
     cell_data: &[(String, Vec<f64>)],
+    extra_points: &[(String, Vec<f64>)],
 ) -> Result<(String, FileRecord)> {
     let region: Vec<i32> = mesh.regions.iter().map(|&r| r as i32).collect();
     let state = as_i32(&fields.state);
@@ -245,6 +262,12 @@ pub(super) fn write_solution_vtu(
     if lower.is_some() {
         points.push(("covered_low", DataArray::I32(&covered_low)));
     }
+    // A run's further fields (a sensitivity run's influence maps) last.
+    points.extend(
+        extra_points
+            .iter()
+            .map(|(n, v)| (n.as_str(), DataArray::F64(v))),
+    );
     let cells: Vec<(&str, DataArray)> = std::iter::once(("region", DataArray::I32(&region)))
         .chain(
             cell_data
@@ -298,6 +321,28 @@ pub fn write_files(
     options: &WriteOptions,
     extra: &mut dyn FnMut(&Path, &NodalFields) -> Result<Vec<String>>,
 ) -> Result<Summary> {
+    write_files_with(dir, outcome, case, options, extra, &Extras::default())
+}
+
+/// What a run adds to the files of its solve: point fields of `solution.vtu` and keys of
+/// `summary.json` (a sensitivity run's influence maps and totals).
+#[derive(Debug, Clone, Default)]
+pub(crate) struct Extras {
+    /// Further point fields of `solution.vtu`, one value per vertex in the user's order.
+    pub(crate) point_data: Vec<(String, Vec<f64>)>,
+    /// The sensitivity totals of `summary.json`.
+    pub(crate) sensitivity: Option<crate::outcome::SensitivityTotals>,
+}
+
+/// [`write_files`] with the [`Extras`] of a run.
+pub(crate) fn write_files_with(
+    dir: &Path,
+    outcome: &Outcome,
+    case: &Case,
+    options: &WriteOptions,
+    extra: &mut dyn FnMut(&Path, &NodalFields) -> Result<Vec<String>>,
+    extras: &Extras,
+) -> Result<Summary> {
     let t0 = Instant::now();
     let (fields, totals) = outcome.checked_fields()?;
     let r = &outcome.report;
@@ -326,6 +371,7 @@ pub fn write_files(
                 options.vtu,
                 &run_id,
                 &options.cell_data,
+                &extras.point_data,
             ))
         });
         if csv {
@@ -356,6 +402,7 @@ pub fn write_files(
     summary.input_hash = hash;
     summary.plot_options = options.plot_options.clone();
     summary.adapt = options.adapt.clone();
+    summary.sensitivity = extras.sensitivity.clone();
     summary.files.extend(written);
     summary.files.extend(extra_written);
     summary.time_write_s = t0.elapsed().as_secs_f64();
@@ -374,8 +421,20 @@ pub fn write_result_set(
     options: &WriteOptions,
     extra: &mut dyn FnMut(&Path, &NodalFields) -> Result<Vec<String>>,
 ) -> Result<Summary> {
+    write_result_set_with(target, outcome, case, options, extra, &Extras::default())
+}
+
+/// [`write_result_set`] with the [`Extras`] of a run.
+pub(crate) fn write_result_set_with(
+    target: &Path,
+    outcome: &Outcome,
+    case: &Case,
+    options: &WriteOptions,
+    extra: &mut dyn FnMut(&Path, &NodalFields) -> Result<Vec<String>>,
+    extras: &Extras,
+) -> Result<Summary> {
     let set = ResultSet::begin(target, options.force)?;
-    let summary = write_files(set.dir(), outcome, case, options, extra)?;
+    let summary = write_files_with(set.dir(), outcome, case, options, extra, extras)?;
     // Stopped while writing: the staging directory goes, the previous result stays.
     case.settings.cancel.check()?;
     set.commit()?;

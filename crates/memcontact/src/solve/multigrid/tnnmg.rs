@@ -173,7 +173,7 @@ pub fn solve(
 /// foundations (where the membrane penetrates a body, the Newton matrices add its L to S).
 /// S's values are copied, then its diagonal shifted, on all threads (a copy the size of
 /// the problem).
-pub(super) fn setup_matrix(model: &Model) -> Csr {
+pub(crate) fn setup_matrix(model: &Model) -> Csr {
     use rayon::prelude::*;
     const ROWS: usize = 4096;
     let s = &model.s;

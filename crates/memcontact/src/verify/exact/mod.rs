@@ -17,6 +17,7 @@
 mod benchmarks;
 mod bessel;
 mod disk;
+mod disk_derivative;
 mod manufactured;
 mod solution;
 #[cfg(test)]
