@@ -7,6 +7,7 @@ mod case;
 mod convert;
 mod mesh;
 mod result;
+mod sensitivity;
 mod study;
 mod sweep;
 mod views;
@@ -89,6 +90,22 @@ fn solve_on(
     })
 }
 
+/// The case a dict describes (the sections of a case file but `mesh`) on `mesh`, given as
+/// data, as `solve_on` makes it: for the runs that take a `Case` (sensitivities, fits).
+#[pyfunction]
+#[pyo3(signature = (mesh, data, label=None))]
+fn case_on(
+    mesh: PyRef<'_, PyMesh>,
+    data: &Bound<'_, PyDict>,
+    label: Option<String>,
+) -> PyResult<PyCase> {
+    let case = case::case_on_mesh(data, &mesh.hierarchy)?;
+    Ok(PyCase {
+        case,
+        label: label.unwrap_or_else(|| "mesh".into()),
+    })
+}
+
 /// The sections of a case file as a dict (the TOML parsed, nothing checked yet): for a
 /// case file without `[mesh]` solved on a mesh given as data.
 #[pyfunction]
@@ -113,7 +130,14 @@ fn _memcontact(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<sweep::PySweep>()?;
     m.add_class::<study::PyStudy>()?;
     m.add_class::<adapt::PyAdapt>()?;
+    m.add_class::<sensitivity::PySensitivities>()?;
+    m.add_class::<sensitivity::PyFit>()?;
+    m.add_class::<sensitivity::PyFitProblem>()?;
     m.add_function(wrap_pyfunction!(solve, m)?)?;
+    m.add_function(wrap_pyfunction!(sensitivity::sensitivities, m)?)?;
+    m.add_function(wrap_pyfunction!(sensitivity::fit, m)?)?;
+    m.add_function(wrap_pyfunction!(sensitivity::fit_problem, m)?)?;
+    m.add_function(wrap_pyfunction!(case_on, m)?)?;
     m.add_function(wrap_pyfunction!(sweep::sweep, m)?)?;
     m.add_function(wrap_pyfunction!(study::convergence, m)?)?;
     m.add_function(wrap_pyfunction!(solve_on, m)?)?;

@@ -51,7 +51,17 @@ from typing import (
 import numpy as np
 
 from . import _memcontact as _native
-from ._memcontact import Adapt, Case, Mesh, Result, Study, Sweep
+from ._memcontact import (
+    Adapt,
+    Case,
+    Fit,
+    FitProblem,
+    Mesh,
+    Result,
+    Sensitivities,
+    Study,
+    Sweep,
+)
 from ._sections import (
     SECTIONS as _SECTIONS,
     Boundary,
@@ -70,12 +80,15 @@ __all__ = [
     "Adapt",
     "Boundary",
     "Case",
+    "Fit",
+    "FitProblem",
     "Lower",
     "Membrane",
     "Mesh",
     "Obstacle",
     "Output",
     "Result",
+    "Sensitivities",
     "Solver",
     "SolverError",
     "Study",
@@ -84,11 +97,14 @@ __all__ = [
     "adapt",
     "convergence",
     "disk",
+    "fit",
+    "fit_problem",
     "load_case",
     "polygon",
     "read_gmsh",
     "rectangle",
     "refine",
+    "sensitivities",
     "solve",
     "solve_many",
     "solve_mesh",
@@ -123,12 +139,15 @@ class SolverError(RuntimeError):
         The best iterate (``result.kkt_residual``: its certificate).
     sweep : Sweep or None
         The steps solved, for a sweep.
+    fit : Fit or None
+        For a fit that did not converge: the fit with its best iterate.
     """
 
     def __init__(self, message: str, result: Result, sweep: Optional[Sweep] = None) -> None:
         super().__init__(message, result)
         self.result: Result = result
         self.sweep: Optional[Sweep] = sweep
+        self.fit: Optional[Fit] = None
 
     def __str__(self) -> str:
         return str(self.args[0])
@@ -1026,3 +1045,346 @@ def solve_many(
             except Exception:  # pragma: no cover - best effort
                 pass
         raise
+
+
+# ---------------------------------------------------------------------------------------
+# Sensitivities and back-analysis.
+
+
+def _sensor_entries(sensors: Any) -> List[Dict[str, Any]]:
+    """``[[sensor]]`` entries from a mapping ``name -> (x, y)`` (or ``name -> dict`` of the
+    sensor's keys) or a sequence of dicts with ``name`` and ``at``."""
+    if isinstance(sensors, Mapping):
+        items = []
+        for name, value in sensors.items():
+            if isinstance(value, Mapping):
+                items.append({"name": name, **dict(value)})
+            else:
+                items.append({"name": name, "at": value})
+    elif isinstance(sensors, (str, bytes)) or not isinstance(sensors, Iterable):
+        raise TypeError(
+            "sensors: give a dict name -> (x, y) or a list of dicts with name and at, "
+            f"not {type(sensors).__name__}"
+        )
+    else:
+        items = []
+        for s in sensors:
+            if not isinstance(s, Mapping):
+                raise TypeError(
+                    f"sensors: each sensor is a dict with name and at, not {type(s).__name__}"
+                )
+            items.append(dict(s))
+    out = []
+    for s in items:
+        entry = dict(s)
+        if "at" in entry and isinstance(entry["at"], (np.ndarray, tuple)):
+            entry["at"] = np.asarray(entry["at"]).tolist()
+        for key in ("measured", "sigma"):
+            if isinstance(entry.get(key), np.generic):
+                entry[key] = entry[key].item()
+        out.append(entry)
+    return out
+
+
+def _measurement_entries(measurements: Any, data: Dict[str, Any]) -> Dict[str, Any]:
+    """The case's sensors and ``[fit]`` keys for ``measurements``: a path of a CSV file
+    (``name,x,y,u[,sigma]``), a mapping ``sensor name -> measured deflection`` (for the
+    case's own sensors), or a table with the columns ``name, x, y, u`` and optionally
+    ``sigma`` (a dict of columns or a ``pandas.DataFrame``)."""
+    if isinstance(measurements, (str, os.PathLike)):
+        return {"measurements": os.fspath(measurements)}
+    columns = getattr(measurements, "columns", None)
+    if columns is not None or (
+        isinstance(measurements, Mapping) and {"name", "x", "y", "u"} <= set(measurements)
+    ):
+        table = {str(c): list(np.asarray(measurements[c]).tolist()) for c in
+                 (columns if columns is not None else measurements.keys())}
+        missing = {"name", "x", "y", "u"} - set(table)
+        if missing:
+            raise ValueError(
+                f"measurements: the table has no column {', '.join(sorted(missing))} "
+                "(the columns: name, x, y, u and optionally sigma)"
+            )
+        sensors = []
+        for k, name in enumerate(table["name"]):
+            s: Dict[str, Any] = {
+                "name": str(name),
+                "at": [table["x"][k], table["y"][k]],
+                "measured": table["u"][k],
+            }
+            if "sigma" in table:
+                s["sigma"] = table["sigma"][k]
+            sensors.append(s)
+        return {"sensor": sensors}
+    if isinstance(measurements, Mapping):
+        sensors = [dict(s) for s in data.get("sensor", [])]
+        known = {s.get("name") for s in sensors}
+        unknown = [str(n) for n in measurements if n not in known]
+        if unknown:
+            raise ValueError(
+                f"measurements: {', '.join(unknown)} is not a sensor of the case (its "
+                f"sensors: {', '.join(sorted(str(n) for n in known if n)) or 'none'})"
+            )
+        for s in sensors:
+            if s.get("name") in measurements:
+                v = measurements[s["name"]]
+                s["measured"] = v.item() if isinstance(v, np.generic) else v
+        return {"sensor": sensors}
+    raise TypeError(
+        "measurements: give a CSV file's path, a dict sensor name -> deflection, or a "
+        f"table with the columns name, x, y, u, not {type(measurements).__name__}"
+    )
+
+
+def _case_with(
+    case: Optional[CaseLike], mesh: Optional[Mesh], extra: Callable[[Dict[str, Any]], None]
+) -> Case:
+    """``case`` (a Case, dict or path; with ``mesh``, a case without ``[mesh]``) with its
+    dict changed by ``extra``, as a :class:`Case`."""
+    if mesh is None:
+        if case is None:
+            raise TypeError("a case is needed (a Case, a dict or a case file's path)")
+        if isinstance(case, Case):
+            data, label = _sections_of(case.to_dict()), case.label
+        elif isinstance(case, Mapping):
+            data, label = _sections_of(case), "case"
+        else:
+            c = load_case(case)  # type: ignore[arg-type]
+            data, label = _sections_of(c.to_dict()), c.label
+        extra(data)
+        _refuse_functions(data)
+        return Case(data, label)
+    if not isinstance(mesh, Mesh):
+        raise TypeError(f"mesh: give a memcontact.Mesh, got {type(mesh).__name__}")
+    data, label, replaced = _case_data(case)
+    if "mesh" in data and not replaced:
+        raise ValueError(
+            "mesh: the case has a [mesh] section and mesh= gives a mesh: leave one out"
+        )
+    extra(data)
+    return _native.case_on(mesh, _bind(data, mesh), label)
+
+
+def _names(value: Any, what: str) -> List[str]:
+    if isinstance(value, str):
+        return [value]
+    if not isinstance(value, Iterable):
+        raise TypeError(f"{what}: give a list of names, not {type(value).__name__}")
+    return [str(v) for v in value]
+
+
+def sensitivities(
+    case: Optional[CaseLike] = None,
+    *,
+    outputs: Optional[Sequence[str]] = None,
+    parameters: Optional[Sequence[str]] = None,
+    sensors: Optional[Any] = None,
+    mesh: Optional[Mesh] = None,
+    influence: bool = True,
+) -> Sensitivities:
+    """Solves a case and differentiates its outputs in its parameters exactly through the
+    contact, as ``memcontact solve`` does for a case with ``[sensitivity]``
+    (docs/sensitivities.md).
+
+    Parameters
+    ----------
+    case : Case, dict or path
+        The case (with ``mesh``, a case without ``[mesh]``). Its ``[sensitivity]`` section,
+        if any, gives the outputs and parameters not given here.
+    outputs : list of str, optional
+        ``energy``, ``max_deflection``, ``total_contact_force``,
+        ``total_contact_force_low``, ``contact_area``, ``sensors`` (every sensor),
+        ``sensor:NAME``, ``contact_force:REGION``.
+    parameters : list of str, optional
+        Case keys holding a number (``membrane.tension``, ``obstacle.stiffness``, a region's
+        ``obstacle.stiffness.soft``, ``lower.stiffness.clay``, ...), or ``membrane.load``,
+        ``obstacle.shape``, ``lower.shape`` given as expressions (then a factor on the load,
+        an offset of the surface).
+    sensors : dict or list, optional
+        Sensors added to the case's: ``{"S1": (x, y), ...}`` or a list of dicts with
+        ``name`` and ``at`` (and ``measured``, ``sigma``).
+    mesh : Mesh, optional
+        The mesh to solve on (as :func:`solve`).
+    influence : bool
+        Also compute the influence maps (dQ/dh per vertex).
+
+    Returns
+    -------
+    Sensitivities
+        ``outputs``, ``parameters``, ``values`` (one per output), ``jacobian`` (outputs ×
+        parameters), ``elasticity``, the one-sided derivatives and ``nonsmooth`` where
+        biactive vertices make the map only directionally differentiable, ``influence``
+        (arrays over the vertices), ``result`` (the solve), ``rows`` and ``to_pandas()``
+        (the rows of ``sensitivity.csv``), ``write(dir)``.
+
+    Raises
+    ------
+    ValueError
+        An unknown output or parameter (the message lists the valid ones), a sensor
+        outside the mesh, bad data.
+    SolverError
+        The solve was not accepted (no derivatives of an uncertified answer).
+
+    Examples
+    --------
+    >>> s = mc.sensitivities(mc.load_case("examples/disk.toml", {"mesh.size": 0.2}),
+    ...                      outputs=["energy"], parameters=["obstacle.stiffness"])
+    >>> s.jacobian.shape
+    (1, 1)
+    """
+
+    def extra(data: Dict[str, Any]) -> None:
+        if sensors is not None:
+            data["sensor"] = list(data.get("sensor", [])) + _sensor_entries(sensors)
+
+    c = _case_with(case, mesh, extra)
+    out = None if outputs is None else _names(outputs, "outputs")
+    par = None if parameters is None else _names(parameters, "parameters")
+    s, result = _native.sensitivities(c, out, par, bool(influence))
+    _check(result)
+    if s is None:  # pragma: no cover - an accepted solve has its derivatives
+        raise SolverError("no derivatives were computed", result)
+    return s
+
+
+def _fit_case(
+    case: Optional[CaseLike],
+    measurements: Any,
+    parameters: Optional[Mapping[str, Sequence[float]]],
+    sensors: Any,
+    mesh: Optional[Mesh],
+    options: Dict[str, Any],
+) -> Case:
+    def extra(data: Dict[str, Any]) -> None:
+        if sensors is not None:
+            data["sensor"] = list(data.get("sensor", [])) + _sensor_entries(sensors)
+        section = dict(data.get("fit", {}))
+        if parameters is not None:
+            if not isinstance(parameters, Mapping):
+                raise TypeError(
+                    "parameters: give a dict case key -> (min, max), not "
+                    f"{type(parameters).__name__}"
+                )
+            section["parameters"] = {
+                str(k): np.asarray(v, dtype=float).tolist() for k, v in parameters.items()
+            }
+        if measurements is not None:
+            found = _measurement_entries(measurements, data)
+            if "measurements" in found:
+                section["measurements"] = found["measurements"]
+            else:
+                section.pop("measurements", None)
+                data["sensor"] = found["sensor"]
+        for key, value in options.items():
+            if value is not None:
+                section[key] = value
+        data["fit"] = section
+
+    return _case_with(case, mesh, extra)
+
+
+def fit(
+    case: Optional[CaseLike] = None,
+    measurements: Any = None,
+    parameters: Optional[Mapping[str, Sequence[float]]] = None,
+    *,
+    sensors: Any = None,
+    mesh: Optional[Mesh] = None,
+    max_iterations: Optional[int] = None,
+    tolerance: Optional[float] = None,
+    prior: Optional[float] = None,
+    check: bool = True,
+) -> Fit:
+    """Fits case parameters (soil stiffnesses, ...) to measured deflections: bounded
+    Levenberg-Marquardt in the logarithm of positive parameters with the exact Jacobian, as
+    ``memcontact solve`` does for a case with ``[fit]`` (docs/sensitivities.md).
+
+    Parameters
+    ----------
+    case : Case, dict or path
+        The case; its values of the fitted keys are the start. Its ``[fit]`` section, if
+        any, gives what is not given here.
+    measurements : path, dict or table, optional
+        A CSV file (``name,x,y,u`` and optionally ``sigma``), a dict ``sensor name ->
+        measured deflection`` for the case's sensors, or a table (dict of columns or
+        ``pandas.DataFrame``) with the columns ``name, x, y, u`` (and ``sigma``). Without
+        it, the sensors' ``measured`` values.
+    parameters : dict, optional
+        Case key -> ``(min, max)`` bounds.
+    sensors : dict or list, optional
+        Sensors added to the case's (as :func:`sensitivities`).
+    mesh : Mesh, optional
+        The mesh to solve on (as :func:`solve`).
+    max_iterations, tolerance, prior : optional
+        The ``[fit]`` options (``prior``: the weight of a pull toward the start).
+    check : bool
+        Raise :class:`SolverError` when the fit does not converge (default; its ``fit``
+        attribute holds the best iterate); ``False`` returns it.
+
+    Returns
+    -------
+    Fit
+        ``parameters`` (key -> fitted value), ``std_errors``, ``correlation``,
+        ``singular_values``, ``rms``, ``iterations``, ``converged``, ``stop``, ``warning``
+        (the parameters cannot be told apart by the measurements), ``measurements``,
+        ``rows``/``to_pandas()`` (the rows of ``fit.csv``), ``result`` (the solve at the
+        fitted values), ``case`` (the case with them), ``write(dir)``.
+
+    Raises
+    ------
+    ValueError
+        Unknown keys, bounds that exclude the start, sensors outside the mesh, NaN or
+        negative sigma, fewer measurements than parameters without a prior.
+    SolverError
+        The start's solve was not accepted, or (with ``check``) the fit did not converge.
+    """
+    c = _fit_case(
+        case,
+        measurements,
+        parameters,
+        sensors,
+        mesh,
+        {"max_iterations": max_iterations, "tolerance": tolerance, "prior": prior},
+    )
+    f = _native.fit(c)
+    if check and not f.converged:
+        err = SolverError(
+            f"the fit did not converge (stop: {f.stop}, rms {f.rms:.3e} after "
+            f"{f.iterations} iterations); .fit holds its best iterate",
+            f.result,
+        )
+        err.fit = f
+        raise err
+    if f.warning:
+        warnings.warn(f.warning, stacklevel=2)
+    return f
+
+
+def fit_problem(
+    case: Optional[CaseLike] = None,
+    measurements: Any = None,
+    parameters: Optional[Mapping[str, Sequence[float]]] = None,
+    *,
+    sensors: Any = None,
+    mesh: Optional[Mesh] = None,
+) -> FitProblem:
+    """The model of a fit for an optimiser of one's own: residuals and their exact
+    Jacobian in the parameters, for ``scipy.optimize.least_squares`` (arguments as
+    :func:`fit`).
+
+    Returns
+    -------
+    FitProblem
+        ``names``, ``x0`` (the case's values), ``bounds`` (``(lower, upper)``),
+        ``residuals(p)``, ``jacobian(p)``, ``residuals_and_jacobian(p)`` (one warm-started
+        solve per new p), ``solves``.
+
+    Examples
+    --------
+    >>> from scipy.optimize import least_squares
+    >>> problem = mc.fit_problem(case)                                 # doctest: +SKIP
+    >>> least_squares(problem.residuals, problem.x0, jac=problem.jacobian,
+    ...               bounds=problem.bounds)                           # doctest: +SKIP
+    """
+    c = _fit_case(case, measurements, parameters, sensors, mesh, {})
+    return _native.fit_problem(c)

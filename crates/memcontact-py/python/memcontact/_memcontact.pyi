@@ -12,8 +12,11 @@ __version__: str
 __all__ = [
     "Adapt",
     "Case",
+    "Fit",
+    "FitProblem",
     "Mesh",
     "Result",
+    "Sensitivities",
     "Study",
     "Sweep",
     "__version__",
@@ -23,11 +26,15 @@ __all__ = [
     "_toml_value",
     "adapt",
     "adapt_on",
+    "case_on",
     "convergence",
     "disk",
+    "fit",
+    "fit_problem",
     "polygon",
     "read_gmsh",
     "rectangle",
+    "sensitivities",
     "solve",
     "solve_on",
     "sweep",
@@ -920,3 +927,241 @@ def _mesh_from_state(state: Dict[str, Any]) -> Mesh: ...
 def _result_from_state(state: Dict[str, Any]) -> Result: ...
 def _toml_value(value: Any) -> str: ...
 def _case_table(path: Union[str, PathLike[str]]) -> Dict[str, Any]: ...
+
+@final
+class Sensitivities:
+    """The derivatives of a case's outputs in its parameters (docs/sensitivities.md)."""
+
+    @property
+    def outputs(self) -> List[str]:
+        """The outputs' names, the rows of ``jacobian``."""
+        ...
+    @property
+    def parameters(self) -> List[str]:
+        """The parameters' case keys, the columns of ``jacobian``."""
+        ...
+    @property
+    def kinds(self) -> List[str]:
+        """``value``, ``factor`` or ``offset`` for each parameter."""
+        ...
+    @property
+    def parameter_values(self) -> npt.NDArray[np.float64]:
+        """The parameters' values in the case (1 for a factor, 0 for an offset)."""
+        ...
+    @property
+    def values(self) -> npt.NDArray[np.float64]:
+        """The outputs' values."""
+        ...
+    @property
+    def jacobian(self) -> npt.NDArray[np.float64]:
+        """dQ/dp, outputs × parameters."""
+        ...
+    @property
+    def derivative_plus(self) -> npt.NDArray[np.float64]:
+        """The derivative in the direction +δp, outputs × parameters."""
+        ...
+    @property
+    def derivative_minus(self) -> npt.NDArray[np.float64]:
+        """Minus the derivative in the direction −δp, outputs × parameters."""
+        ...
+    @property
+    def nonsmooth(self) -> npt.NDArray[np.bool_]:
+        """Where the one-sided derivatives differ, outputs × parameters."""
+        ...
+    @property
+    def elasticity(self) -> npt.NDArray[np.float64]:
+        """(p/Q) dQ/dp, outputs × parameters (NaN for an offset, p = 0 or Q = 0)."""
+        ...
+    @property
+    def influence(self) -> Dict[str, npt.NDArray[np.float64]]:
+        """The influence maps over the vertices (``dJ_dh``, ``dsensor_NAME_dh``, ...)."""
+        ...
+    @property
+    def biactive(self) -> int:
+        """The number of biactive vertices."""
+        ...
+    @property
+    def biactive_vertices(self) -> List[int]:
+        """The biactive vertices."""
+        ...
+    @property
+    def mode(self) -> str:
+        """``adjoint``, ``tangent`` or ``one_sided``."""
+        ...
+    @property
+    def solves(self) -> List[Dict[str, Any]]:
+        """Every linear solve (what, solver, iterations, residual, seconds)."""
+        ...
+    @property
+    def result(self) -> Result:
+        """The solve the derivatives were taken at."""
+        ...
+    @property
+    def columns(self) -> List[str]:
+        """The columns of ``rows``."""
+        ...
+    @property
+    def rows(self) -> List[Dict[str, Any]]:
+        """The rows of ``sensitivity.csv``, one per output and parameter."""
+        ...
+    def write(
+        self,
+        directory: Union[str, PathLike[str]],
+        force: bool = False,
+        vtu: Optional[_VtuEncoding] = None,
+        pictures: bool = True,
+    ) -> Dict[str, Any]:
+        """Writes the command-line tool's result set (with ``sensitivity.csv`` and the
+        influence maps), atomically; returns the summary."""
+        ...
+    def to_pandas(self) -> Any:
+        """The rows as a DataFrame."""
+        ...
+
+@final
+class Fit:
+    """A fit of case parameters to measured deflections (``fit.json``)."""
+
+    @property
+    def names(self) -> List[str]:
+        """The fitted case keys, in order."""
+        ...
+    @property
+    def parameters(self) -> Dict[str, float]:
+        """Key -> fitted value."""
+        ...
+    @property
+    def values(self) -> npt.NDArray[np.float64]:
+        """The fitted values, in the order of ``names``."""
+        ...
+    @property
+    def start(self) -> npt.NDArray[np.float64]:
+        """The start values."""
+        ...
+    @property
+    def std_errors(self) -> npt.NDArray[np.float64]:
+        """The standard errors."""
+        ...
+    @property
+    def correlation(self) -> npt.NDArray[np.float64]:
+        """The correlation matrix."""
+        ...
+    @property
+    def singular_values(self) -> npt.NDArray[np.float64]:
+        """The singular values of the scaled Jacobian."""
+        ...
+    @property
+    def bounds(self) -> npt.NDArray[np.float64]:
+        """One ``[min, max]`` row per parameter."""
+        ...
+    @property
+    def condition_number(self) -> float:
+        """The condition number of the scaled Jacobian."""
+        ...
+    @property
+    def rms(self) -> float:
+        """The root-mean-square of the weighted residuals."""
+        ...
+    @property
+    def iterations(self) -> int:
+        """Accepted iterations."""
+        ...
+    @property
+    def solves(self) -> int:
+        """Forward solves, trial steps included."""
+        ...
+    @property
+    def converged(self) -> bool:
+        """Whether the fit converged."""
+        ...
+    @property
+    def stop(self) -> str:
+        """Why it stopped."""
+        ...
+    @property
+    def warning(self) -> Optional[str]:
+        """The identifiability warning (None when the parameters are identifiable)."""
+        ...
+    @property
+    def measurements(self) -> List[Dict[str, Any]]:
+        """The measurements and the deflections computed there."""
+        ...
+    @property
+    def summary(self) -> Dict[str, Any]:
+        """Everything of the fit as a dict."""
+        ...
+    @property
+    def result(self) -> Result:
+        """The solve at the fitted (or best) parameters."""
+        ...
+    @property
+    def case(self) -> Case:
+        """The case with the fitted values."""
+        ...
+    @property
+    def columns(self) -> List[str]:
+        """The columns of ``rows`` (those of ``fit.csv``)."""
+        ...
+    @property
+    def rows(self) -> List[Dict[str, Any]]:
+        """The accepted iterates, as the rows of ``fit.csv``."""
+        ...
+    def write(
+        self,
+        directory: Union[str, PathLike[str]],
+        force: bool = False,
+        vtu: Optional[_VtuEncoding] = None,
+        pictures: bool = True,
+    ) -> Dict[str, Any]:
+        """Writes the command-line tool's result set (with ``fit.json``, ``fit.csv`` and
+        ``fit.png``), atomically; returns the summary."""
+        ...
+    def to_pandas(self) -> Any:
+        """The iterates as a DataFrame."""
+        ...
+
+@final
+class FitProblem:
+    """A fit's model: residuals and their exact Jacobian, for an optimiser of one's own."""
+
+    @property
+    def names(self) -> List[str]:
+        """The fitted case keys, in order."""
+        ...
+    @property
+    def x0(self) -> npt.NDArray[np.float64]:
+        """The start (the case's values)."""
+        ...
+    @property
+    def bounds(self) -> Tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]:
+        """``(lower, upper)``."""
+        ...
+    @property
+    def measurements(self) -> List[str]:
+        """The measured sensors' names (the rows of the residuals)."""
+        ...
+    @property
+    def solves(self) -> int:
+        """Forward solves so far."""
+        ...
+    def residuals(self, p: Sequence[float]) -> npt.NDArray[np.float64]:
+        """The weighted residuals (Q(p) − m)/σ."""
+        ...
+    def jacobian(self, p: Sequence[float]) -> npt.NDArray[np.float64]:
+        """Their Jacobian in p, measurements × parameters."""
+        ...
+    def residuals_and_jacobian(
+        self, p: Sequence[float]
+    ) -> Tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]:
+        """Both at once."""
+        ...
+
+def sensitivities(
+    case: Case,
+    outputs: Optional[Sequence[str]] = None,
+    parameters: Optional[Sequence[str]] = None,
+    influence: bool = True,
+) -> Tuple[Optional[Sensitivities], Result]: ...
+def fit(case: Case) -> Fit: ...
+def fit_problem(case: Case) -> FitProblem: ...
+def case_on(mesh: Mesh, data: Mapping[str, Any], label: Optional[str] = None) -> Case: ...
