@@ -126,7 +126,7 @@ def test_equal_to_the_command_line_tool(cli, tmp_path):
 
 def measured(soft, stiff, names):
     u, _ = deflections(site(soft, stiff), names)
-    return dict(zip(names, u))
+    return {n: float(v) for n, v in zip(names, u)}
 
 
 def test_fit_recovers_the_stiffnesses_and_scipy_agrees(cli, tmp_path):
