@@ -461,7 +461,10 @@ impl PyFit {
     #[getter]
     fn std_errors<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
         self.cache.get(py, 2, || {
-            owned1(py, self.fit.parameters.iter().map(|p| p.std_error).collect())
+            owned1(
+                py,
+                self.fit.parameters.iter().map(|p| p.std_error).collect(),
+            )
         })
     }
 
@@ -488,11 +491,7 @@ impl PyFit {
         self.cache.get(py, 5, || {
             owned2(
                 py,
-                self.fit
-                    .parameters
-                    .iter()
-                    .flat_map(|p| p.bounds)
-                    .collect(),
+                self.fit.parameters.iter().flat_map(|p| p.bounds).collect(),
                 2,
             )
         })
@@ -669,8 +668,8 @@ pub struct PyFitProblem {
 pub fn fit_problem(py: Python<'_>, case: PyRef<'_, PyCase>) -> PyResult<PyFitProblem> {
     let c = case.case.clone();
     drop(case);
-    let problem = crate::convert::detached(py, || FitProblem::new(&c, &mut Silent))
-        .map_err(py_err)?;
+    let problem =
+        crate::convert::detached(py, || FitProblem::new(&c, &mut Silent)).map_err(py_err)?;
     Ok(PyFitProblem {
         names: problem.parameter_names(),
         start: problem.start(),
