@@ -4,7 +4,7 @@
 #![no_main]
 
 use libfuzzer_sys::fuzz_target;
-use memcontact::field::expr::Expr;
+use memcontact::field::Expr;
 
 fuzz_target!(|data: &[u8]| {
     // The first 16 bytes pick the point; the rest is the expression.
