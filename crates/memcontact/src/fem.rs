@@ -277,6 +277,68 @@ pub fn assemble_stiffness_and_mass(
     t: f64,
     h: Option<&dyn Coefficient>,
 ) -> (Csr, Option<Csr>) {
+    let (s, l) = assemble_rows(mesh, dofs, adj, pattern, Some(t), h);
+    (s.expect("the stiffness matrix was asked for"), l)
+}
+
+/// The consistent foundation matrix `L_ij = ∫ h g_i g_j` alone on `pattern`, by the
+/// element integrals of [`assemble_stiffness_and_mass`]; the triangles of regions where h
+/// is 0 are not visited (a region's derivative coefficient is 0 outside it).
+pub fn assemble_mass(
+    mesh: &Mesh,
+    dofs: &DofMap,
+    adj: &VertexTriangles,
+    pattern: &Arc<Pattern>,
+    h: &dyn Coefficient,
+) -> Csr {
+    assemble_rows(mesh, dofs, adj, pattern, None, Some(h))
+        .1
+        .expect("the mass matrix was asked for")
+}
+
+/// `xᵀ L x` for the consistent foundation matrix `L_ij = ∫ h g_i g_j` of `h` over the
+/// unknowns (x indexed by unknowns), by its element matrices, without assembling L: the
+/// triangles of regions where h is 0 are skipped. Sums in fixed blocks of triangles, so
+/// that the result does not depend on the thread count.
+pub fn mass_quad_form(mesh: &Mesh, dofs: &DofMap, h: &dyn Coefficient, x: &[f64]) -> f64 {
+    const BLOCK: usize = 8192;
+    let nt = mesh.n_triangles();
+    let blocks: Vec<f64> = (0..nt.div_ceil(BLOCK))
+        .into_par_iter()
+        .map(|b| {
+            let mut sum = 0.0;
+            for k in b * BLOCK..((b + 1) * BLOCK).min(nt) {
+                let region = mesh.regions[k];
+                if h.on_region(region) == Some(0.0) {
+                    continue;
+                }
+                let xs =
+                    mesh.triangles[k].map(|w| dofs.of(w as usize).map_or(0.0, |i| x[i as usize]));
+                if xs == [0.0; 3] {
+                    continue;
+                }
+                let m = Element::of(mesh, k).weighted_mass_matrix(h, region);
+                for a in 0..3 {
+                    for c in 0..3 {
+                        sum += m[sym_index(a, c)] * xs[a] * xs[c];
+                    }
+                }
+            }
+            sum
+        })
+        .collect();
+    blocks.iter().sum()
+}
+
+/// [`assemble_stiffness_and_mass`], S assembled when `t` is given and L when `h` is.
+fn assemble_rows(
+    mesh: &Mesh,
+    dofs: &DofMap,
+    adj: &VertexTriangles,
+    pattern: &Arc<Pattern>,
+    t: Option<f64>,
+    h: Option<&dyn Coefficient>,
+) -> (Option<Csr>, Option<Csr>) {
     let n = pattern.n();
     // Where h varies on a triangle's region: its element matrix, computed once (every
     // corner's row reads it), with h evaluated once per quadrature point.
@@ -295,27 +357,26 @@ pub fn assemble_stiffness_and_mass(
             .collect(),
         _ => Vec::new(),
     };
-    let mut s = Csr::zeros(pattern.clone());
+    let mut s = t.map(|_| Csr::zeros(pattern.clone()));
     let mut l = h.map(|_| Csr::zeros(pattern.clone()));
-    let s_blocks = row_chunks(pattern, &mut s.val, ROW_BLOCK);
-    let l_blocks: Vec<Option<&mut [f64]>> = match &mut l {
-        Some(l) => row_chunks(pattern, &mut l.val, ROW_BLOCK)
-            .into_iter()
-            .map(|(_, block)| Some(block))
-            .collect(),
-        None => (0..s_blocks.len()).map(|_| None).collect(),
-    };
-    s_blocks
-        .into_par_iter()
-        .zip(l_blocks)
-        .for_each(|((first, s_block), mut l_block)| {
-            let rows = first..(first + ROW_BLOCK).min(n);
+    let (s_blocks, l_blocks) = (
+        optional_row_chunks(pattern, s.as_mut(), n),
+        optional_row_chunks(pattern, l.as_mut(), n),
+    );
+    s_blocks.into_par_iter().zip(l_blocks).enumerate().for_each(
+        |(b, (mut s_block, mut l_block))| {
+            let rows = block_rows(n, b);
             let base = pattern.ptr(rows.start);
             for i in rows {
                 let range = pattern.ptr(i) - base..pattern.ptr(i + 1) - base;
                 let cols = &pattern.col[pattern.ptr(i)..pattern.ptr(i + 1)];
                 let v = dofs.vertex[i];
                 for &k in adj.of(v as usize) {
+                    let region = mesh.regions[k as usize];
+                    let h_const = h.and_then(|h| h.on_region(region));
+                    if s_block.is_none() && h_const == Some(0.0) {
+                        continue;
+                    }
                     let tri = mesh.triangles[k as usize];
                     let a = corner(tri, v);
                     let c = tri.map(|w| mesh.points[w as usize]);
@@ -329,16 +390,16 @@ pub fn assemble_stiffness_and_mass(
                     let two_area = e[2][0] * (-e[1][1]) + e[2][1] * e[1][0];
                     let inv = 1.0 / two_area;
                     let e = e.map(|q| [q[0] * inv, q[1] * inv]);
-                    let scale = t * 0.5 * two_area;
-                    let region = mesh.regions[k as usize];
-                    let h_const = h.and_then(|h| h.on_region(region));
+                    let scale = t.unwrap_or(0.0) * 0.5 * two_area;
                     for (b, &w) in tri.iter().enumerate() {
                         let Some(j) = dofs.of(w as usize) else {
                             continue;
                         };
                         let pos = position(cols, j);
-                        s_block[range.start + pos] +=
-                            scale * (e[a][0] * e[b][0] + e[a][1] * e[b][1]);
+                        if let Some(sb) = s_block.as_deref_mut() {
+                            sb[range.start + pos] +=
+                                scale * (e[a][0] * e[b][0] + e[a][1] * e[b][1]);
+                        }
                         if let Some(lb) = l_block.as_deref_mut() {
                             lb[range.start + pos] += match h_const {
                                 Some(hc) => hc * 0.5 * two_area * mass_fraction(a, b),
@@ -348,8 +409,25 @@ pub fn assemble_stiffness_and_mass(
                     }
                 }
             }
-        });
+        },
+    );
     (s, l)
+}
+
+/// The blocks of [`ROW_BLOCK`] rows of `m`'s values, or as many `None` when there is no
+/// matrix.
+fn optional_row_chunks<'a>(
+    pattern: &Pattern,
+    m: Option<&'a mut Csr>,
+    n: usize,
+) -> Vec<Option<&'a mut [f64]>> {
+    match m {
+        Some(m) => row_chunks(pattern, &mut m.val, ROW_BLOCK)
+            .into_iter()
+            .map(|(_, block)| Some(block))
+            .collect(),
+        None => (0..n.div_ceil(ROW_BLOCK)).map(|_| None).collect(),
+    }
 }
 
 /// `∫_T c λ_a` for the corners a = 0, 1, 2 of triangle `k`: `|T| c / 3` where c is constant
@@ -808,6 +886,41 @@ mod tests {
                 let c = e.weighted_mass(&2.5, 0, a, b);
                 assert!((q - c).abs() < 1e-14);
             }
+        }
+    }
+
+    #[test]
+    fn mass_quad_form_is_the_assembled_matrix_quadratic_form() {
+        // 0 on the triangles left of x = 0 (skipped), varying on the others.
+        struct RightOnly;
+        impl Coefficient for RightOnly {
+            fn at(&self, p: Point, region: u32) -> f64 {
+                if region == 2 {
+                    0.0
+                } else {
+                    1.0 + p[0] * p[0] + 0.5 * p[1]
+                }
+            }
+            fn on_region(&self, region: u32) -> Option<f64> {
+                (region == 2).then_some(0.0)
+            }
+        }
+        let mut m = crate::mesh::generate::disk([0.0, 0.0], 1.0, 0.1).unwrap();
+        m.regions = (0..m.n_triangles())
+            .map(|k| if m.corners(k)[0][0] < 0.0 { 2 } else { 0 })
+            .collect();
+        let adj = VertexTriangles::new(&m);
+        let dofs = DofMap::new(&m);
+        let pat = Arc::new(unknowns_pattern(&m, &dofs, &adj, &m.boundary_vertices()).unwrap());
+        let x: Vec<f64> = (0..dofs.len())
+            .map(|i| (0.37 * i as f64).sin() + 0.2)
+            .collect();
+        for c in [&RightOnly as &dyn Coefficient, &3.5] {
+            let l = assemble_mass(&m, &dofs, &adj, &pat, c);
+            let (_, with_s) = assemble_stiffness_and_mass(&m, &dofs, &adj, &pat, 1.0, Some(c));
+            assert_eq!(l.val, with_s.unwrap().val, "L alone is L assembled with S");
+            let (a, b) = (l.quad_form(&x), mass_quad_form(&m, &dofs, c, &x));
+            assert!(a > 0.0 && (a - b).abs() <= 1e-13 * a, "{a} against {b}");
         }
     }
 

@@ -10,7 +10,9 @@ use super::sampling::{mollify, paper_epsilon, vertex_average};
 use super::system::Model;
 use crate::error::{Error, Result};
 use crate::fem::assemble_lift;
-use crate::fem::{assemble_stiffness_and_mass, unknowns_pattern, Loads, VertexTriangles};
+use crate::fem::{
+    assemble_mass, assemble_stiffness_and_mass, unknowns_pattern, Loads, VertexTriangles,
+};
 use crate::field::Coefficient;
 use crate::mesh::boundary::FixedBoundary;
 use crate::mesh::{DofMap, Mesh};
@@ -352,19 +354,6 @@ pub(super) fn assemble_body(
         h_vertices,
         epsilon,
     })
-}
-
-/// The consistent mass matrix `∫ h gᵢ gⱼ` alone, on the pattern of S.
-pub(super) fn assemble_mass(
-    mesh: &Mesh,
-    dofs: &DofMap,
-    adj: &VertexTriangles,
-    pattern: &Arc<crate::sparse::Pattern>,
-    h: &dyn Coefficient,
-) -> Csr {
-    assemble_stiffness_and_mass(mesh, dofs, adj, pattern, 0.0, Some(h))
-        .1
-        .expect("a mass matrix was asked for")
 }
 
 /// `n` copies of `v`, written on all threads.

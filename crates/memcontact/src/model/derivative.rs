@@ -7,36 +7,87 @@
 //! same sampling of φ and its mollifier radius, same averaging of boundary heights, the
 //! rigid regions masked as in the solve).
 
-use super::assemble::{assemble_mass, Masked};
+use super::assemble::Masked;
 use super::body::FoundationMatrix;
 use super::data::{BodyData, BodyStiffness, Foundation, Sampling};
 use super::sampling::{mollify, vertex_average};
 use crate::error::Result;
-use crate::fem::{assemble_lift, Loads, VertexTriangles};
+use crate::fem::{assemble_lift, assemble_mass, mass_quad_form, Loads, VertexTriangles};
 use crate::field::Coefficient;
 use crate::mesh::boundary::FixedBoundary;
 use crate::mesh::{DofMap, Mesh};
 use crate::sparse::Pattern;
-use std::sync::Arc;
+use std::sync::{Arc, OnceLock};
 
-/// The mesh and numbering the derivative data are assembled on (those of the model).
+/// `xᵀ dL x` for the consistent foundation matrix dL of the derivative coefficient `c` of a
+/// body's stiffness (its rigid regions masked), from the element matrices: the energy's
+/// derivative `½ p̂ᵀ dL p̂` (docs/theory.md#envelope) needs no assembled dL.
+pub fn consistent_foundation_form(
+    mesh: &Mesh,
+    dofs: &DofMap,
+    c: &dyn Coefficient,
+    rigid_regions: &[u32],
+    x: &[f64],
+) -> f64 {
+    let body = BodyData {
+        shape: &0.0,
+        stiffness: BodyStiffness::Elastic(c),
+        rigid_regions,
+        foundation: Foundation::Consistent,
+        sampling: Sampling::Nodal,
+    };
+    let masked = Masked::new(body);
+    mass_quad_form(
+        mesh,
+        dofs,
+        masked.elastic().expect("an elastic coefficient"),
+        x,
+    )
+}
+
+/// The mesh and numbering the derivative data are assembled on (those of the model), with
+/// the vertex → triangles adjacency and the triangles' areas built on first use and shared
+/// by every parameter's assembly.
 pub struct DerivativeAssembly<'a> {
     /// The solved mesh (the solver's numbering).
     pub mesh: &'a Mesh,
-    /// Its vertex → triangles adjacency.
-    pub adj: &'a VertexTriangles,
     /// The model's unknowns.
     pub dofs: &'a DofMap,
     /// The pattern of S (and of a consistent L).
     pub pattern: &'a Arc<Pattern>,
+    /// The vertex → triangles adjacency.
+    adjacency: OnceLock<VertexTriangles>,
+    /// The triangles' areas ([`Mesh::areas`]).
+    triangle_areas: OnceLock<Vec<f64>>,
 }
 
-impl DerivativeAssembly<'_> {
+impl<'a> DerivativeAssembly<'a> {
+    /// The assembly on `mesh` with the unknowns `dofs` and the pattern of S.
+    pub fn new(mesh: &'a Mesh, dofs: &'a DofMap, pattern: &'a Arc<Pattern>) -> Self {
+        DerivativeAssembly {
+            mesh,
+            dofs,
+            pattern,
+            adjacency: OnceLock::new(),
+            triangle_areas: OnceLock::new(),
+        }
+    }
+
+    /// The vertex → triangles adjacency (built on the first call).
+    fn adj(&self) -> &VertexTriangles {
+        self.adjacency
+            .get_or_init(|| VertexTriangles::new(self.mesh))
+    }
+
+    /// The triangles' areas (computed on the first call).
+    fn areas(&self) -> &[f64] {
+        self.triangle_areas.get_or_init(|| self.mesh.areas())
+    }
+
     /// `∫ c gᵢ` over the unknowns and `∫_Ω c`: the derivative of D and of the total load in
     /// a datum of f whose derivative coefficient is `c`.
     pub fn load(&self, c: &dyn Coefficient) -> (Vec<f64>, f64) {
-        let areas = self.mesh.areas();
-        Loads::new(self.mesh, self.dofs, self.adj, &areas).vector_and_integral(c)
+        Loads::new(self.mesh, self.dofs, self.adj(), self.areas()).vector_and_integral(c)
     }
 
     /// The foundation matrix of the derivative coefficient `c` of a body's stiffness, with
@@ -61,16 +112,13 @@ impl DerivativeAssembly<'_> {
             Foundation::Consistent => FoundationMatrix::Consistent(assemble_mass(
                 self.mesh,
                 self.dofs,
-                self.adj,
+                self.adj(),
                 self.pattern,
                 h,
             )),
-            Foundation::Lumped => {
-                let areas = self.mesh.areas();
-                FoundationMatrix::Lumped(
-                    Loads::new(self.mesh, self.dofs, self.adj, &areas).vector(h),
-                )
-            }
+            Foundation::Lumped => FoundationMatrix::Lumped(
+                Loads::new(self.mesh, self.dofs, self.adj(), self.areas()).vector(h),
+            ),
         }
     }
 
@@ -88,7 +136,7 @@ impl DerivativeAssembly<'_> {
         let masked = Masked::new(body);
         vertex_average(
             self.mesh,
-            self.adj,
+            self.adj(),
             masked.elastic().expect("an elastic coefficient"),
         )
     }
@@ -98,20 +146,20 @@ impl DerivativeAssembly<'_> {
     /// vertex.
     pub fn surface(&self, c: &dyn Coefficient, epsilon: Option<f64>) -> Vec<f64> {
         match epsilon {
-            None => vertex_average(self.mesh, self.adj, c),
-            Some(eps) => mollify(self.mesh, self.adj, c, eps),
+            None => vertex_average(self.mesh, self.adj(), c),
+            Some(eps) => mollify(self.mesh, self.adj(), c, eps),
         }
     }
 
     /// The derivative coefficient `c` of the boundary heights, averaged at the fixed
     /// vertices as the model averages g (0 elsewhere), over all vertices.
     pub fn heights(&self, c: &dyn Coefficient, free: &[String]) -> Result<Vec<f64>> {
-        let fixed = FixedBoundary::new(self.mesh, self.adj, free)?;
+        let fixed = FixedBoundary::new(self.mesh, self.adj(), free)?;
         super::boundary::boundary_heights(self.mesh, &fixed, c)
     }
 
     /// The lifting `S_fix G` of heights `g` (over all vertices) for the tension `t`.
     pub fn lift(&self, t: f64, g: &[f64]) -> Vec<f64> {
-        assemble_lift(self.mesh, self.dofs, self.adj, t, g)
+        assemble_lift(self.mesh, self.dofs, self.adj(), t, g)
     }
 }

@@ -24,6 +24,6 @@ pub use checks::{
 pub use data::{
     BodyData, BodyStiffness, BoundaryData, Extensions, Foundation, ProblemData, Sampling,
 };
-pub(crate) use derivative::DerivativeAssembly;
+pub(crate) use derivative::{consistent_foundation_form, DerivativeAssembly};
 pub use sampling::paper_epsilon;
 pub use system::Model;

@@ -193,6 +193,9 @@ impl Prepared {
     ) -> Result<Prepared> {
         let bound = BoundData::new(problem, mesh)?;
         let mut parameters = Vec::with_capacity(request.parameters.len());
+        // The energy alone (envelope derivatives, no maps) needs no assembled dL.
+        let for_solves = request.influence || request.outputs.iter().any(|o| o != "energy");
+        let asm = crate::model::DerivativeAssembly::new(mesh, &model.dofs, &model.s.pattern);
         for key in &request.parameters {
             let k = ParameterKey::parse(problem, key).map_err(|m| crate::error::Error::Case {
                 file: None,
@@ -200,7 +203,7 @@ impl Prepared {
                 key: "sensitivity.parameters".into(),
                 message: m,
             })?;
-            parameters.push(DataDerivative::new(problem, &k, mesh, model)?);
+            parameters.push(DataDerivative::new(problem, &k, &asm, model, for_solves)?);
         }
         let outputs = outputs::resolve(&request.outputs, sensors, mesh, model, &bound)?;
         let sensor_names = outputs

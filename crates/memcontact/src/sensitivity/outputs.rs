@@ -16,14 +16,14 @@
 //!   where the level set crosses triangles transversally. (The area in `summary.json` is
 //!   the nodal area of the vertices in contact, a step function of U.)
 
-use super::parameters::DataDerivative;
+use super::parameters::{BodyDerivative, DataDerivative};
 use super::states::{PieceStates, Side, States};
 use crate::case::Sensor;
 use crate::discretization::BoundData;
 use crate::error::{Error, Result};
 use crate::field::nodal::NodalP1;
 use crate::mesh::Mesh;
-use crate::model::{FoundationMatrix, Model};
+use crate::model::{Foundation, FoundationMatrix, Model};
 
 /// What an output is, resolved against the mesh.
 #[derive(Debug, Clone)]
@@ -486,21 +486,33 @@ impl At<'_> {
             };
             j -= 0.5 * k * m.s.quad_form(u);
         }
-        if let Some(dl) = &d.up.dl {
+        if d.up.stiffness.is_some() {
             let p = self.states.p_hat(m, u);
-            j += 0.5 * quad(dl, &p);
+            j += 0.5 * self.dl_form(&d.up, m.foundation, &p);
         }
         if let Some(dphi) = &d.up.dphi {
             j -= crate::sparse::dot(&self.forces.up, dphi);
         }
-        if let (Some(dl), Some(_)) = (&d.low.dl, &m.lower) {
+        if let (Some(_), Some(low)) = (&d.low.stiffness, &m.lower) {
             let q = self.states.q_hat(m, u);
-            j += 0.5 * quad(dl, &q);
+            j += 0.5 * self.dl_form(&d.low, low.foundation, &q);
         }
         if let (Some(dphi), false) = (&d.low.dphi, self.forces.low.is_empty()) {
             j += crate::sparse::dot(&self.forces.low, dphi);
         }
         j
+    }
+
+    /// `xᵀ dL x` for a body's derivative `b` on a body with `foundation`: from the element
+    /// matrices where it is consistent (dL need not be assembled), else from dL.
+    fn dl_form(&self, b: &BodyDerivative, foundation: Foundation, x: &[f64]) -> f64 {
+        match (&b.stiffness, foundation, &b.dl) {
+            (Some((c, rigid)), Foundation::Consistent, _) => {
+                crate::model::consistent_foundation_form(self.mesh, &self.model.dofs, c, rigid, x)
+            }
+            (_, _, Some(dl)) => quad(dl, x),
+            _ => 0.0,
+        }
     }
 
     /// `∂R/∂p` on the free unknowns of the piece `ps` (zero on the held ones), with

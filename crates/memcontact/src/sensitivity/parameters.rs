@@ -11,8 +11,7 @@
 use crate::case::{ParameterKey, ParameterKind, ParameterTarget};
 use crate::discretization::bind_height;
 use crate::error::{Error, Result};
-use crate::field::{Field, Stiffness};
-use crate::mesh::Mesh;
+use crate::field::{BoundField, Field, Stiffness};
 use crate::model::{DerivativeAssembly, Foundation, FoundationMatrix, Model, VertexValues};
 use crate::problem::{Obstacle, Problem};
 use std::collections::BTreeMap;
@@ -20,7 +19,12 @@ use std::collections::BTreeMap;
 /// The derivative of one body's data (the obstacle's, or the body below's).
 #[derive(Debug, Clone, Default)]
 pub struct BodyDerivative {
-    /// dL (consistent on the pattern of S, or the lumped diagonal).
+    /// The derivative coefficient of the stiffness and the body's rigid regions: the
+    /// energy's `½ p̂ᵀ dL p̂` from the element matrices
+    /// ([`crate::model::consistent_foundation_form`]).
+    pub stiffness: Option<(BoundField, Vec<u32>)>,
+    /// dL (consistent on the pattern of S, or the lumped diagonal). A consistent dL is
+    /// assembled only for data prepared for solves ([`DataDerivative::new`]).
     pub dl: Option<FoundationMatrix>,
     /// dh at every vertex (as the model keeps h for its outputs).
     pub dh_vertices: Option<Vec<f64>>,
@@ -109,21 +113,19 @@ fn stiffness_derivative(s: &Stiffness, key: &ParameterKey) -> Field {
 }
 
 impl DataDerivative {
-    /// The derivative data of `key` for `model`, assembled on `mesh` (the solved mesh, in
-    /// the solver's numbering) by the model's own kernels.
+    /// The derivative data of `key` for `model`, assembled by `asm` (on the solved mesh, in
+    /// the solver's numbering) with the model's own kernels. With `for_solves` false, only
+    /// what the energy's envelope derivative reads: a consistent dL and dh at the vertices
+    /// (for linear solves, other outputs and moved models) are left out, the costly part on
+    /// a large mesh.
     pub fn new(
         problem: &Problem,
         key: &ParameterKey,
-        mesh: &Mesh,
+        asm: &DerivativeAssembly,
         model: &Model,
+        for_solves: bool,
     ) -> Result<DataDerivative> {
-        let adj = crate::fem::VertexTriangles::new(mesh);
-        let asm = DerivativeAssembly {
-            mesh,
-            adj: &adj,
-            dofs: &model.dofs,
-            pattern: &model.s.pattern,
-        };
+        let mesh = asm.mesh;
         let mut d = DataDerivative {
             key: key.clone(),
             tension: false,
@@ -152,8 +154,13 @@ impl DataDerivative {
                     .bind_to_mesh(&format!("{section}.stiffness"), mesh)?;
                 let f = stiffness_derivative(&obstacle.stiffness, key);
                 let c = f.bind_to_mesh(&name(&format!("{section}.stiffness")), mesh)?;
-                b.dl = Some(asm.foundation(&c, &bound.rigid_tags, foundation));
-                b.dh_vertices = Some(asm.vertex_stiffness(&c, &bound.rigid_tags));
+                if for_solves || foundation == Foundation::Lumped {
+                    b.dl = Some(asm.foundation(&c, &bound.rigid_tags, foundation));
+                }
+                if for_solves {
+                    b.dh_vertices = Some(asm.vertex_stiffness(&c, &bound.rigid_tags));
+                }
+                b.stiffness = Some((c, bound.rigid_tags));
             }
             Ok(b)
         };
@@ -274,6 +281,10 @@ fn move_body(
     phi_fixed: &mut [(u32, f64)],
     h_vertices: &mut VertexValues,
 ) {
+    assert!(
+        d.stiffness.is_none() || (d.dl.is_some() && d.dh_vertices.is_some()),
+        "derivative data prepared for the energy alone cannot move a model"
+    );
     if let Some(dl) = &d.dl {
         match (l, dl) {
             (FoundationMatrix::Consistent(a), FoundationMatrix::Consistent(b)) => {

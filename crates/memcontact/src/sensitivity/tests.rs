@@ -276,9 +276,31 @@ fn envelope(foundation: &str) {
     };
     let grad: Vec<f64> = (0..n).map(|i| states.r[i] + lp[i] - lq[i]).collect();
     println!("{foundation}: parameter, dJ/dp (envelope), chain rule, relative difference");
-    for d in &s.prepared.parameters {
+    // Prepared for the energy alone (no maps): no consistent dL is assembled, the
+    // envelope reads the element matrices; the same derivatives.
+    let lean = Prepared::new(
+        &case.problem,
+        &case.sensors,
+        &Request {
+            influence: false,
+            ..req.clone()
+        },
+        s.discretization.mesh(),
+        model,
+    )
+    .unwrap();
+    for (d, e) in s.prepared.parameters.iter().zip(&lean.parameters) {
         let dr = at.dr(d);
         let env = at.envelope(d, &dr);
+        if foundation == "consistent" {
+            assert!(e.up.dl.is_none() && e.low.dl.is_none());
+        }
+        let lean_env = at.envelope(e, &at.dr(e));
+        assert!(
+            (lean_env - env).abs() <= 1e-13 * env.abs().max(1e-12),
+            "{}: {lean_env:e} against {env:e}",
+            d.key.key
+        );
         let (du, _) = lcp::directional(&at, &states, None, 1e-12, d, &dr, 1.0).unwrap();
         // ∂ₚJ of the piece at fixed U.
         let mut partial = crate::sparse::dot(u, &dr);
