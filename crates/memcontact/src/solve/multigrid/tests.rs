@@ -619,24 +619,29 @@ fn backward_sweep_with_product_is_the_sweep_and_its_product() {
 fn forcing_is_quadratic_until_the_tolerance_is_near() {
     let tol = 1e-10;
     // Far from the answer: the square of the residual (capped at ¼).
-    assert_eq!(forcing(1e-2, tol, 0.0), 1e-4);
-    assert_eq!(forcing(3.0, tol, 0.0), 0.25);
+    assert_eq!(forcing(1e-2, tol, 0.0, FINISH_FACTOR), 1e-4);
+    assert_eq!(forcing(3.0, tol, 0.0, FINISH_FACTOR), 0.25);
     // The square within the finishing factor of the tolerance: straight to a quarter of it.
-    assert_eq!(forcing(1e-4, tol, 0.0), 0.25 * tol);
-    assert_eq!(forcing(1e-12, tol, 0.0), 0.25 * tol);
+    assert_eq!(forcing(1e-4, tol, 0.0, FINISH_FACTOR), 0.25 * tol);
+    assert_eq!(forcing(1e-12, tol, 0.0, FINISH_FACTOR), 0.25 * tol);
     // Never above the current residual's square, never below a quarter of the tolerance.
     for k in 0..40 {
         let kkt = 10f64.powf(-0.3 * k as f64);
-        let f = forcing(kkt, tol, 0.0);
+        let f = forcing(kkt, tol, 0.0, FINISH_FACTOR);
         assert!(f <= kkt.min(0.5).powi(2).max(0.25 * tol), "{kkt}: {f}");
         assert!(f >= 0.25 * tol, "{kkt}: {f}");
     }
     // A rounding floor above the tolerance: the finish starts from the floor's neighbourhood
     // (the square at N = 4096: residual 3.6e-4 after two iterations, floor 1.4e-9).
-    assert_eq!(forcing(3.6e-4, tol, 0.0), 3.6e-4 * 3.6e-4);
-    assert_eq!(forcing(3.6e-4, tol, 1.4e-9), 0.25 * tol);
+    assert_eq!(forcing(3.6e-4, tol, 0.0, FINISH_FACTOR), 3.6e-4 * 3.6e-4);
+    assert_eq!(forcing(3.6e-4, tol, 1.4e-9, FINISH_FACTOR), 0.25 * tol);
     // A floor below the tolerance changes nothing.
-    assert_eq!(forcing(1e-3, tol, 1e-12), 1e-6);
+    assert_eq!(forcing(1e-3, tol, 1e-12, FINISH_FACTOR), 1e-6);
+    // The algebraic levels' factor finishes from further away: from 5·10⁻³ (its square is
+    // within 10⁶ of the tolerance), not from 5·10⁻².
+    let algebraic = TnnmgOptions::default().finish_factor_algebraic;
+    assert_eq!(forcing(5e-3, tol, 0.0, algebraic), 0.25 * tol);
+    assert_eq!(forcing(5e-2, tol, 0.0, algebraic), 5e-2 * 5e-2);
 }
 
 #[test]
