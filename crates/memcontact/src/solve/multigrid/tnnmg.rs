@@ -73,12 +73,13 @@ pub struct TnnmgOptions {
     /// (at 10⁶) that level cost; with 10⁵ to 2.4·10⁵ vertices (a level below of 25 000 to
     /// 60 000 unknowns) the finest level would take one iteration more, hence the bound.
     pub nested_pass_over_algebraic: usize,
-    /// [`FINISH_FACTOR`] on algebraic levels: once the vertex states repeat, the Newton
+    /// The geometric levels' finishing factor (10³) on algebraic levels: once the vertex
+    /// states repeat, the Newton
     /// correction goes straight to the tolerance when the square of the scaled KKT
     /// residual is within this factor of it (with the tolerance 1e-10 of the benchmark:
-    /// from a residual of 10⁻² down, against 3·10⁻⁴ with [`FINISH_FACTOR`]). On imported
+    /// from a residual of 10⁻² down, against 3·10⁻⁴ with 10³). On imported
     /// Gmsh meshes the iteration reaches 10⁻³ to 10⁻² with its states settled, and with
-    /// [`FINISH_FACTOR`] took one quadratic step to 10⁻⁶–10⁻⁷ and another to finish; with
+    /// 10³ took one quadratic step to 10⁻⁶–10⁻⁷ and another to finish; with
     /// this factor it finishes at once, one iteration fewer for as many cycles: 6 → 5
     /// (consistent) and 5 → 4 (lumped) iterations at 1.2·10⁶ vertices, 6 → 5 and 4 → 4 on
     /// a graded mesh with a hole (2.1·10⁵), unchanged at 1.3·10⁵. 10⁷ finished one more
