@@ -73,10 +73,9 @@ pub struct TnnmgOptions {
     /// (at 10⁶) that level cost; with 10⁵ to 2.4·10⁵ vertices (a level below of 25 000 to
     /// 60 000 unknowns) the finest level would take one iteration more, hence the bound.
     pub nested_pass_over_algebraic: usize,
-    /// The geometric levels' finishing factor (10³) on algebraic levels: once the vertex
-    /// states repeat, the Newton
-    /// correction goes straight to the tolerance when the square of the scaled KKT
-    /// residual is within this factor of it (with the tolerance 1e-10 of the benchmark:
+    /// The finishing factor on algebraic levels (geometric levels use 10³): once the
+    /// vertex states repeat, the Newton correction goes straight to the tolerance when the
+    /// square of the scaled KKT residual is within this factor of it (with the tolerance 1e-10 of the benchmark:
     /// from a residual of 10⁻² down, against 3·10⁻⁴ with 10³). On imported
     /// Gmsh meshes the iteration reaches 10⁻³ to 10⁻² with its states settled, and with
     /// 10³ took one quadratic step to 10⁻⁶–10⁻⁷ and another to finish; with
