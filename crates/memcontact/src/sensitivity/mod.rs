@@ -193,8 +193,9 @@ impl Prepared {
     ) -> Result<Prepared> {
         let bound = BoundData::new(problem, mesh)?;
         let mut parameters = Vec::with_capacity(request.parameters.len());
-        // The energy alone (envelope derivatives, no maps) needs no assembled dL.
-        let for_solves = request.influence || request.outputs.iter().any(|o| o != "energy");
+        // The energy alone (envelope derivatives; its influence map reads p̂ alone) needs no
+        // assembled dL.
+        let for_solves = request.outputs.iter().any(|o| o != "energy");
         let asm = crate::model::DerivativeAssembly::new(mesh, &model.dofs, &model.s.pattern);
         for key in &request.parameters {
             let k = ParameterKey::parse(problem, key).map_err(|m| crate::error::Error::Case {

@@ -251,7 +251,9 @@ fn solved(case: &Case, req: &Request) -> Solved {
 /// through the tangent solve, `∂ₚJ + ∇J·δU` with ∇J from the solution itself, to 1e-10.
 fn envelope(foundation: &str) {
     let case = Case::from_toml_str(&site(foundation), None).unwrap();
-    let req = request(&["energy"], &PARAMETERS);
+    // With an output besides the energy, the derivative data are those of the solves
+    // (dL assembled), which the chain rule below reads.
+    let req = request(&["energy", "total_contact_force"], &PARAMETERS);
     let s = solved(&case, &req);
     let model = &s.discretization.model;
     let u = &s.report.u;
@@ -276,15 +278,12 @@ fn envelope(foundation: &str) {
     };
     let grad: Vec<f64> = (0..n).map(|i| states.r[i] + lp[i] - lq[i]).collect();
     println!("{foundation}: parameter, dJ/dp (envelope), chain rule, relative difference");
-    // Prepared for the energy alone (no maps): no consistent dL is assembled, the
-    // envelope reads the element matrices; the same derivatives.
+    // Prepared for the energy alone (with its influence map): no consistent dL is
+    // assembled, the envelope reads the element matrices; the same derivatives.
     let lean = Prepared::new(
         &case.problem,
         &case.sensors,
-        &Request {
-            influence: false,
-            ..req.clone()
-        },
+        &request(&["energy"], &PARAMETERS),
         s.discretization.mesh(),
         model,
     )
