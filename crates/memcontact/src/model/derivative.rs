@@ -29,20 +29,25 @@ pub fn consistent_foundation_form(
     rigid_regions: &[u32],
     x: &[f64],
 ) -> f64 {
-    let body = BodyData {
-        shape: &0.0,
-        stiffness: BodyStiffness::Elastic(c),
-        rigid_regions,
-        foundation: Foundation::Consistent,
-        sampling: Sampling::Nodal,
-    };
-    let masked = Masked::new(body);
+    let masked = masked(c, rigid_regions);
     mass_quad_form(
         mesh,
         dofs,
         masked.elastic().expect("an elastic coefficient"),
         x,
     )
+}
+
+/// The derivative coefficient `c` of a body's stiffness with the body's rigid regions
+/// masked to 0, as the model masks the stiffness ([`Masked`]).
+fn masked<'b>(c: &'b dyn Coefficient, rigid_regions: &'b [u32]) -> Masked<'b> {
+    Masked::new(BodyData {
+        shape: &0.0,
+        stiffness: BodyStiffness::Elastic(c),
+        rigid_regions,
+        foundation: Foundation::Consistent,
+        sampling: Sampling::Nodal,
+    })
 }
 
 /// The mesh and numbering the derivative data are assembled on (those of the model), with
@@ -99,14 +104,7 @@ impl<'a> DerivativeAssembly<'a> {
         rigid_regions: &[u32],
         foundation: Foundation,
     ) -> FoundationMatrix {
-        let body = BodyData {
-            shape: &0.0,
-            stiffness: BodyStiffness::Elastic(c),
-            rigid_regions,
-            foundation,
-            sampling: Sampling::Nodal,
-        };
-        let masked = Masked::new(body);
+        let masked = masked(c, rigid_regions);
         let h = masked.elastic().expect("an elastic coefficient");
         match foundation {
             Foundation::Consistent => FoundationMatrix::Consistent(assemble_mass(
@@ -126,14 +124,7 @@ impl<'a> DerivativeAssembly<'a> {
     /// over the triangles around it, rigid regions masked), as the model keeps h for its
     /// outputs.
     pub fn vertex_stiffness(&self, c: &dyn Coefficient, rigid_regions: &[u32]) -> Vec<f64> {
-        let body = BodyData {
-            shape: &0.0,
-            stiffness: BodyStiffness::Elastic(c),
-            rigid_regions,
-            foundation: Foundation::Lumped,
-            sampling: Sampling::Nodal,
-        };
-        let masked = Masked::new(body);
+        let masked = masked(c, rigid_regions);
         vertex_average(
             self.mesh,
             self.adj(),
