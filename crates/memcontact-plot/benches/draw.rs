@@ -85,6 +85,7 @@ fn main() {
         pressure: &pressure,
         covered: &covered,
         lower: None,
+        numbering: None,
     };
     let options = PlotOptions {
         title: Some(format!("synthetic square N = {n}")),
@@ -122,7 +123,7 @@ fn main() {
             "{:<28} {:>8.3} s",
             "  rasterise",
             best(&mut || {
-                std::hint::black_box(raster::rasterise(&pv, data.triangles, frame));
+                std::hint::black_box(raster::rasterise(&pv, data.triangles, frame, None));
             })
         );
         println!(
@@ -136,7 +137,7 @@ fn main() {
             "{:<28} {:>8.3} s",
             "  one level line of u",
             best(&mut || {
-                std::hint::black_box(raster::level_segments(&pv, data.triangles, &u, 0.3));
+                std::hint::black_box(raster::level_segments(&pv, data.triangles, &u, 0.3, None));
             })
         );
     }

@@ -16,7 +16,9 @@ use crate::colormap::{self, Colormap, Norm};
 use crate::raster::{self, Fragments, MapTransform, EMPTY};
 use crate::text::{self, Anchor, Style};
 use crate::ticks;
-use crate::{BodyData, PlotData, PlotKind, PlotOptions, Units, MAP_HEIGHT, MAP_WIDTH};
+use crate::{
+    BodyData, PlotData, PlotKind, PlotOptions, Units, UserNumbering, MAP_HEIGHT, MAP_WIDTH,
+};
 use crate::{Error, Result};
 use rayon::prelude::*;
 
@@ -95,15 +97,25 @@ pub struct MapLayout {
 impl MapLayout {
     /// Fits the mesh of `data` into the map area and rasterises it.
     pub fn new(data: &PlotData) -> MapLayout {
-        MapLayout::of(data.points, data.triangles, data.bbox())
+        MapLayout::numbered(data.points, data.triangles, data.bbox(), data.numbering)
     }
 
     /// Fits the triangles (bounding box `bbox`, `[xmin, xmax, ymin, ymax]`) into the map
     /// area and rasterises them.
     pub fn of(points: &[[f64; 2]], triangles: &[[u32; 3]], bbox: [f64; 4]) -> MapLayout {
+        MapLayout::numbered(points, triangles, bbox, None)
+    }
+
+    /// [`MapLayout::of`] for a mesh renumbered from the user's `numbering`.
+    fn numbered(
+        points: &[[f64; 2]],
+        triangles: &[[u32; 3]],
+        bbox: [f64; 4],
+        numbering: Option<UserNumbering>,
+    ) -> MapLayout {
         let (transform, frame) = MapTransform::fit(bbox, MAP_AREA);
         let pv: Vec<[f64; 2]> = points.par_iter().map(|&p| transform.to_pixel(p)).collect();
-        let frags = raster::rasterise(&pv, triangles, frame);
+        let frags = raster::rasterise(&pv, triangles, frame, numbering);
         let boundary = raster::boundary_edges(points.len(), triangles);
         let covered = frags.covered() as f64;
         let vertex_spacing = (covered / points.len().max(1) as f64).sqrt();
@@ -220,17 +232,19 @@ fn draw_boundary(canvas: &mut Canvas, l: &MapLayout) {
     canvas.composite(&m, BOUNDARY, 1.0);
 }
 
-/// The level line `values = level` as a coverage mask.
+/// The level line `values = level` as a coverage mask (`mesh`: the triangles and their
+/// user numbering).
+#[allow(clippy::too_many_arguments)]
 fn level_mask(
     canvas: &Canvas,
     l: &MapLayout,
-    tris: &[[u32; 3]],
+    (tris, numbering): (&[[u32; 3]], Option<UserNumbering>),
     values: &[f64],
     level: f64,
     width: f64,
     dashed: bool,
 ) -> Coverage {
-    let segs = raster::level_segments(&l.pv, tris, values, level);
+    let segs = raster::level_segments(&l.pv, tris, values, level, numbering);
     let mut m = Coverage::new(canvas.width, canvas.height, l.frame);
     if dashed {
         // Dashes need a continuous arc length: chain the segments into polylines.
@@ -256,7 +270,7 @@ struct Label {
 fn contours(
     canvas: &mut Canvas,
     l: &MapLayout,
-    tris: &[[u32; 3]],
+    (tris, numbering): (&[[u32; 3]], Option<UserNumbering>),
     values: &[f64],
     (lo, hi): (f64, f64),
     count: usize,
@@ -271,7 +285,7 @@ fn contours(
     } else {
         ticks::nice_step(lo, hi, count + 1)
     };
-    let segs = raster::level_sets(&l.pv, tris, values, &levels);
+    let segs = raster::level_sets(&l.pv, tris, values, &levels, numbering);
     let mut mask = Coverage::new(canvas.width, canvas.height, l.frame);
     for s in segs.iter().flatten() {
         mask.segment(s[0], s[1], 1.0);
@@ -419,17 +433,18 @@ pub(crate) fn render(
     let mut boxes = Vec::new();
     let n = data.points.len();
     let tris = data.triangles;
+    let mesh = (tris, data.numbering);
     let f = &l.frags;
     let contact = indicator(n, |i| data.state[i] >= 0);
     let outline = |canvas: &mut Canvas, color: Rgb, width: f64| {
-        let m = level_mask(canvas, l, tris, &contact, 0.5, width, false);
+        let m = level_mask(canvas, l, mesh, &contact, 0.5, width, false);
         canvas.composite(&m, color, 1.0);
     };
     // The body below's contact zone, outlined dashed.
     let lower_contact = data.lower.map(|low| indicator(n, |i| low.state[i] >= 0));
     let lower_outline = |canvas: &mut Canvas, color: Rgb, width: f64| {
         if let Some(c) = &lower_contact {
-            let m = level_mask(canvas, l, tris, c, 0.5, width, true);
+            let m = level_mask(canvas, l, mesh, c, 0.5, width, true);
             canvas.composite(&m, color, 1.0);
         }
     };
@@ -473,7 +488,7 @@ pub(crate) fn render(
                 map.at(norm.t(f.interp(k, tris, data.u)))
             });
             draw_boundary(&mut canvas, l);
-            let labels = contours(&mut canvas, l, tris, data.u, (lo, hi), 8, &[]);
+            let labels = contours(&mut canvas, l, mesh, data.u, (lo, hi), 8, &[]);
             outline(&mut canvas, OUTLINE, DEFLECTION_OUTLINE_WIDTH);
             lower_outline(&mut canvas, LOWER_OUTLINE, DEFLECTION_OUTLINE_WIDTH);
             markers = l.markers();
@@ -590,7 +605,7 @@ pub(crate) fn render(
                 map.at(norm.t(f.interp(k, tris, &field)))
             });
             draw_boundary(&mut canvas, l);
-            let labels = contours(&mut canvas, l, tris, &field, (lo, hi), 6, &[]);
+            let labels = contours(&mut canvas, l, mesh, &field, (lo, hi), 6, &[]);
             outline(&mut canvas, PRESSURE_OUTLINE, 2.0);
             lower_outline(&mut canvas, LOWER_PRESSURE_OUTLINE, 2.0);
             let mut entries = match data.lower {
@@ -606,7 +621,7 @@ pub(crate) fn render(
                 ),
             };
             if let Some(a) = options.allowable_pressure {
-                let m = level_mask(&canvas, l, tris, &field, 1.0, 3.0, false);
+                let m = level_mask(&canvas, l, mesh, &field, 1.0, 3.0, false);
                 canvas.composite(&m, [0, 0, 0], 1.0);
                 entries.push((Swatch::Line([0, 0, 0], 3.0), "pressure = allowable".into()));
                 entries.push((
@@ -693,7 +708,7 @@ pub(crate) fn render(
                 }
             });
             draw_boundary(&mut canvas, l);
-            let m = level_mask(&canvas, l, tris, &covered, 0.5, 1.6, true);
+            let m = level_mask(&canvas, l, mesh, &covered, 0.5, 1.6, true);
             canvas.composite(&m, [60, 60, 60], 1.0);
             outline(&mut canvas, OUTLINE, 2.4);
             bar_range = gr.map(|_| (glo, ghi));
@@ -893,6 +908,7 @@ fn liftoff_two_bodies(
 ) -> (Option<(f64, f64)>, Vec<String>) {
     let n = data.points.len();
     let tris = data.triangles;
+    let mesh = (tris, data.numbering);
     let f = &l.frags;
     let covered = indicator(n, |i| data.covered[i] || low.covered[i]);
     let up = indicator(n, |i| data.state[i] >= 0);
@@ -953,11 +969,11 @@ fn liftoff_two_bodies(
     });
     draw_boundary(canvas, l);
     let some_uncovered = (0..n).any(|i| !(data.covered[i] || low.covered[i]));
-    let m = level_mask(canvas, l, tris, &covered, 0.5, 1.6, true);
+    let m = level_mask(canvas, l, mesh, &covered, 0.5, 1.6, true);
     canvas.composite(&m, [60, 60, 60], 1.0);
-    let m = level_mask(canvas, l, tris, &up, 0.5, 2.4, false);
+    let m = level_mask(canvas, l, mesh, &up, 0.5, 2.4, false);
     canvas.composite(&m, OUTLINE, 1.0);
-    let m = level_mask(canvas, l, tris, &down, 0.5, 2.4, true);
+    let m = level_mask(canvas, l, mesh, &down, 0.5, 2.4, true);
     canvas.composite(&m, LOWER_OUTLINE, 1.0);
     furniture(
         canvas,
@@ -1208,7 +1224,7 @@ pub fn field_plot(
         map.at(norm.t(f.interp(k, triangles, values)))
     });
     draw_boundary(&mut canvas, &l);
-    let labels = contours(&mut canvas, &l, triangles, values, (lo, hi), 8, &[]);
+    let labels = contours(&mut canvas, &l, (triangles, None), values, (lo, hi), 8, &[]);
     draw_labels(&mut canvas, &labels, &mut boxes);
     let units = Units::default();
     furniture(
@@ -1316,10 +1332,10 @@ pub fn mesh_plot(
     }
     canvas.composite(&edges, [90, 90, 90], 0.85);
     draw_boundary(&mut canvas, &l);
-    let outline = level_mask(&canvas, &l, triangles, &inside, 0.5, 2.2, false);
+    let outline = level_mask(&canvas, &l, (triangles, None), &inside, 0.5, 2.2, false);
     canvas.composite(&outline, OUTLINE, 1.0);
     if let Some(c) = &inside_low {
-        let outline = level_mask(&canvas, &l, triangles, c, 0.5, 2.2, true);
+        let outline = level_mask(&canvas, &l, (triangles, None), c, 0.5, 2.2, true);
         canvas.composite(&outline, LOWER_OUTLINE, 1.0);
     }
     furniture(&mut canvas, &l, units, title, None, &mut boxes);
@@ -1411,6 +1427,7 @@ mod tests {
             pressure: &pressure,
             covered: &covered,
             lower: Some(lower),
+            numbering: None,
         };
         data.validate().unwrap();
         let short = &state_low[1..];

@@ -26,6 +26,8 @@ pub const LOWER_SHADE: Rgb = [222, 206, 240];
 /// both ends; with a body below, φ_low and its contact indicator (NaN and 0 without).
 #[derive(Debug, Clone, Copy)]
 struct Piece {
+    /// The user's number of the triangle (ties along the line go to the lower).
+    k: u32,
     t: [f64; 2],
     u: [f64; 2],
     phi: [f64; 2],
@@ -64,9 +66,10 @@ fn pieces(data: &PlotData, a: [f64; 2], b: [f64; 2]) -> Vec<Piece> {
     let chunks: Vec<Vec<Piece>> = data
         .triangles
         .par_chunks(1 << 14)
-        .map(|chunk| {
+        .enumerate()
+        .map(|(c, chunk)| {
             let mut out = Vec::new();
-            for t in chunk {
+            for (i, t) in chunk.iter().enumerate() {
                 let Some(([lo, hi], ab)) =
                     crate::segment::clip(t.map(|v| data.points[v as usize]), a, d)
                 else {
@@ -79,6 +82,7 @@ fn pieces(data: &PlotData, a: [f64; 2], b: [f64; 2]) -> Vec<Piece> {
                 };
                 let at = |f: &dyn Fn(usize) -> f64| [eval(f, lo), eval(f, hi)];
                 out.push(Piece {
+                    k: crate::UserNumbering::triangle(data.numbering, (c * (1 << 14) + i) as u32),
                     t: [lo, hi],
                     u: at(&|i| data.u[i]),
                     phi: at(&phi),
@@ -91,7 +95,11 @@ fn pieces(data: &PlotData, a: [f64; 2], b: [f64; 2]) -> Vec<Piece> {
         })
         .collect();
     let mut all = chunks.concat();
-    all.sort_by(|p, q| p.t[0].total_cmp(&q.t[0]).then(p.t[1].total_cmp(&q.t[1])));
+    all.sort_by(|p, q| {
+        (p.t[0].total_cmp(&q.t[0]))
+            .then(p.t[1].total_cmp(&q.t[1]))
+            .then(p.k.cmp(&q.k))
+    });
     all
 }
 

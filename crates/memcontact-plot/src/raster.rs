@@ -13,6 +13,7 @@
 //! boundary edges of a triangle list.
 
 use crate::canvas::PixelRect;
+use crate::UserNumbering;
 use rayon::prelude::*;
 
 /// Rows per band of the parallel fill.
@@ -128,14 +129,42 @@ impl Fragments {
     }
 }
 
-/// The edge function of the directed edge `a → b` at `p`, evaluated from the
-/// lower-numbered vertex so that both triangles of a shared edge get exactly opposite
-/// values.
+/// The edge function of the directed edge `a → b` at `p`, evaluated from the end with the
+/// lower user number (see [`UserNumbering`]) so that both triangles of a shared edge get
+/// exactly opposite values.
 #[inline]
-fn edge(pv: &[[f64; 2]], a: u32, b: u32, p: [f64; 2]) -> f64 {
-    let (i, j, s) = if a < b { (a, b, 1.0) } else { (b, a, -1.0) };
-    let (pi, pj) = (pv[i as usize], pv[j as usize]);
-    s * ((pj[0] - pi[0]) * (p[1] - pi[1]) - (pj[1] - pi[1]) * (p[0] - pi[0]))
+fn edge(pv: &[[f64; 2]], a: u32, b: u32, p: [f64; 2], numbering: Option<UserNumbering>) -> f64 {
+    EdgeFn::new(pv, a, b, numbering).at(p)
+}
+
+/// An edge function with its base point and direction taken once per triangle.
+#[derive(Clone, Copy)]
+struct EdgeFn {
+    /// The end with the lower user number.
+    base: [f64; 2],
+    /// From that end to the other.
+    d: [f64; 2],
+    /// +1 when the base is the edge's start, −1 when it is its end.
+    sign: f64,
+}
+
+impl EdgeFn {
+    #[inline]
+    fn new(pv: &[[f64; 2]], a: u32, b: u32, numbering: Option<UserNumbering>) -> EdgeFn {
+        let lower = UserNumbering::vertex(numbering, a) < UserNumbering::vertex(numbering, b);
+        let (i, j, sign) = if lower { (a, b, 1.0) } else { (b, a, -1.0) };
+        let (pi, pj) = (pv[i as usize], pv[j as usize]);
+        EdgeFn {
+            base: pi,
+            d: [pj[0] - pi[0], pj[1] - pi[1]],
+            sign,
+        }
+    }
+
+    #[inline]
+    fn at(&self, p: [f64; 2]) -> f64 {
+        self.sign * (self.d[0] * (p[1] - self.base[1]) - self.d[1] * (p[0] - self.base[0]))
+    }
 }
 
 /// True when a point exactly on the edge `a → b` belongs to the triangle on the edge's
@@ -148,8 +177,16 @@ fn left_owns(pv: &[[f64; 2]], a: u32, b: u32) -> bool {
     -d[1] > 0.0 || (d[1] == 0.0 && d[0] > 0.0)
 }
 
-/// Rasterises `triangles` (vertices at pixel coordinates `pv`) into `rect`.
-pub fn rasterise(pv: &[[f64; 2]], triangles: &[[u32; 3]], rect: PixelRect) -> Fragments {
+/// Rasterises `triangles` (vertices at pixel coordinates `pv`) into `rect`; with a
+/// `numbering`, ties are decided by the user's numbers (a pixel centre covered by two
+/// overlapping triangles goes to the one the user numbered last), so the result is the
+/// same as for the mesh in the user's numbering.
+pub fn rasterise(
+    pv: &[[f64; 2]],
+    triangles: &[[u32; 3]],
+    rect: PixelRect,
+    numbering: Option<UserNumbering>,
+) -> Fragments {
     let w = rect.width().max(0) as usize;
     let h = rect.height().max(0) as usize;
     let mut tri = vec![EMPTY; w * h];
@@ -208,7 +245,7 @@ pub fn rasterise(pv: &[[f64; 2]], triangles: &[[u32; 3]], rect: PixelRect) -> Fr
             for &t in &binned[start[b] as usize..start[b + 1] as usize] {
                 let [v0, v1, v2] = triangles[t as usize];
                 let (p0, p1, p2) = (pv[v0 as usize], pv[v1 as usize], pv[v2 as usize]);
-                let area = edge(pv, v0, v1, p2);
+                let area = edge(pv, v0, v1, p2, numbering);
                 if area == 0.0 || !area.is_finite() {
                     continue;
                 }
@@ -225,17 +262,31 @@ pub fn rasterise(pv: &[[f64; 2]], triangles: &[[u32; 3]], rect: PixelRect) -> Fr
                     left_owns(pv, v2, v0) == (sign > 0.0),
                     left_owns(pv, v0, v1) == (sign > 0.0),
                 ];
+                let f = [
+                    EdgeFn::new(pv, v1, v2, numbering),
+                    EdgeFn::new(pv, v2, v0, numbering),
+                    EdgeFn::new(pv, v0, v1, numbering),
+                ];
+                let user_t = UserNumbering::triangle(numbering, t);
                 for j in j0..=j1 {
                     let y = rect.y0 as f64 + j as f64 + 0.5;
                     let row = (j - band_j0) as usize * w;
                     for i in i0..=i1 {
                         let p = [i as f64 + 0.5, y];
-                        let e0 = sign * edge(pv, v1, v2, p);
-                        let e1 = sign * edge(pv, v2, v0, p);
-                        let e2 = sign * edge(pv, v0, v1, p);
+                        let e0 = sign * f[0].at(p);
+                        let e1 = sign * f[1].at(p);
+                        let e2 = sign * f[2].at(p);
                         let inside = |e: f64, o: bool| e > 0.0 || (e == 0.0 && o);
                         if inside(e0, own[0]) && inside(e1, own[1]) && inside(e2, own[2]) {
                             let k = row + (i - rect.x0) as usize;
+                            // Of overlapping triangles, the one the user numbered last
+                            // (in the user's numbering, the last drawn).
+                            if numbering.is_some()
+                                && tri[k] != EMPTY
+                                && UserNumbering::triangle(numbering, tri[k]) > user_t
+                            {
+                                continue;
+                            }
                             let a = area.abs();
                             tri[k] = t;
                             bary[k] = [(e1 / a) as f32, (e2 / a) as f32];
@@ -250,14 +301,16 @@ pub fn rasterise(pv: &[[f64; 2]], triangles: &[[u32; 3]], rect: PixelRect) -> Fr
 /// The segments (pixel coordinates) of the level line `values = level` of the P1 field
 /// `values` (marching triangles: a vertex is "above" when its value is ≥ the level).
 /// Triangles with a non-finite value are skipped. Crossing points are computed from the
-/// edge's lower-numbered vertex, so neighbouring segments meet exactly.
+/// edge's end with the lower (user) number, so neighbouring segments meet exactly; the
+/// segments come in the user's triangle order.
 pub fn level_segments(
     pv: &[[f64; 2]],
     triangles: &[[u32; 3]],
     values: &[f64],
     level: f64,
+    numbering: Option<UserNumbering>,
 ) -> Vec<[[f64; 2]; 2]> {
-    level_sets(pv, triangles, values, &[level])
+    level_sets(pv, triangles, values, &[level], numbering)
         .pop()
         .unwrap_or_default()
 }
@@ -269,12 +322,15 @@ pub fn level_sets(
     triangles: &[[u32; 3]],
     values: &[f64],
     levels: &[f64],
+    numbering: Option<UserNumbering>,
 ) -> Vec<Vec<[[f64; 2]; 2]>> {
-    let chunks: Vec<Vec<Vec<[[f64; 2]; 2]>>> = triangles
+    let user = |v: u32| UserNumbering::vertex(numbering, v);
+    let chunks: Vec<Vec<Vec<(u32, [[f64; 2]; 2])>>> = triangles
         .par_chunks(1 << 15)
-        .map(|chunk| {
+        .enumerate()
+        .map(|(c, chunk)| {
             let mut out = vec![Vec::new(); levels.len()];
-            for t in chunk {
+            for (i, t) in chunk.iter().enumerate() {
                 let f = t.map(|v| values[v as usize]);
                 if !f.iter().all(|x| x.is_finite()) {
                     continue;
@@ -292,7 +348,7 @@ pub fn level_sets(
                     for e in 0..3 {
                         if above[e] != above[(e + 1) % 3] && n < 2 {
                             let (a, b) = (t[e], t[(e + 1) % 3]);
-                            let (a, b) = if a < b { (a, b) } else { (b, a) };
+                            let (a, b) = if user(a) < user(b) { (a, b) } else { (b, a) };
                             let (fa, fb) = (values[a as usize], values[b as usize]);
                             let s = (level - fa) / (fb - fa);
                             let (pa, pb) = (pv[a as usize], pv[b as usize]);
@@ -300,14 +356,23 @@ pub fn level_sets(
                             n += 1;
                         }
                     }
-                    out[k].push(pts);
+                    let k_t = (c * (1 << 15) + i) as u32;
+                    out[k].push((UserNumbering::triangle(numbering, k_t), pts));
                 }
             }
             out
         })
         .collect();
     (0..levels.len())
-        .map(|k| chunks.iter().flat_map(|c| c[k].iter().copied()).collect())
+        .map(|k| {
+            let mut segs: Vec<(u32, [[f64; 2]; 2])> =
+                chunks.iter().flat_map(|c| c[k].iter().copied()).collect();
+            // In the user's triangle order (each triangle gives one segment per level).
+            if numbering.is_some() {
+                segs.sort_unstable_by_key(|s| s.0);
+            }
+            segs.into_iter().map(|s| s.1).collect()
+        })
         .collect()
 }
 
@@ -434,7 +499,7 @@ mod tests {
             .iter()
             .map(|p| [0.5 + 62.0 * p[0], 63.5 - 62.0 * p[1]])
             .collect();
-        let f = rasterise(&pv, &tris, rect);
+        let f = rasterise(&pv, &tris, rect, None);
         // Pixels whose centres lie inside the closed square [0.5, 62.5]²: covered once.
         for y in 0..64 {
             for x in 0..64 {
@@ -452,7 +517,7 @@ mod tests {
         // one triangle when each triangle is rasterised alone.
         let mut count = vec![0u8; 64 * 64];
         for t in 0..tris.len() {
-            let g = rasterise(&pv, &tris[t..t + 1], rect);
+            let g = rasterise(&pv, &tris[t..t + 1], rect, None);
             for (c, &k) in count.iter_mut().zip(&g.tri) {
                 *c += (k != EMPTY) as u8;
             }
@@ -481,10 +546,10 @@ mod tests {
         let t = MapTransform::fit([0.0, 1.0, 0.0, 1.0], PixelRect::new(10, 10, 300, 200)).0;
         let pv: Vec<[f64; 2]> = pts.iter().map(|&p| t.to_pixel(p)).collect();
         let rect = PixelRect::new(0, 0, 320, 220);
-        let a = rasterise(&pv, &tris, rect);
+        let a = rasterise(&pv, &tris, rect, None);
         let mut rev = tris.clone();
         rev.reverse();
-        let b = rasterise(&pv, &rev, rect);
+        let b = rasterise(&pv, &rev, rect, None);
         let n = tris.len() as u32;
         for (x, y) in a.tri.iter().zip(&b.tri) {
             assert_eq!(*x == EMPTY, *y == EMPTY);
@@ -496,7 +561,7 @@ mod tests {
             .num_threads(1)
             .build()
             .unwrap();
-        let c = pool.install(|| rasterise(&pv, &tris, rect));
+        let c = pool.install(|| rasterise(&pv, &tris, rect, None));
         assert_eq!(a.tri, c.tri);
         assert_eq!(a.bary, c.bary);
     }
@@ -521,7 +586,7 @@ mod tests {
     fn level_lines_and_boundary() {
         let (pts, tris) = grid(10);
         let u: Vec<f64> = pts.iter().map(|p| p[0]).collect();
-        let segs = level_segments(&pts, &tris, &u, 0.55);
+        let segs = level_segments(&pts, &tris, &u, 0.55, None);
         assert!(!segs.is_empty());
         for s in &segs {
             for p in s {

@@ -329,9 +329,13 @@ fn order_by_key(keys: &[u32]) -> Vec<u32> {
 /// `√n`: about 0.7 for a structured grid numbered row by row, of order `√n` for a
 /// scattered numbering.
 pub fn edge_span(mesh: &Mesh) -> f64 {
-    let n = mesh.n_vertices().max(1) as f64;
-    let total: f64 = mesh
-        .triangles
+    span_of(mesh.n_vertices(), &mesh.triangles)
+}
+
+/// [`edge_span`] of `triangles` on `n_vertices` vertices.
+fn span_of(n_vertices: usize, triangles: &[[u32; 3]]) -> f64 {
+    let n = n_vertices.max(1) as f64;
+    let total: f64 = triangles
         .par_iter()
         .with_min_len(8192)
         .map(|t| {
@@ -339,7 +343,7 @@ pub fn edge_span(mesh: &Mesh) -> f64 {
             s(t[0], t[1]) + s(t[1], t[2]) + s(t[2], t[0])
         })
         .sum();
-    total / (3.0 * mesh.n_triangles().max(1) as f64) / n.sqrt()
+    total / (3.0 * triangles.len().max(1) as f64) / n.sqrt()
 }
 
 /// Meshes whose [`edge_span`] is at most this are kept in their order (a row-by-row
@@ -351,11 +355,18 @@ pub const LOCAL_SPAN: f64 = 4.0;
 /// ([`LOCAL_SPAN`]: nothing is built, a structured mesh of millions of vertices needs no
 /// identity permutations).
 pub fn renumbering_for_locality(mesh: &Mesh) -> Option<Reordering> {
-    if edge_span(mesh) <= LOCAL_SPAN {
+    locality_order(&mesh.points, &mesh.triangles)
+}
+
+/// [`renumbering_for_locality`] of the triangles `triangles` on the vertices `points`
+/// (every index in range): for arrays that are not a [`Mesh`], such as a result's
+/// pictures.
+pub fn locality_order(points: &[Point], triangles: &[[u32; 3]]) -> Option<Reordering> {
+    if span_of(points.len(), triangles) <= LOCAL_SPAN {
         return None;
     }
-    let vertices = Permutation::from_order(curve_order(&mesh.points));
-    let triangles = Permutation::from_order(triangle_order(&mesh.triangles, &vertices));
+    let vertices = Permutation::from_order(curve_order(points));
+    let triangles = Permutation::from_order(triangle_order(triangles, &vertices));
     Some(Reordering {
         vertices,
         triangles,

@@ -51,7 +51,7 @@ impl Outcome {
 
     /// The fields and totals in the solver's numbering: those of the report, or derived
     /// from its `u` when it has none.
-    fn solver_fields(&self) -> (Cow<'_, NodalFields>, Totals) {
+    pub(crate) fn solver_fields(&self) -> (Cow<'_, NodalFields>, Totals) {
         match &self.report.derived {
             Some(d) => (Cow::Borrowed(&d.0), d.1),
             None => {

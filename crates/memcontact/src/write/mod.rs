@@ -26,9 +26,9 @@ pub use memcontact_plot::{PlotKind, PlotOptions, Units as PlotUnits};
 #[cfg(feature = "bench")]
 pub use pictures::write_parts_seconds;
 pub use pictures::{
-    adapt_pictures, draw_all, pictures, plot_options, render_png, steps_kind, study_pictures,
-    sweep_picture, write_png, write_result, SweepWriter, CONVERGENCE_PICTURE, H_SWEEP_PICTURE,
-    MESH_PICTURE, SWEEP_PICTURE,
+    adapt_pictures, draw_all, outcome_pictures, pictures, plot_options, render_png, steps_kind,
+    study_pictures, sweep_picture, write_png, write_result, SweepWriter, CONVERGENCE_PICTURE,
+    H_SWEEP_PICTURE, MESH_PICTURE, SWEEP_PICTURE,
 };
 pub use redraw::{load as load_result, Loaded, LowerData, ResultData};
 pub use result::{

@@ -11,6 +11,7 @@ use super::{step_label, write_result_set, SweepSet, WriteOptions};
 use crate::case::StepSpec;
 use crate::case::{Case, PictureKind, VtuFormat};
 use crate::error::{Error, Result};
+use crate::mesh::reorder::Reordering;
 use crate::mesh::Mesh;
 use crate::outcome::fields::NodalFields;
 use crate::outcome::{Outcome, StepRow, Summary};
@@ -18,7 +19,7 @@ use crate::verify::convergence::LevelResult;
 use crate::verify::study::{StudyOutcome, StudyResult};
 use memcontact_plot::{
     render, render_line_plot, BodyData, Canvas, LinePlot, PlotData, PlotKind, PlotOptions, Series,
-    Units,
+    Units, UserNumbering,
 };
 use rayon::prelude::*;
 use std::path::{Path, PathBuf};
@@ -69,15 +70,70 @@ pub fn write_png(path: &Path, canvas: &Canvas) -> Result<()> {
 /// Draws the pictures `options.plots` into `dir` (`deflection.png`, `pressure.png`,
 /// `liftoff.png`, `profile.png`), each written atomically; returns the files written.
 pub fn draw_all(dir: &Path, data: &PlotData, options: &PlotOptions) -> Result<Vec<PathBuf>> {
-    let pictures = render(data, options)?;
-    pictures
+    in_local_order(data, |data| {
+        let pictures = render(data, options)?;
+        pictures
+            .par_iter()
+            .map(|p| {
+                let path = dir.join(p.kind.file_name());
+                write_png(&path, &p.canvas)?;
+                Ok(path)
+            })
+            .collect()
+    })
+}
+
+/// Calls `draw` with `data` renumbered for locality when its numbering is scattered (a
+/// mesh generator's: the renumbering of the solver, vertices along the Hilbert curve),
+/// with the user's numbering attached so that the pictures are the same (see
+/// [`UserNumbering`]) and drawn several times faster; with `data` itself when its order is already local or
+/// it is renumbered already. Invalid data are refused before anything is moved.
+fn in_local_order<T>(data: &PlotData, draw: impl FnOnce(&PlotData) -> Result<T>) -> Result<T> {
+    if data.numbering.is_some() {
+        return draw(data);
+    }
+    data.validate()?;
+    let Some(order) = crate::mesh::reorder::locality_order(data.points, data.triangles) else {
+        return draw(data);
+    };
+    let v = &order.vertices;
+    let triangles: Vec<[u32; 3]> = order
+        .triangles
+        .old_of_new
         .par_iter()
-        .map(|p| {
-            let path = dir.join(p.kind.file_name());
-            write_png(&path, &p.canvas)?;
-            Ok(path)
-        })
-        .collect()
+        .with_min_len(8192)
+        .map(|&k| data.triangles[k as usize].map(|x| v.new_of_old[x as usize]))
+        .collect();
+    let (points, u, phi) = (v.to_new(data.points), v.to_new(data.u), v.to_new(data.phi));
+    let (state, pressure, covered) = (
+        v.to_new(data.state),
+        v.to_new(data.pressure),
+        v.to_new(data.covered),
+    );
+    let lower = data.lower.map(|l| {
+        (
+            v.to_new(l.phi),
+            v.to_new(l.state),
+            v.to_new(l.pressure),
+            v.to_new(l.covered),
+        )
+    });
+    draw(&PlotData {
+        points: &points,
+        triangles: &triangles,
+        u: &u,
+        phi: &phi,
+        state: &state,
+        pressure: &pressure,
+        covered: &covered,
+        lower: lower.as_ref().map(|l| BodyData {
+            phi: &l.0,
+            state: &l.1,
+            pressure: &l.2,
+            covered: &l.3,
+        }),
+        numbering: Some(user_numbering(&order)),
+    })
 }
 
 /// Calls `draw` with the fields of `fields` on `mesh` as the picture crate takes them:
@@ -89,7 +145,34 @@ fn with_plot_data<T>(
     fields: &NodalFields,
     draw: impl FnOnce(&PlotData) -> Result<T>,
 ) -> Result<T> {
-    draw(&PlotData {
+    in_local_order(&plot_data(mesh, fields, None), draw)
+}
+
+/// Calls `draw` with the fields of the solved `outcome` as the picture crate takes them, in
+/// the solver's numbering with the user's attached (see [`outcome_pictures`]).
+fn with_outcome_data<T>(outcome: &Outcome, draw: impl FnOnce(&PlotData) -> Result<T>) -> Result<T> {
+    let mesh = outcome.discretization.mesh();
+    let (fields, _) = outcome.solver_fields();
+    let numbering = mesh.numbering.as_deref().map(user_numbering);
+    in_local_order(&plot_data(mesh, &fields, numbering), draw)
+}
+
+/// The user's numbering of a mesh renumbered by `r`, as the picture crate takes it.
+fn user_numbering(r: &Reordering) -> UserNumbering<'_> {
+    UserNumbering {
+        vertices: &r.vertices.old_of_new,
+        triangles: &r.triangles.old_of_new,
+    }
+}
+
+/// The picture crate's view of `fields` on `mesh`, in the numbering of both, with the
+/// user's `numbering` of a renumbered mesh.
+fn plot_data<'a>(
+    mesh: &'a Mesh,
+    fields: &'a NodalFields,
+    numbering: Option<UserNumbering<'a>>,
+) -> PlotData<'a> {
+    PlotData {
         points: &mesh.points,
         triangles: &mesh.triangles,
         u: &fields.u,
@@ -103,7 +186,8 @@ fn with_plot_data<T>(
             pressure: &l.pressure,
             covered: &l.covered,
         }),
-    })
+        numbering,
+    }
 }
 
 /// The pictures of `options` as the `extra` files of [`super::write_files`]:
@@ -117,6 +201,28 @@ pub fn pictures<'a>(
             return Ok(Vec::new());
         }
         let files = with_plot_data(mesh, fields, |data| {
+            draw_all(dir, data, options).map_err(|e| Error::Data(format!("pictures: {e}")))
+        })?;
+        Ok(files
+            .iter()
+            .filter_map(|f| f.file_name().map(|n| n.to_string_lossy().into_owned()))
+            .collect())
+    }
+}
+
+/// [`pictures`] of the solved `outcome`, as the `extra` files of its result set: drawn from
+/// the solver's own arrays (renumbered for locality) with the user's numbering attached,
+/// which gives the same files as the fields in the user's numbering, without a copy of
+/// them; the fields the result set passes (the user's) are not read.
+pub fn outcome_pictures<'a>(
+    outcome: &'a Outcome,
+    options: &'a PlotOptions,
+) -> impl FnMut(&Path, &NodalFields) -> Result<Vec<String>> + 'a {
+    move |dir: &Path, _: &NodalFields| {
+        if options.plots.is_empty() {
+            return Ok(Vec::new());
+        }
+        let files = with_outcome_data(outcome, |data| {
             draw_all(dir, data, options).map_err(|e| Error::Data(format!("pictures: {e}")))
         })?;
         Ok(files
@@ -164,7 +270,7 @@ pub fn write_parts_seconds(
         input_hash(case);
         Ok(())
     })?;
-    with_plot_data(&mesh, &fields, |data| {
+    with_outcome_data(outcome, |data| {
         let maps = plots.plots.iter().any(|k| *k != PlotKind::Profile);
         let mut layout = None;
         if maps {
@@ -272,8 +378,7 @@ pub fn write_result(
         plot_options: serde_json::to_value(plots).ok(),
         ..options.clone()
     };
-    let mesh = outcome.mesh();
-    let mut draw = pictures(&mesh, plots);
+    let mut draw = outcome_pictures(outcome, plots);
     write_result_set(target, outcome, case, &options, &mut draw)
 }
 
@@ -348,8 +453,7 @@ impl SweepWriter {
             adapt: None,
             unconverged: false,
         };
-        let mesh = outcome.mesh();
-        let mut draw = pictures(&mesh, &plots);
+        let mut draw = outcome_pictures(outcome, &plots);
         self.set
             .write_step(step, outcome, case, &options, &mut draw)
     }

@@ -60,6 +60,7 @@ impl ResultData {
                 pressure: &l.pressure,
                 covered: &l.covered,
             }),
+            numbering: None,
         }
     }
 }

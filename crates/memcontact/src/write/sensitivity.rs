@@ -5,7 +5,7 @@
 //! numbers in their shortest round-trip form and NaN as an empty field, like the other CSV
 //! files.
 
-use super::pictures::{pictures, write_png};
+use super::pictures::{outcome_pictures, write_png};
 use super::result::{write_result_set_with, Extras};
 use super::WriteOptions;
 use crate::case::Case;
@@ -277,7 +277,7 @@ pub fn write_sensitivity_result(
         sensitivity: sensitivities.map(SensitivityTotals::of),
     };
     let mesh = outcome.mesh();
-    let mut maps = pictures(&mesh, plots);
+    let mut maps = outcome_pictures(outcome, plots);
     let title = format!("Fit: {}", plots.title.as_deref().unwrap_or(&options.label));
     let mut extra = |dir: &Path, fields: &NodalFields| -> Result<Vec<String>> {
         let mut names = maps(dir, fields)?;
