@@ -1,7 +1,7 @@
 //! Pictures of data renumbered for locality with the user's numbering attached are the
 //! pictures of the data in the user's numbering.
 
-use crate::{render, BodyData, PlotData, PlotKind, PlotOptions, UserNumbering};
+use crate::{render, BodyData, PlotData, PlotOptions, UserNumbering};
 
 /// A structured grid of the unit square numbered in a scattered order (as a mesh
 /// generator's), with fields shaped like a solution: the obstacle touched in the middle,
@@ -76,7 +76,13 @@ fn scattered(m: usize) -> Scattered {
     let covered: Vec<bool> = points.iter().map(|p| p[0] < 0.93).collect();
     let covered_low: Vec<bool> = points.iter().map(|p| p[1] > 0.05).collect();
     let state: Vec<i8> = (0..n)
-        .map(|i| if covered[i] { state_of(u[i] - phi[i]) } else { -1 })
+        .map(|i| {
+            if covered[i] {
+                state_of(u[i] - phi[i])
+            } else {
+                -1
+            }
+        })
         .collect();
     let state_low: Vec<i8> = (0..n)
         .map(|i| {
@@ -87,9 +93,7 @@ fn scattered(m: usize) -> Scattered {
             }
         })
         .collect();
-    let pressure = (0..n)
-        .map(|i| 50.0 * (u[i] - phi[i]).max(0.0))
-        .collect();
+    let pressure = (0..n).map(|i| 50.0 * (u[i] - phi[i]).max(0.0)).collect();
     let pressure_low = (0..n)
         .map(|i| 30.0 * (phi_low[i] - u[i]).max(0.0))
         .collect();

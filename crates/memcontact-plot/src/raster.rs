@@ -315,6 +315,9 @@ pub fn level_segments(
         .unwrap_or_default()
 }
 
+/// A level line's segment in a triangle, with the user's number of the triangle.
+type NumberedSegment = (u32, [[f64; 2]; 2]);
+
 /// [`level_segments`] for several levels in one pass over the triangles: one list of
 /// segments per level.
 pub fn level_sets(
@@ -325,7 +328,7 @@ pub fn level_sets(
     numbering: Option<UserNumbering>,
 ) -> Vec<Vec<[[f64; 2]; 2]>> {
     let user = |v: u32| UserNumbering::vertex(numbering, v);
-    let chunks: Vec<Vec<Vec<(u32, [[f64; 2]; 2])>>> = triangles
+    let chunks: Vec<Vec<Vec<NumberedSegment>>> = triangles
         .par_chunks(1 << 15)
         .enumerate()
         .map(|(c, chunk)| {
@@ -365,7 +368,7 @@ pub fn level_sets(
         .collect();
     (0..levels.len())
         .map(|k| {
-            let mut segs: Vec<(u32, [[f64; 2]; 2])> =
+            let mut segs: Vec<NumberedSegment> =
                 chunks.iter().flat_map(|c| c[k].iter().copied()).collect();
             // In the user's triangle order (each triangle gives one segment per level).
             if numbering.is_some() {
