@@ -328,6 +328,7 @@ fn order_by_key(keys: &[u32]) -> Vec<u32> {
 /// The mean distance `|i − j|` between the numbers of the two ends of an edge, in units of
 /// `√n`: about 0.7 for a structured grid numbered row by row, of order `√n` for a
 /// scattered numbering.
+#[cfg(any(test, feature = "bench"))]
 pub fn edge_span(mesh: &Mesh) -> f64 {
     span_of(mesh.n_vertices(), &mesh.triangles)
 }
@@ -346,6 +347,13 @@ fn span_of(n_vertices: usize, triangles: &[[u32; 3]]) -> f64 {
     total / (3.0 * triangles.len().max(1) as f64) / n.sqrt()
 }
 
+/// `true` when `triangles` on `n_vertices` vertices are numbered in a scattered order
+/// (their mean edge span above [`LOCAL_SPAN`]): those [`locality_order`] renumbers. Reads the
+/// triangles alone (an index out of range is no error here).
+pub fn scattered(n_vertices: usize, triangles: &[[u32; 3]]) -> bool {
+    span_of(n_vertices, triangles) > LOCAL_SPAN
+}
+
 /// Meshes whose [`edge_span`] is at most this are kept in their order (a row-by-row
 /// structured grid, or a mesh already renumbered for locality).
 pub const LOCAL_SPAN: f64 = 4.0;
@@ -362,7 +370,7 @@ pub fn renumbering_for_locality(mesh: &Mesh) -> Option<Reordering> {
 /// (every index in range): for arrays that are not a [`Mesh`], such as a result's
 /// pictures.
 pub fn locality_order(points: &[Point], triangles: &[[u32; 3]]) -> Option<Reordering> {
-    if span_of(points.len(), triangles) <= LOCAL_SPAN {
+    if !scattered(points.len(), triangles) {
         return None;
     }
     let vertices = Permutation::from_order(curve_order(points));

@@ -89,11 +89,12 @@ pub fn draw_all(dir: &Path, data: &PlotData, options: &PlotOptions) -> Result<Ve
 /// [`UserNumbering`]) and drawn several times faster; with `data` itself when its order is already local or
 /// it is renumbered already. Invalid data are refused before anything is moved.
 fn in_local_order<T>(data: &PlotData, draw: impl FnOnce(&PlotData) -> Result<T>) -> Result<T> {
-    if data.numbering.is_some() {
+    use crate::mesh::reorder::{locality_order, scattered};
+    if data.numbering.is_some() || !scattered(data.points.len(), data.triangles) {
         return draw(data);
     }
     data.validate()?;
-    let Some(order) = crate::mesh::reorder::locality_order(data.points, data.triangles) else {
+    let Some(order) = locality_order(data.points, data.triangles) else {
         return draw(data);
     };
     let v = &order.vertices;
