@@ -118,7 +118,8 @@ enum Command {
         /// Standard benchmark: lumped, consistent or both.
         #[arg(long, default_value = "both")]
         foundation: String,
-        /// Standard benchmark: also print the time per solver phase.
+        /// Also print the time per solver phase (the standard benchmark's per size, a case's
+        /// after each row).
         #[arg(long)]
         phases: bool,
         /// Benchmark this case file.
@@ -252,6 +253,7 @@ fn main() -> ExitCode {
                     repeat,
                     pictures,
                     write_parts,
+                    phases,
                 })
             } else {
                 bench_cmd::run(&sizes, &foundation, phases)

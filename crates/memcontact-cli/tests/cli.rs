@@ -432,3 +432,30 @@ fn ambiguous_gmsh_region_names_are_warned_about_and_refused() {
     assert_eq!(o.status.code(), Some(1), "{t}");
     assert!(t.contains("'2' is ambiguous") && t.contains("clay"), "{t}");
 }
+
+#[test]
+fn a_case_benchmark_prints_the_solver_phases_when_asked() {
+    let case = examples().join("gmsh-disk.toml");
+    let phases_of = |args: &[&str]| -> Vec<(String, f64)> {
+        let mut all = vec!["bench", "--case", case.to_str().unwrap()];
+        all.extend_from_slice(args);
+        let o = run(&all);
+        assert!(o.status.success(), "{}", text(&o));
+        let out = String::from_utf8_lossy(&o.stdout).into_owned();
+        out.lines()
+            .filter_map(|l| l.trim().strip_prefix("solver phases, seconds: "))
+            .flat_map(|l| l.split(", ").map(str::to_string).collect::<Vec<_>>())
+            .map(|p| {
+                let (name, s) = p.rsplit_once(' ').unwrap();
+                (name.to_string(), s.parse::<f64>().unwrap())
+            })
+            .collect()
+    };
+    assert!(phases_of(&[]).is_empty(), "no phases without --phases");
+    let phases = phases_of(&["--phases"]);
+    let names: Vec<&str> = phases.iter().map(|(n, _)| n.as_str()).collect();
+    // The imported disk is solved by the active-set method: its factorisation is a phase.
+    assert!(names.contains(&"factorisation"), "{names:?}");
+    assert!(names.contains(&"certificate"), "{names:?}");
+    assert!(phases.iter().all(|(_, s)| s.is_finite() && *s >= 0.0));
+}

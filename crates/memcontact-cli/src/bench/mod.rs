@@ -128,6 +128,8 @@ pub struct CaseRun {
     /// With `write_parts`: the seconds of each part of writing alone, one after the other
     /// after the run (`memcontact::bench::write_parts_seconds`).
     pub write_parts: Vec<(String, f64, f64)>,
+    /// The solver's phases with their seconds (as `memcontact solve` prints them).
+    pub solver_phases: Vec<(String, f64)>,
 }
 
 /// The names of [`CaseRun::seconds`].
@@ -204,6 +206,11 @@ pub fn run_case(case: &Case, scratch: &Path, pictures: bool, write_parts: bool) 
         accepted: r.accepted,
         stolen,
         write_parts: Vec::new(),
+        solver_phases: r
+            .solver_phases
+            .iter()
+            .map(|p| (p.name.to_string(), p.seconds))
+            .collect(),
     };
     let run = if write_parts {
         std::fs::create_dir_all(&dir)?;
@@ -277,6 +284,12 @@ pub fn write_parts_row(parts: &[(String, f64, f64)]) -> String {
     )
 }
 
+/// The line after a row with the seconds of each of the solver's phases (`--phases`).
+pub fn solver_phases_row(phases: &[(String, f64)]) -> String {
+    let each: Vec<String> = phases.iter().map(|(n, s)| format!("{n} {s:.3}")).collect();
+    format!("    solver phases, seconds: {}", each.join(", "))
+}
+
 /// The note after a row whose run lost CPU time to the host of a virtual machine (more
 /// than a clock tick or two): its times are longer than the code's by up to that much.
 pub fn stolen_note(stolen: Option<f64>) -> String {
@@ -302,6 +315,8 @@ pub struct CaseBench {
     pub pictures: bool,
     /// Time each part of writing alone after each run.
     pub write_parts: bool,
+    /// Print the solver's phases after each row.
+    pub phases: bool,
 }
 
 /// Runs the case benchmark, printing the table as rows are measured.
@@ -346,6 +361,9 @@ pub fn run_case_bench(b: &CaseBench) -> Result<()> {
         for _ in 0..b.repeat {
             let run = run_case(&c, &scratch, b.pictures, b.write_parts)?;
             println!("{}", case_row(&run));
+            if b.phases {
+                println!("{}", solver_phases_row(&run.solver_phases));
+            }
             if !run.write_parts.is_empty() {
                 println!("{}", write_parts_row(&run.write_parts));
             }
