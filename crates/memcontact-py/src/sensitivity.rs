@@ -22,18 +22,9 @@ use std::path::PathBuf;
 use std::sync::Mutex;
 use std::time::Instant;
 
-/// The columns of `sensitivity.csv` as the rows of [`PySensitivities::rows`] give them.
-const SENSITIVITY_COLUMNS: [&str; 9] = [
-    "output",
-    "parameter",
-    "value",
-    "derivative",
-    "elasticity",
-    "derivative_plus",
-    "derivative_minus",
-    "nonsmooth",
-    "kind",
-];
+/// The columns of [`PySensitivities::rows`] after those of `sensitivity.csv`: the earlier
+/// names of its `biactive` and `parameter_kind`, kept for code written against them.
+const EARLIER_COLUMNS: [&str; 2] = ["nonsmooth", "kind"];
 
 /// The columns of `fit.csv`'s rows as [`PyFit::rows`] gives them (then one per parameter).
 const FIT_COLUMNS: [&str; 5] = ["iteration", "rms", "step", "damping", "solves"];
@@ -259,10 +250,14 @@ impl PySensitivities {
         self.result.clone_ref(py)
     }
 
-    /// The columns of `rows` (those of `sensitivity.csv`, then `nonsmooth` and `kind`).
+    /// The columns of `rows`: those of `sensitivity.csv`, then `nonsmooth` and `kind`
+    /// (the same as `biactive` and `parameter_kind`, under their earlier names).
     #[getter]
     fn columns(&self) -> Vec<&'static str> {
-        SENSITIVITY_COLUMNS.to_vec()
+        memcontact::write::SENSITIVITY_COLUMNS
+            .into_iter()
+            .chain(EARLIER_COLUMNS)
+            .collect()
     }
 
     /// One dict per output and parameter, as the rows of `sensitivity.csv` (None where
@@ -287,6 +282,9 @@ impl PySensitivities {
                 };
                 row.set_item("derivative_plus", cell(py, plus)?)?;
                 row.set_item("derivative_minus", cell(py, minus)?)?;
+                row.set_item("biactive", i32::from(self.s.nonsmooth[k]))?;
+                row.set_item("parameter_kind", self.s.parameters[p].kind.name())?;
+                row.set_item("parameter_value", cell(py, self.s.parameters[p].value)?)?;
                 row.set_item("nonsmooth", self.s.nonsmooth[k])?;
                 row.set_item("kind", self.s.parameters[p].kind.name())?;
                 list.append(row)?;

@@ -110,7 +110,14 @@ def test_equal_to_the_command_line_tool(cli, tmp_path):
     with open(out / "sensitivity.csv") as f:
         rows = list(csv.DictReader(f))
     assert len(rows) == len(s.rows)
+    # The rows have the file's columns (then two earlier names of two of them).
+    assert s.columns == list(rows[0].keys()) + ["nonsmooth", "kind"]
     for got, want in zip(s.rows, rows):
+        assert list(got.keys()) == s.columns
+        assert got["biactive"] == int(want["biactive"]) == int(got["nonsmooth"])
+        assert got["parameter_kind"] == want["parameter_kind"] == got["kind"]
+        assert got["parameter_value"] == pytest.approx(float(want["parameter_value"]),
+                                                       rel=1e-12)
         assert got["output"] == want["output"] and got["parameter"] == want["parameter"]
         assert got["derivative"] == pytest.approx(float(want["derivative"]), rel=1e-9,
                                                   abs=1e-15)

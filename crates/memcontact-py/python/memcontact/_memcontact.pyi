@@ -998,11 +998,14 @@ class Sensitivities:
         ...
     @property
     def columns(self) -> List[str]:
-        """The columns of ``rows``."""
+        """The columns of ``rows``: those of ``sensitivity.csv``, then ``nonsmooth`` and
+        ``kind`` (the same as ``biactive`` and ``parameter_kind``, under their earlier
+        names)."""
         ...
     @property
     def rows(self) -> List[Dict[str, Any]]:
-        """The rows of ``sensitivity.csv``, one per output and parameter."""
+        """The rows of ``sensitivity.csv``, one per output and parameter (None where the
+        file's cell is empty)."""
         ...
     def write(
         self,
