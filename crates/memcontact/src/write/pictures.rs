@@ -86,8 +86,9 @@ pub fn draw_all(dir: &Path, data: &PlotData, options: &PlotOptions) -> Result<Ve
 /// Calls `draw` with `data` renumbered for locality when its numbering is scattered (a
 /// mesh generator's: the renumbering of the solver, vertices along the Hilbert curve),
 /// with the user's numbering attached so that the pictures are the same (see
-/// [`UserNumbering`]) and drawn several times faster; with `data` itself when its order is already local or
-/// it is renumbered already. Invalid data are refused before anything is moved.
+/// [`UserNumbering`]) and drawn several times faster; with `data` itself when its order
+/// is already local or it is renumbered already. Invalid data are refused before
+/// anything is moved.
 fn in_local_order<T>(data: &PlotData, draw: impl FnOnce(&PlotData) -> Result<T>) -> Result<T> {
     use crate::mesh::reorder::{locality_order, scattered};
     if data.numbering.is_some() || !scattered(data.points.len(), data.triangles) {
