@@ -339,9 +339,6 @@ impl PlotData<'_> {
                 ("covered_low", l.covered.len()),
             ]);
         }
-        if let Some(num) = &self.numbering {
-            lengths.push(("user numbers of the vertices", num.vertices.len()));
-        }
         for (name, len) in lengths {
             if len != n {
                 return Err(Error::Data(format!(

@@ -63,9 +63,11 @@ fn pieces(data: &PlotData, a: [f64; 2], b: [f64; 2]) -> Vec<Piece> {
         Some(low) if low.state[i] >= 0 => 1.0,
         _ => 0.0,
     };
+    /// Triangles per task.
+    const CHUNK: usize = 1 << 14;
     let chunks: Vec<Vec<Piece>> = data
         .triangles
-        .par_chunks(1 << 14)
+        .par_chunks(CHUNK)
         .enumerate()
         .map(|(c, chunk)| {
             let mut out = Vec::new();
@@ -82,7 +84,7 @@ fn pieces(data: &PlotData, a: [f64; 2], b: [f64; 2]) -> Vec<Piece> {
                 };
                 let at = |f: &dyn Fn(usize) -> f64| [eval(f, lo), eval(f, hi)];
                 out.push(Piece {
-                    k: crate::UserNumbering::triangle(data.numbering, (c * (1 << 14) + i) as u32),
+                    k: crate::UserNumbering::triangle(data.numbering, (c * CHUNK + i) as u32),
                     t: [lo, hi],
                     u: at(&|i| data.u[i]),
                     phi: at(&phi),

@@ -328,8 +328,10 @@ pub fn level_sets(
     numbering: Option<UserNumbering>,
 ) -> Vec<Vec<[[f64; 2]; 2]>> {
     let user = |v: u32| UserNumbering::vertex(numbering, v);
+    /// Triangles per task.
+    const CHUNK: usize = 1 << 15;
     let chunks: Vec<Vec<Vec<NumberedSegment>>> = triangles
-        .par_chunks(1 << 15)
+        .par_chunks(CHUNK)
         .enumerate()
         .map(|(c, chunk)| {
             let mut out = vec![Vec::new(); levels.len()];
@@ -359,7 +361,7 @@ pub fn level_sets(
                             n += 1;
                         }
                     }
-                    let k_t = (c * (1 << 15) + i) as u32;
+                    let k_t = (c * CHUNK + i) as u32;
                     out[k].push((UserNumbering::triangle(numbering, k_t), pts));
                 }
             }

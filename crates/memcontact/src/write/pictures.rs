@@ -192,6 +192,15 @@ fn plot_data<'a>(
     }
 }
 
+/// [`draw_all`] as the `extra` files of a result set: the names of the files written.
+fn draw_named(dir: &Path, data: &PlotData, options: &PlotOptions) -> Result<Vec<String>> {
+    let files = draw_all(dir, data, options).map_err(|e| Error::Data(format!("pictures: {e}")))?;
+    Ok(files
+        .iter()
+        .filter_map(|f| f.file_name().map(|n| n.to_string_lossy().into_owned()))
+        .collect())
+}
+
 /// The pictures of `options` as the `extra` files of [`super::write_files`]:
 /// drawn into the directory from the nodal fields on `mesh`; returns their names.
 pub fn pictures<'a>(
@@ -202,13 +211,7 @@ pub fn pictures<'a>(
         if options.plots.is_empty() {
             return Ok(Vec::new());
         }
-        let files = with_plot_data(mesh, fields, |data| {
-            draw_all(dir, data, options).map_err(|e| Error::Data(format!("pictures: {e}")))
-        })?;
-        Ok(files
-            .iter()
-            .filter_map(|f| f.file_name().map(|n| n.to_string_lossy().into_owned()))
-            .collect())
+        with_plot_data(mesh, fields, |data| draw_named(dir, data, options))
     }
 }
 
@@ -224,13 +227,7 @@ pub fn outcome_pictures<'a>(
         if options.plots.is_empty() {
             return Ok(Vec::new());
         }
-        let files = with_outcome_data(outcome, |data| {
-            draw_all(dir, data, options).map_err(|e| Error::Data(format!("pictures: {e}")))
-        })?;
-        Ok(files
-            .iter()
-            .filter_map(|f| f.file_name().map(|n| n.to_string_lossy().into_owned()))
-            .collect())
+        with_outcome_data(outcome, |data| draw_named(dir, data, options))
     }
 }
 
