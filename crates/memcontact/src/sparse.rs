@@ -423,9 +423,13 @@ pub fn first_where<T: Copy + Sync>(
 /// Groups the entries of items `0..m` by key, in compressed-row form: `entries(i)` gives
 /// item i's up to `K` entries `(key < n_keys, value)`, and the result `(ptr, values)` holds
 /// the values of key `k` in `values[ptr[k]..ptr[k + 1]]`, in increasing item order (a
-/// counting sort). Large inputs are split into ranges of keys, one per thread: each scans
-/// every item and keeps the entries it owns, so the result is the same for any number of
-/// threads.
+/// stable counting sort). Large inputs whose keys follow the items' order (a mesh
+/// numbered for locality) are split into ranges of keys, one per thread
+/// ([`group_by_key_by_ranges`]); scattered keys (a mesh in a mesh generator's numbering),
+/// whose counters that would miss the cache at every entry, are sorted in two passes that
+/// stay in cache: fixed chunks of items are first sorted by buckets of [`KEY_BUCKET`]
+/// consecutive keys, then every bucket gathers its entries from the chunks in order and
+/// sorts them by key. Either way the result is the same, for any number of threads.
 pub(crate) fn group_by_key<T, const K: usize>(
     n_keys: usize,
     m: usize,
@@ -434,9 +438,137 @@ pub(crate) fn group_by_key<T, const K: usize>(
 where
     T: Copy + Default + Send + Sync,
 {
-    /// Keys from which the ranges are built in parallel.
-    const PARALLEL: usize = 1 << 16;
-    let parts = if n_keys >= PARALLEL {
+    if n_keys < PARALLEL_KEYS || keys_follow_items(n_keys, m, &entries) {
+        return group_by_key_by_ranges(n_keys, m, entries);
+    }
+    // Items per chunk of the first pass: at least 2¹⁴, at most 256 chunks (each keeps a
+    // counter per bucket).
+    let chunk = (1 << 14).max(m.div_ceil(256));
+    let n_buckets = n_keys.div_ceil(KEY_BUCKET);
+    let bucket_of = |key: u32| key as usize / KEY_BUCKET;
+    // First pass: each chunk's entries sorted by bucket (in item order within a bucket),
+    // with where each bucket starts in it.
+    let chunks: Vec<(Vec<usize>, Vec<(u32, T)>)> = (0..m.div_ceil(chunk))
+        .into_par_iter()
+        .map(|c| {
+            let items = c * chunk..((c + 1) * chunk).min(m);
+            let mut start = vec![0usize; n_buckets + 1];
+            for i in items.clone() {
+                for (key, _) in entries(i).into_iter().flatten() {
+                    start[bucket_of(key) + 1] += 1;
+                }
+            }
+            for b in 0..n_buckets {
+                start[b + 1] += start[b];
+            }
+            let mut next = start.clone();
+            let mut sorted = vec![(0u32, T::default()); start[n_buckets]];
+            for i in items {
+                for (key, value) in entries(i).into_iter().flatten() {
+                    let b = bucket_of(key);
+                    sorted[next[b]] = (key, value);
+                    next[b] += 1;
+                }
+            }
+            (start, sorted)
+        })
+        .collect();
+    // Where every bucket's values start in the result.
+    let mut bucket_start = vec![0usize; n_buckets + 1];
+    for b in 0..n_buckets {
+        let len: usize = chunks
+            .iter()
+            .map(|(start, _)| start[b + 1] - start[b])
+            .sum();
+        bucket_start[b + 1] = bucket_start[b] + len;
+    }
+    let mut ptr = filled(n_keys + 1, 0usize);
+    let mut values = filled(bucket_start[n_buckets], T::default());
+    // Second pass: every bucket sorts its entries by key, into its own parts of `ptr` and
+    // `values`.
+    let mut parts = Vec::with_capacity(n_buckets);
+    let (mut ptr_rest, mut val_rest) = (&mut ptr[1..], &mut values[..]);
+    for b in 0..n_buckets {
+        let keys = (n_keys - b * KEY_BUCKET).min(KEY_BUCKET);
+        let (p, pr) = ptr_rest.split_at_mut(keys);
+        let (v, vr) = val_rest.split_at_mut(bucket_start[b + 1] - bucket_start[b]);
+        parts.push((b, p, v));
+        (ptr_rest, val_rest) = (pr, vr);
+    }
+    let chunks = &chunks;
+    let bucket_start = &bucket_start;
+    parts.into_par_iter().for_each(|(b, ptr_part, out)| {
+        let lo = (b * KEY_BUCKET) as u32;
+        let own = || {
+            chunks
+                .iter()
+                .flat_map(move |(start, sorted)| &sorted[start[b]..start[b + 1]])
+        };
+        let mut next = vec![0usize; ptr_part.len()];
+        for &(key, _) in own() {
+            next[(key - lo) as usize] += 1;
+        }
+        let mut sum = 0;
+        for (n, p) in next.iter_mut().zip(ptr_part.iter_mut()) {
+            let count = *n;
+            *n = sum;
+            sum += count;
+            *p = bucket_start[b] + sum;
+        }
+        for &(key, value) in own() {
+            let k = (key - lo) as usize;
+            out[next[k]] = value;
+            next[k] += 1;
+        }
+    });
+    (ptr, values)
+}
+
+/// Keys from which [`group_by_key`] runs on all threads.
+const PARALLEL_KEYS: usize = 1 << 16;
+
+/// Whether the keys of `entries` mostly follow the items' order: the first keys of 4096
+/// items spread evenly through `0..m` jump by at most 8 `n_keys` in all (a sweep through
+/// the keys jumps by about `n_keys`; scattered keys by about a third of it per sample).
+fn keys_follow_items<T, const K: usize>(
+    n_keys: usize,
+    m: usize,
+    entries: &impl Fn(usize) -> [Option<(u32, T)>; K],
+) -> bool {
+    const SAMPLES: usize = 4096;
+    if m < 2 * SAMPLES {
+        return true;
+    }
+    let step = m / SAMPLES;
+    let mut previous: Option<u32> = None;
+    let mut jumps = 0u64;
+    for s in 0..SAMPLES {
+        if let Some((key, _)) = entries(s * step).into_iter().flatten().next() {
+            if let Some(p) = previous {
+                jumps += u64::from(key.abs_diff(p));
+            }
+            previous = Some(key);
+        }
+    }
+    jumps <= 8 * n_keys as u64
+}
+
+/// Consecutive keys per bucket of [`group_by_key`]'s passes (their counters fit in the
+/// first-level cache).
+const KEY_BUCKET: usize = 1 << 12;
+
+/// [`group_by_key`] for keys that follow the items' order (or few keys): the keys are
+/// split into ranges, one per thread, and each thread scans every item and keeps the
+/// entries it owns (its counters are then written in a sweep through its range).
+fn group_by_key_by_ranges<T, const K: usize>(
+    n_keys: usize,
+    m: usize,
+    entries: impl Fn(usize) -> [Option<(u32, T)>; K] + Sync,
+) -> (Vec<usize>, Vec<T>)
+where
+    T: Copy + Default + Send + Sync,
+{
+    let parts = if n_keys >= PARALLEL_KEYS {
         rayon::current_num_threads().clamp(1, 16)
     } else {
         1
@@ -577,18 +709,12 @@ mod tests {
         Csr::from_triplets(n, &t)
     }
 
-    #[test]
-    fn grouping_by_key_is_a_stable_counting_sort_for_any_thread_count() {
-        // Two entries per item, some missing, keys scattered; beyond the parallel size.
-        let (n_keys, m) = (70_000, 150_000);
-        let entries = |i: usize| {
-            let a = ((i * 7919) % n_keys) as u32;
-            let b = ((i * 104_729 + 13) % n_keys) as u32;
-            [
-                Some((a, i as u64)),
-                (!i.is_multiple_of(3)).then_some((b, (i as u64) << 32)),
-            ]
-        };
+    /// `group_by_key` of `entries` against lists filled item by item, on 1 to 3 threads.
+    fn check_grouping<const K: usize>(
+        n_keys: usize,
+        m: usize,
+        entries: impl Fn(usize) -> [Option<(u32, u64)>; K] + Sync,
+    ) {
         let mut lists = vec![Vec::new(); n_keys];
         for i in 0..m {
             for (key, value) in entries(i).into_iter().flatten() {
@@ -597,8 +723,9 @@ mod tests {
         }
         for threads in [1, 2, 3] {
             let (ptr, values) =
-                crate::parallel::on_threads(threads, || group_by_key(n_keys, m, entries));
+                crate::parallel::on_threads(threads, || group_by_key(n_keys, m, &entries));
             assert_eq!(ptr.len(), n_keys + 1);
+            assert_eq!(values.len(), ptr[n_keys]);
             for (k, list) in lists.iter().enumerate() {
                 assert_eq!(
                     &values[ptr[k]..ptr[k + 1]],
@@ -607,6 +734,37 @@ mod tests {
                 );
             }
         }
+    }
+
+    #[test]
+    fn grouping_by_key_is_a_stable_counting_sort_for_any_thread_count() {
+        // Two entries per item, some missing, beyond the parallel size; keys scattered
+        // (sorted by buckets) and keys following the items (split into ranges).
+        let (n_keys, m) = (70_000, 150_000);
+        let scattered = |i: usize| {
+            let a = ((i * 7919) % n_keys) as u32;
+            let b = ((i * 104_729 + 13) % n_keys) as u32;
+            [
+                Some((a, i as u64)),
+                (!i.is_multiple_of(3)).then_some((b, (i as u64) << 32)),
+            ]
+        };
+        assert!(!keys_follow_items(n_keys, m, &scattered));
+        check_grouping(n_keys, m, scattered);
+        let local = |i: usize| {
+            let a = (i * n_keys / m) as u32;
+            [
+                Some((a, i as u64)),
+                (!i.is_multiple_of(3)).then_some(((a + 1).min(n_keys as u32 - 1), 7)),
+            ]
+        };
+        assert!(keys_follow_items(n_keys, m, &local));
+        check_grouping(n_keys, m, local);
+        // No entries at all, and fewer keys than a bucket holds past the last one.
+        check_grouping(n_keys, m, |_| [None::<(u32, u64)>]);
+        check_grouping(PARALLEL_KEYS + 5, 20_000, |i| {
+            [Some((((i * 7919) % (PARALLEL_KEYS + 5)) as u32, i as u64))]
+        });
     }
 
     #[test]
