@@ -448,7 +448,7 @@ where
     let bucket_of = |key: u32| key as usize / KEY_BUCKET;
     // First pass: each chunk's entries sorted by bucket (in item order within a bucket),
     // with where each bucket starts in it.
-    let chunks: Vec<(Vec<usize>, Vec<(u32, T)>)> = (0..m.div_ceil(chunk))
+    let chunks: Vec<BucketedChunk<T>> = (0..m.div_ceil(chunk))
         .into_par_iter()
         .map(|c| {
             let items = c * chunk..((c + 1) * chunk).min(m);
@@ -523,6 +523,10 @@ where
     });
     (ptr, values)
 }
+
+/// A chunk of items' entries sorted by bucket in [`group_by_key`]: where each bucket starts,
+/// and the entries.
+type BucketedChunk<T> = (Vec<usize>, Vec<(u32, T)>);
 
 /// Keys from which [`group_by_key`] runs on all threads.
 const PARALLEL_KEYS: usize = 1 << 16;
