@@ -774,3 +774,67 @@ fn rhs_and_start(held: &[bool]) -> (Vec<f64>, Vec<f64>) {
         .collect();
     (b, start)
 }
+
+#[test]
+fn nested_transfers_choose_their_columns_as_the_stored_ones_do() {
+    // `Transfer::nested` finds from the rows alone what `with_columns_from` finds against
+    // the stored columns: on uniform refinement (whole rows), on local bisection (rows
+    // with other vertices), and on a pattern that does not hold the columns (stored).
+    use crate::adapt::bisect::{bisect, label_longest_edge};
+    let mut h = Hierarchy::single(label_longest_edge(&square(6)));
+    for step in 0..3 {
+        let m = h.finest();
+        let marked: Vec<u32> = (0..m.n_triangles() as u32)
+            .filter(|k| (k * 7 + step) % 5 == 0)
+            .collect();
+        let b = bisect(m, &marked).unwrap();
+        h.levels.push(b.mesh);
+        h.refinements.push(b.refinement);
+    }
+    for (name, h) in [("square", square_hierarchy(4, 3)), ("bisected", h)] {
+        for k in 0..h.depth() - 1 {
+            let (coarse, fine) = (DofMap::new(&h.levels[k]), DofMap::new(&h.levels[k + 1]));
+            let model = bench_model(&h.levels[k + 1], Some(1000.0), Foundation::Lumped);
+            let pattern = model.s.pattern.clone();
+            let diagonal = Csr::diagonal(&vec![1.0; fine.len()]).pattern;
+            for (what, pat) in [("pattern", &pattern), ("diagonal", &diagonal)] {
+                let r = &h.refinements[k];
+                let nested = Transfer::nested(r, &coarse, &fine, pat).unwrap();
+                let stored = Transfer::new(r, &coarse, &fine)
+                    .unwrap()
+                    .with_columns_from(pat);
+                let at = format!("{name}, level {k}, {what}");
+                assert_eq!(
+                    nested.columns_from_fine_rows(),
+                    stored.columns_from_fine_rows(),
+                    "{at}"
+                );
+                assert_eq!(
+                    nested.columns_are_whole_rows(),
+                    stored.columns_are_whole_rows(),
+                    "{at}"
+                );
+                assert_eq!(nested.single_parent, stored.single_parent, "{at}");
+                assert_eq!(nested.injection(), stored.injection(), "{at}");
+                let x: Vec<f64> = (0..fine.len())
+                    .map(|i| ((i * 7919) % 1013) as f64 / 1013.0 - 0.3)
+                    .collect();
+                let (mut a, mut b) = (vec![0.0; coarse.len()], vec![0.0; coarse.len()]);
+                nested.restrict(&x, &mut a);
+                stored.restrict(&x, &mut b);
+                assert_eq!(a, b, "{at}: restriction");
+                assert_eq!(
+                    nested.galerkin_pattern(&pattern),
+                    stored.galerkin_pattern(&pattern),
+                    "{at}: Galerkin pattern"
+                );
+            }
+            assert!(
+                Transfer::nested(&h.refinements[k], &coarse, &fine, &pattern)
+                    .unwrap()
+                    .columns_from_fine_rows(),
+                "{name}, level {k}: nested meshes' patterns hold the columns"
+            );
+        }
+    }
+}
