@@ -103,21 +103,22 @@ impl Levels {
         let level = |k: usize| dofs.get(k).unwrap_or(finest);
         // Levels without unknowns cannot carry a correction: start above them.
         let first = (0..nl).position(|k| !level(k).is_empty()).unwrap_or(nl - 1);
-        // Coarsest last: each transfer reads its columns from the pattern of its fine
-        // level, known once the finer levels' Galerkin patterns are.
         let mut transfers = Vec::with_capacity(nl - 1 - first);
-        let mut patterns = vec![pattern];
-        for (k, refinement) in refinements.iter().enumerate().skip(first).rev() {
-            let fine = patterns.last().expect("the finest pattern");
-            let t = Transfer::nested(refinement, level(k), level(k + 1), fine)?;
-            let coarse = t.galerkin_pattern(fine);
-            transfers.push(t);
-            patterns.push(Arc::new(coarse));
+        for (k, refinement) in refinements.iter().enumerate().skip(first) {
+            transfers.push(Transfer::new(refinement, level(k), level(k + 1))?);
         }
-        transfers.reverse();
-        patterns.reverse();
         let sizes = (first..nl).map(|k| level(k).len()).collect();
         let dofs: Vec<DofMap> = dofs.into_iter().skip(first).collect();
+        // Coarsest last: each transfer reads its columns from the pattern of its fine
+        // level, known once the finer levels' Galerkin patterns are.
+        let mut patterns = vec![pattern];
+        for t in transfers.iter_mut().rev() {
+            let fine = patterns.last().expect("the finest pattern");
+            *t = std::mem::replace(t, Transfer::aggregation(&[], 0)).with_columns_from(fine);
+            let coarse = t.galerkin_pattern(fine);
+            patterns.push(Arc::new(coarse));
+        }
+        patterns.reverse();
         Ok(Levels {
             kind: Kind::Geometric,
             sizes,

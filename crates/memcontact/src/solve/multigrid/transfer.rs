@@ -77,50 +77,6 @@ impl Transfer {
     /// P between the unknowns of two consecutive levels. `refinement.parents` must have one
     /// entry per fine vertex, each naming coarse vertices; anything else is an error.
     pub fn new(refinement: &Refinement, coarse: &DofMap, fine: &DofMap) -> Result<Transfer> {
-        let (parents, weights) = Transfer::rows(refinement, coarse, fine)?;
-        Ok(Transfer::from_rows(parents, weights, coarse.len()))
-    }
-
-    /// [`Transfer::new`] between nested meshes whose fine level's operator has the pattern
-    /// `fine_pattern`: the columns are read from that pattern when it holds them (as
-    /// [`Transfer::with_columns_from`] would choose, found from the rows alone, so that
-    /// the stored columns are never built), else stored.
-    pub fn nested(
-        refinement: &Refinement,
-        coarse: &DofMap,
-        fine: &DofMap,
-        fine_pattern: &Arc<Pattern>,
-    ) -> Result<Transfer> {
-        let (parents, weights) = Transfer::rows(refinement, coarse, fine)?;
-        let n_coarse = coarse.len();
-        let weight_code: Vec<u8> = weights
-            .par_iter()
-            .with_min_len(4096)
-            .map(|&w| weight_code(w))
-            .collect();
-        match fine_rows(&parents, &weight_code, n_coarse, fine_pattern) {
-            Some((on, whole)) => Ok(Transfer {
-                n_coarse,
-                single_parent: weights.par_iter().with_min_len(4096).all(|w| w[1] == 0.0),
-                parents,
-                weight_code,
-                columns: Columns::FineRows {
-                    on,
-                    fine: fine_pattern.clone(),
-                    whole,
-                },
-            }),
-            None => Ok(Transfer::from_rows(parents, weights, n_coarse)),
-        }
-    }
-
-    /// The rows of [`Transfer::new`]: every fine unknown's parents and their weights.
-    #[allow(clippy::type_complexity)]
-    fn rows(
-        refinement: &Refinement,
-        coarse: &DofMap,
-        fine: &DofMap,
-    ) -> Result<(Vec<[u32; 2]>, Vec<[f32; 2]>)> {
         let n_cv = coarse.n_vertices();
         if refinement.parents.len() != fine.n_vertices() {
             return Err(Error::Mesh(format!(
@@ -160,11 +116,12 @@ impl Transfer {
                 }
             }
         };
-        Ok(if n_fine >= VECTOR_ROWS {
+        let (parents, weights): (Vec<[u32; 2]>, Vec<[f32; 2]>) = if n_fine >= VECTOR_ROWS {
             fine.vertex.par_iter().with_min_len(4096).map(map).unzip()
         } else {
             fine.vertex.iter().map(map).unzip()
-        })
+        };
+        Ok(Transfer::from_rows(parents, weights, coarse.len()))
     }
 
     /// The piecewise-constant prolongation of an aggregation: fine unknown `v` belongs to
@@ -547,70 +504,6 @@ impl Transfer {
             *d = any;
         });
     }
-}
-
-/// The columns of P read from the fine pattern, from P's rows alone (`parents` and their
-/// `weight_code`s): per coarse unknown, the one fine unknown of weight 1 on it, and
-/// whether every row so read holds nothing but children (see [`Columns::FineRows`]).
-/// `None` when some coarse unknown has no single fine unknown of weight 1 on it, or when
-/// the row of that fine unknown misses one of its children: the pattern does not hold
-/// the columns. The children are then those [`Transfer::with_columns_from`] checks
-/// against the stored columns (each row's entries are distinct, so a row holding as many
-/// children as the coarse unknown has holds them all, in increasing order).
-fn fine_rows(
-    parents: &[[u32; 2]],
-    weight_code: &[u8],
-    n_coarse: usize,
-    fine: &Pattern,
-) -> Option<(Vec<u32>, bool)> {
-    use std::sync::atomic::{AtomicU32, Ordering::Relaxed};
-    if fine.n() != parents.len() {
-        return None;
-    }
-    // Per coarse unknown: its children, those of weight 1, and (when it is the only one)
-    // the fine unknown of weight 1. Counts are sums: the same in any order.
-    let zeros = || -> Vec<AtomicU32> { (0..n_coarse).map(|_| AtomicU32::new(0)).collect() };
-    let (children, ones, on) = (zeros(), zeros(), zeros());
-    parents
-        .par_iter()
-        .zip(weight_code.par_iter())
-        .enumerate()
-        .with_min_len(4096)
-        .for_each(|(w, (p, &code))| {
-            let wt = WEIGHTS[code as usize];
-            for s in 0..2 {
-                if wt[s] != 0.0 {
-                    let i = p[s] as usize;
-                    children[i].fetch_add(1, Relaxed);
-                    if wt[s] == 1.0 {
-                        ones[i].fetch_add(1, Relaxed);
-                        on[i].store(w as u32, Relaxed);
-                    }
-                }
-            }
-        });
-    let weight_of = |w: usize, i: usize| {
-        let [p0, p1] = parents[w];
-        let [w0, w1] = WEIGHTS[weight_code[w] as usize];
-        (p0 as usize == i && w0 != 0.0) || (p1 as usize == i && w1 != 0.0)
-    };
-    let rows: Option<Vec<(u32, bool)>> = (0..n_coarse)
-        .into_par_iter()
-        .with_min_len(4096)
-        .map(|i| {
-            if ones[i].load(Relaxed) != 1 {
-                return None;
-            }
-            let v = on[i].load(Relaxed);
-            let row = &fine.col[fine.ptr(v as usize)..fine.ptr(v as usize + 1)];
-            let held = row.iter().filter(|&&w| weight_of(w as usize, i)).count();
-            let count = children[i].load(Relaxed) as usize;
-            (held == count).then_some((v, row.len() == count))
-        })
-        .collect();
-    let rows = rows?;
-    let whole = rows.par_iter().all(|x| x.1);
-    Some((rows.into_par_iter().map(|x| x.0).collect(), whole))
 }
 
 /// The Galerkin patterns of a chain of transfers, coarsest first, ending with `finest`
