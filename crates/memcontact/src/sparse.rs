@@ -440,8 +440,22 @@ where
     T: Copy + Default + Send + Sync,
 {
     if n_keys < PARALLEL_KEYS || keys_follow_items(n_keys, m, &entries) {
-        return group_by_key_by_ranges(n_keys, m, entries);
+        group_by_key_by_ranges(n_keys, m, entries)
+    } else {
+        group_by_key_in_buckets(n_keys, m, entries)
     }
+}
+
+/// [`group_by_key`] for scattered keys: chunks of items sorted by buckets of
+/// [`KEY_BUCKET`] keys, then every bucket sorted by key.
+fn group_by_key_in_buckets<T, const K: usize>(
+    n_keys: usize,
+    m: usize,
+    entries: impl Fn(usize) -> [Option<(u32, T)>; K] + Sync,
+) -> (Vec<usize>, Vec<T>)
+where
+    T: Copy + Default + Send + Sync,
+{
     // Items per chunk of the first pass: at least 2¹⁴, at most 256 chunks (each keeps a
     // counter per bucket).
     let chunk = (1 << 14).max(m.div_ceil(256));
