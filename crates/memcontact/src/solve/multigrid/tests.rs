@@ -648,16 +648,37 @@ fn forcing_is_quadratic_until_the_tolerance_is_near() {
 fn transfer_columns_read_from_the_fine_pattern_give_the_same_sums() {
     use crate::solve::newton::NewtonStates;
     let disk = crate::mesh::generate::disk([0.0, 0.0], 1.0, 0.3).unwrap();
-    for (name, h) in [
-        ("square", square_hierarchy(4, 4)),
-        ("disc", Hierarchy::refined(disk, 3)),
+    // Local refinement: newest-vertex bisection of the triangles near one corner, twice
+    // (most coarse unknowns have no child but the one on them).
+    let local = {
+        use crate::adapt::bisect::{bisect, label_longest_edge};
+        let mut h = Hierarchy::single(label_longest_edge(&square(12)));
+        for _ in 0..2 {
+            let mesh = h.finest();
+            let marked: Vec<u32> = (0..mesh.n_triangles() as u32)
+                .filter(|&k| {
+                    let c = mesh.triangles[k as usize].map(|v| mesh.points[v as usize]);
+                    c.iter().all(|p| p[0] + p[1] < 0.8)
+                })
+                .collect();
+            let b = bisect(mesh, &marked).unwrap();
+            h.levels.push(b.mesh);
+            h.refinements.push(b.refinement);
+        }
+        h
+    };
+    for (name, h, whole) in [
+        ("square", square_hierarchy(4, 4), true),
+        ("disc", Hierarchy::refined(disk, 3), true),
+        ("local", local, false),
     ] {
         let model = bench_model(h.finest(), Some(1000.0), Foundation::Lumped);
         let levels = Levels::new(&h, &model.dofs, model.s.pattern.clone()).unwrap();
-        // Every geometric transfer reads its columns from its fine level's pattern.
+        // Every geometric transfer reads its columns from its fine level's pattern: whole
+        // rows under uniform refinement, the children's positions under local refinement.
         for t in &levels.transfers {
             assert!(
-                t.columns_from_fine_rows() && t.columns_are_whole_rows(),
+                t.columns_from_fine_rows() && t.columns_are_whole_rows() == whole,
                 "{name}"
             );
         }

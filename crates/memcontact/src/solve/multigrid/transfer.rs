@@ -65,11 +65,14 @@ enum Columns {
     /// children, so that every sum over them is the same). Checked when chosen
     /// ([`Transfer::with_columns_from`]); nothing per child is stored.
     /// With `whole`, every entry of those rows is a child, of weight ½ but `on[I]` itself
-    /// (weight 1): the weights need not be looked up.
+    /// (weight 1): the weights need not be looked up. Otherwise (a locally refined level,
+    /// where most coarse unknowns have no child but the one on them) `masks[I]` marks the
+    /// positions of the children in that row, of the same weights: bit k for entry k.
     FineRows {
         on: Vec<u32>,
         fine: Arc<Pattern>,
         whole: bool,
+        masks: Vec<u32>,
     },
 }
 
@@ -186,7 +189,8 @@ impl Transfer {
     /// vertex's children are the fine vertex on it and the midpoints of its edges, all
     /// neighbours of that vertex). Otherwise (aggregation, other patterns) unchanged. The
     /// same children in the same order: every result is bitwise the same, and the columns
-    /// take 4 bytes per coarse unknown instead of about 7 per fine one.
+    /// take 4 bytes per coarse unknown (8 on a locally refined level, with the children's
+    /// positions) instead of about 7 per fine one.
     pub fn with_columns_from(self, fine: &Arc<Pattern>) -> Transfer {
         let Columns::Stored {
             child_ptr,
@@ -202,8 +206,8 @@ impl Transfer {
         // The child of weight 1 of every coarse unknown, and its row's matching entries
         // counted against the stored children.
         // Per coarse unknown: (the fine unknown on it, whether its row holds nothing but
-        // its children, all of weight ½ but itself).
-        let on: Option<Vec<(u32, bool)>> = (0..self.n_coarse)
+        // its children, the positions of the children in its row).
+        let on: Option<Vec<(u32, bool, Option<u32>)>> = (0..self.n_coarse)
             .into_par_iter()
             .with_min_len(4096)
             .map(|i| {
@@ -212,28 +216,45 @@ impl Transfer {
                 let v = children[k] as usize;
                 let row = &fine.col[fine.ptr(v)..fine.ptr(v + 1)];
                 let mut next = lo;
-                for &w in row {
+                // The children's positions (none when one lies beyond the 32nd entry).
+                let mut mask = Some(0u32);
+                for (pos, &w) in row.iter().enumerate() {
                     if self.weight_of(w as usize, i) != 0.0 {
-                        if next == hi || children[next] != w {
+                        // Weight 1 on v itself and ½ on every other child, as the rows'
+                        // columns assume.
+                        if next == hi
+                            || children[next] != w
+                            || child_code[next] != (w as usize != v) as u8
+                        {
                             return None;
                         }
+                        mask = mask.filter(|_| pos < 32).map(|m| m | 1 << pos);
                         next += 1;
                     }
                 }
                 // Codes are 0 (weight 1) or 1 (weight ½): one child of weight 1, v itself.
                 let ones = child_code[lo..hi].iter().filter(|&&c| c == 0).count();
                 let whole = row.len() == hi - lo && ones == 1;
-                (next == hi).then_some((v as u32, whole))
+                (next == hi).then_some((v as u32, whole, mask))
             })
             .collect();
         match on {
             Some(on) => {
                 let whole = on.par_iter().all(|x| x.1);
+                let masks = if whole {
+                    Vec::new()
+                } else {
+                    match on.par_iter().with_min_len(4096).map(|x| x.2).collect() {
+                        Some(masks) => masks,
+                        None => return self,
+                    }
+                };
                 Transfer {
                     columns: Columns::FineRows {
                         on: on.into_par_iter().map(|x| x.0).collect(),
                         fine: fine.clone(),
                         whole,
+                        masks,
                     },
                     ..self
                 }
@@ -273,19 +294,26 @@ impl Transfer {
                     );
                 }
             }
-            Columns::FineRows { on, fine, whole } => {
+            Columns::FineRows {
+                on,
+                fine,
+                whole,
+                masks,
+            } => {
                 let v = on[i] as usize;
                 let row = &fine.col[fine.ptr(v)..fine.ptr(v + 1)];
+                let weight = |w: usize| if w == v { 1.0 } else { 0.5 };
                 if *whole {
                     for &w in row {
-                        f(w as usize, if w as usize == v { 1.0 } else { 0.5 });
+                        f(w as usize, weight(w as usize));
                     }
                 } else {
-                    for &w in row {
-                        let wt = self.weight_of(w as usize, i);
-                        if wt != 0.0 {
-                            f(w as usize, wt);
-                        }
+                    // The set bits, lowest first: the children in increasing order.
+                    let mut mask = masks[i];
+                    while mask != 0 {
+                        let w = row[mask.trailing_zeros() as usize] as usize;
+                        mask &= mask - 1;
+                        f(w, weight(w));
                     }
                 }
             }
