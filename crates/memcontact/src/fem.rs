@@ -123,7 +123,10 @@ impl Element {
     /// c at the points of the degree-5 rule ([`DEGREE5`]) on this triangle.
     #[inline]
     fn quadrature_values(&self, c: &dyn Coefficient, region: u32) -> [f64; 7] {
-        DEGREE5.map(|(l, _)| c.at(map(&self.corners, &l), region))
+        let points = DEGREE5.map(|(l, _)| map(&self.corners, &l));
+        let mut values = [0.0; 7];
+        c.at_points(&points, region, &mut values);
+        values
     }
 }
 

@@ -97,10 +97,12 @@ pub fn estimate(
             let any_rigid = tri
                 .iter()
                 .any(|&v| rigid[v as usize] && rho[v as usize] > 0.0);
-            for (b, w) in DEGREE5 {
-                let p = map(&c, &b);
+            let points = DEGREE5.map(|(b, _)| map(&c, &b));
+            let mut f = [0.0; DEGREE5.len()];
+            load.at_points(&points, region, &mut f);
+            for ((b, w), (p, f)) in DEGREE5.into_iter().zip(points.into_iter().zip(f)) {
                 let rho_p: f64 = (0..3).map(|a| b[a] * rho[tri[a] as usize]).sum();
-                let r = load.at(p, region) - rho_p;
+                let r = f - rho_p;
                 r2 += w * r * r;
                 if any_rigid {
                     let up: f64 = (0..3)

@@ -326,6 +326,16 @@ impl Coefficient for BoundField {
     fn at(&self, p: [f64; 2], region: u32) -> f64 {
         self.eval(p, region)
     }
+    fn at_points(&self, points: &[[f64; 2]], region: u32, out: &mut [f64]) {
+        match self.value(region) {
+            Some(Value::Expr(e)) => e.eval_many(points, out),
+            value => {
+                for (o, &p) in out.iter_mut().zip(points) {
+                    *o = value.map_or(f64::NAN, |v| v.eval(p));
+                }
+            }
+        }
+    }
     fn on_region(&self, region: u32) -> Option<f64> {
         self.region_constant(region)
     }

@@ -10,6 +10,13 @@ pub trait Coefficient: Sync {
     /// The value on a whole region, when constant there (assembly then uses exact
     /// closed-form element integrals instead of quadrature).
     fn on_region(&self, region: u32) -> Option<f64>;
+    /// The values at `points` of a triangle of region `region` into `out` (of the same
+    /// length): [`Coefficient::at`] at each, or what gives the same values faster.
+    fn at_points(&self, points: &[Point], region: u32, out: &mut [f64]) {
+        for (o, &p) in out.iter_mut().zip(points) {
+            *o = self.at(p, region);
+        }
+    }
 }
 
 impl Coefficient for f64 {
