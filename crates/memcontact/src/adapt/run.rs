@@ -7,11 +7,14 @@ use crate::discretization::{build_mesh, check_case_on_mesh, BoundData, Discretiz
 use crate::error::{Error, Invalid, Result};
 use crate::field::{Field, Stiffness};
 use crate::mesh::boundary::FixedBoundary;
+use crate::mesh::refine::{Hierarchy, Refinement};
+use crate::mesh::reorder::renumbering_for_locality;
 use crate::mesh::{Mesh, VertexTriangles};
 use crate::outcome::summary::AdaptTotals;
 use crate::outcome::Outcome;
 use crate::problem::Problem;
 use crate::solve::{Cancellable, Observer};
+use rayon::prelude::*;
 use std::time::Instant;
 
 /// Why the adaptive loop stopped.
@@ -205,8 +208,10 @@ pub fn run_adapt(
         }
         start = Some(b.refinement.prolongate(&u_user));
         interpolate_nodal(&mut problem, &b.refinement, &mut interpolated);
+        let mut refinement = b.refinement;
+        renumber_finished_level(&mut hierarchy, &mut refinement);
         hierarchy.levels.push(b.mesh);
-        hierarchy.refinements.push(b.refinement);
+        hierarchy.refinements.push(refinement);
         step += 1;
     };
     let (outcome, indicators) = kept.expect("step 0 is kept or is an error");
@@ -220,6 +225,35 @@ pub fn run_adapt(
         problem,
         seconds: started.elapsed().as_secs_f64(),
     })
+}
+
+/// The finest level of `hierarchy`, solved and refined (`next` leads from it to the next
+/// mesh), renumbered for locality as every step's discretization would renumber it, with
+/// the relations into and out of it renumbered to match. Done once here, every later step
+/// finds this coarse level's order already local and keeps it, instead of renumbering
+/// every level of the growing hierarchy at every step; the numbering of every level is the
+/// same as before, so the results are too.
+fn renumber_finished_level(hierarchy: &mut Hierarchy, next: &mut Refinement) {
+    let last = hierarchy.levels.len() - 1;
+    let Some(order) = renumbering_for_locality(&hierarchy.levels[last]) else {
+        return;
+    };
+    let order = std::sync::Arc::new(order);
+    hierarchy.levels[last] = order.apply_shared(&hierarchy.levels[last]);
+    let (new_of_old, old_of_new) = (&order.vertices.new_of_old, &order.vertices.old_of_new);
+    if let Some(into) = last.checked_sub(1).map(|k| &mut hierarchy.refinements[k]) {
+        into.parents = old_of_new
+            .par_iter()
+            .with_min_len(8192)
+            .map(|&old| into.parents[old as usize])
+            .collect();
+    }
+    next.parents
+        .par_iter_mut()
+        .with_min_len(8192)
+        .for_each(|p| {
+            *p = p.map(|c| new_of_old[c as usize]);
+        });
 }
 
 /// The checks of `[adapt]` that need the start mesh: `max_vertices` at least its vertices,
@@ -314,6 +348,56 @@ fn interpolate_nodal(
         carry("lower.shape", &mut low.shape);
         if let Stiffness::Elastic(h) = &mut low.stiffness {
             carry("lower.stiffness", h);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::adapt::bisect::{bisect, label_longest_edge};
+
+    /// The loop's hierarchy after `steps` bisections of the triangles near one corner of
+    /// the unit square, with or without renumbering each finished level as the loop does.
+    fn grown(steps: usize, renumber: bool) -> Hierarchy {
+        let mut h = Hierarchy::single(label_longest_edge(&crate::mesh::test_square(10)));
+        for _ in 0..steps {
+            let mesh = h.finest();
+            let marked: Vec<u32> = (0..mesh.n_triangles() as u32)
+                .filter(|&k| {
+                    let c = mesh.triangles[k as usize].map(|v| mesh.points[v as usize]);
+                    c.iter().all(|p| p[0] + 2.0 * p[1] < 0.9)
+                })
+                .collect();
+            let b = bisect(mesh, &marked).unwrap();
+            let mut refinement = b.refinement;
+            if renumber {
+                renumber_finished_level(&mut h, &mut refinement);
+            }
+            h.levels.push(b.mesh);
+            h.refinements.push(refinement);
+        }
+        h
+    }
+
+    #[test]
+    fn levels_renumbered_once_are_those_every_step_would_renumber() {
+        let (plain, once) = (grown(6, false), grown(6, true));
+        let (a, orders_a) = plain.reordered();
+        let (b, orders_b) = once.reordered();
+        // Without the loop's renumbering, bisected levels are scattered and renumbered at
+        // every step; with it, only the newest level is left to renumber.
+        let renumbered = |o: &[Option<_>]| o.iter().filter(|x| x.is_some()).count();
+        assert!(renumbered(&orders_a[..6]) >= 2);
+        assert_eq!(renumbered(&orders_b[..6]), 0);
+        // The same numbering of every level and the same relations between them.
+        for (k, (ma, mb)) in a.levels.iter().zip(&b.levels).enumerate() {
+            assert_eq!(ma.points, mb.points, "level {k}");
+            assert_eq!(ma.triangles, mb.triangles, "level {k}");
+            assert_eq!(ma.regions, mb.regions, "level {k}");
+        }
+        for (k, (ra, rb)) in a.refinements.iter().zip(&b.refinements).enumerate() {
+            assert_eq!(ra.parents, rb.parents, "relation {k}");
         }
     }
 }

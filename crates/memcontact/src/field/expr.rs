@@ -46,7 +46,7 @@ const MAX_TREE_DEPTH: u32 = 1000;
 /// Programs needing at most this many stack slots evaluate without allocating.
 const INLINE_STACK: usize = 24;
 /// Points evaluated together by [`Expr::eval_many`].
-pub const LANES: usize = 8;
+const LANES: usize = 8;
 
 /// A compiled scalar expression of `x` and `y`.
 ///
@@ -118,7 +118,7 @@ impl Expr {
     }
 
     /// The values at the points `points` into `out` (of the same length), bitwise those of
-    /// [`Expr::eval`] at each. Without `if` the program runs once per [`LANES`] points, every
+    /// [`Expr::eval`] at each. Without `if` the program runs once per eight points, every
     /// instruction on all of them: the interpreter's dispatch is paid once per batch, not
     /// once per point (assembly and the error estimator evaluate f at seven quadrature
     /// points of every triangle).
