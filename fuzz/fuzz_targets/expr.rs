@@ -1,6 +1,7 @@
 //! The expression compiler and evaluator: any text either parses or is refused with a
-//! message; a parsed expression evaluates at any point without panicking, and a constant
-//! expression evaluates to its constant everywhere.
+//! message; a parsed expression evaluates at any point without panicking, a constant
+//! expression evaluates to its constant everywhere, and evaluating many points at once
+//! gives each point's own value.
 #![no_main]
 
 use libfuzzer_sys::fuzz_target;
@@ -25,6 +26,12 @@ fuzz_target!(|data: &[u8]| {
             }
             // Evaluation is a pure function of the point.
             assert_eq!(e.eval(x, y).to_bits(), v.to_bits());
+            // Many points at once give each point's value (a NaN is any NaN).
+            let mut many = [0.0; 2];
+            e.eval_many(&[[x, y], [0.5, -0.25]], &mut many);
+            for (m, one) in many.into_iter().zip([v, w]) {
+                assert!(m.to_bits() == one.to_bits() || (m.is_nan() && one.is_nan()));
+            }
         }
         Err(err) => {
             // Messages stay short whatever the input's length.
