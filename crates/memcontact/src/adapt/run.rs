@@ -229,10 +229,10 @@ pub fn run_adapt(
 
 /// The finest level of `hierarchy`, solved and refined (`next` leads from it to the next
 /// mesh), renumbered for locality as every step's discretization would renumber it, with
-/// the relations into and out of it renumbered to match. Done once here, every later step
-/// finds this coarse level's order already local and keeps it, instead of renumbering
-/// every level of the growing hierarchy at every step; the numbering of every level is the
-/// same as before, so the results are too.
+/// the relations into and out of it renumbered to match. Done once here, so that every
+/// later step finds this coarse level's order already local and keeps it instead of
+/// renumbering every level of the growing hierarchy again; every level ends with the
+/// numbering it had before, so the results are the same.
 fn renumber_finished_level(hierarchy: &mut Hierarchy, next: &mut Refinement) {
     let last = hierarchy.levels.len() - 1;
     let Some(order) = renumbering_for_locality(&hierarchy.levels[last]) else {
