@@ -436,12 +436,15 @@ pub struct Attempt {
 pub const ALGEBRAIC_FROM: usize = 10_000;
 
 /// The one `auto` policy: linear when no body can touch (L = 0), multigrid on the mesh's
-/// refinement hierarchy when it has one, multigrid on an algebraic hierarchy for a large
-/// mesh without one, the active-set method otherwise; with the reason.
+/// refinement hierarchy when it has one (of three levels or more, or of two for a large
+/// mesh), multigrid on an algebraic hierarchy for a large mesh without one, the
+/// active-set method otherwise; with the reason.
 pub fn auto_choice(model: &Model, hierarchy: Option<&Hierarchy>) -> (Method, Choice) {
+    let depth = hierarchy.map_or(0, Hierarchy::depth);
     if model.is_linear() {
         (Method::Linear, Choice::LinearProblem)
-    } else if hierarchy.is_some_and(|h| h.depth() >= 3) {
+    } else if depth >= 3 || (depth == 2 && model.n() >= ALGEBRAIC_FROM) {
+        // Multigrid runs on the mesh levels whenever there are two (see `run_method`).
         (Method::Multigrid, Choice::GeometricHierarchy)
     } else if model.n() >= ALGEBRAIC_FROM {
         (Method::Multigrid, Choice::AlgebraicHierarchy)

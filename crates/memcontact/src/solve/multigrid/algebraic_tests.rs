@@ -290,3 +290,82 @@ fn scaled_aggregation_levels_deflect_like_the_fine_mesh() {
         assert!((0.8..1.25).contains(&ratio), "{which} level: {ratio}");
     }
 }
+
+/// A mesh hierarchy whose coarsest mesh is large (an unstructured disc of more than
+/// [`COARSEST`](super::aggregation::COARSEST) unknowns refined once, as `refine = 1` makes
+/// of an imported mesh) gets aggregation levels below it instead of a factorisation of the
+/// whole coarsest mesh: the mesh levels unchanged above, the patterns those of the
+/// symbolic products, and TNNMG on them (the hybrid cycle) agreeing with the active-set
+/// method, with and without nested iteration. A small coarsest mesh keeps its levels.
+#[test]
+fn large_coarsest_meshes_get_aggregation_levels_below() {
+    use super::aggregation::COARSEST;
+    use crate::mesh::refine::Hierarchy;
+    let h = Hierarchy::refined(disk([0.0, 0.0], 1.0, 0.03).unwrap(), 1);
+    let m = model(h.finest(), Some(&300.0), Foundation::Lumped);
+    let mesh_levels = Levels::new(&h, &m.dofs, m.s.pattern.clone()).unwrap();
+    assert!(mesh_levels.sizes[0] > COARSEST, "{:?}", mesh_levels.sizes);
+    let levels = mesh_levels
+        .clone()
+        .with_aggregation_below(&setup_matrix(&m));
+    let below = levels.aggregated;
+    assert!(below >= 1, "{:?}", levels.sizes);
+    assert_eq!(levels.len(), below + mesh_levels.len());
+    assert_eq!(levels.sizes[below..], mesh_levels.sizes[..]);
+    assert!(levels.sizes[0] <= COARSEST, "{:?}", levels.sizes);
+    assert!(levels.sizes.windows(2).all(|w| w[0] < w[1]));
+    let direct = super::transfer::galerkin_patterns(&levels.transfers, m.s.pattern.clone());
+    for (p, q) in levels.patterns.iter().zip(&direct) {
+        assert_eq!((&p.row_ptr, &p.col), (&q.row_ptr, &q.col));
+    }
+    let reference = active_set::solve(&m, &settings(), None, &mut Silent).unwrap();
+    for nested in [true, false] {
+        let what = format!("refined disc, nested {nested}");
+        let options = TnnmgOptions {
+            nested,
+            ..TnnmgOptions::default()
+        };
+        let (sol, rep) = solve_with(
+            &m,
+            Coarsening::Geometric(&h),
+            &settings(),
+            &options,
+            None,
+            &mut Silent,
+        )
+        .unwrap();
+        assert_eq!(sol.coarsening, Some(Kind::Geometric));
+        assert!(
+            sol.certificate.kkt() <= 1e-11,
+            "{what}: {:?}",
+            sol.certificate
+        );
+        let d = rel_diff(&sol.u, &reference.u);
+        assert!(d < 1e-8, "{what}: differs from active set by {d:e}");
+        for w in sol.history.windows(2) {
+            assert!(
+                w[1].energy <= w[0].energy + 1e-13 * w[0].energy.abs(),
+                "{what}"
+            );
+        }
+        let solved = if nested { levels.len() } else { 1 };
+        assert_eq!(rep.levels.len(), solved, "{what}: levels reported");
+        // From zero the hard start costs a few iterations more, as on any levels.
+        let limit = if nested { 4 } else { 10 };
+        assert!(
+            sol.iterations <= limit,
+            "{what}: {} iterations",
+            sol.iterations
+        );
+    }
+    // A coarsest mesh the factorisation takes whole keeps the mesh levels alone.
+    let h = Hierarchy::refined(disk([0.0, 0.0], 1.0, 0.3).unwrap(), 2);
+    let m = model(h.finest(), Some(&300.0), Foundation::Lumped);
+    let levels = Levels::new(&h, &m.dofs, m.s.pattern.clone()).unwrap();
+    let (len, sizes) = (levels.len(), levels.sizes.clone());
+    let levels = levels.with_aggregation_below(&setup_matrix(&m));
+    assert_eq!(
+        (levels.aggregated, levels.len(), levels.sizes),
+        (0, len, sizes)
+    );
+}

@@ -18,7 +18,7 @@
 //! * Coarsest level: sparse Cholesky ([`Cholesky`], symbolic analysis once), zero rows
 //!   replaced by the identity.
 
-use super::levels::{Kind, Levels};
+use super::levels::Levels;
 use super::operator::{apply, values_into, zero_held, TopOperator};
 use super::smoother::*;
 
@@ -77,7 +77,7 @@ impl<'a> Multigrid<'a> {
             smoothing: (1, 1),
             krylov: (0..top)
                 .map(|k| {
-                    if levels.kind == Kind::Algebraic && k > 0 {
+                    if k > 0 && k <= levels.aggregated {
                         [zeros(k), zeros(k), zeros(k)]
                     } else {
                         Default::default()
@@ -202,9 +202,10 @@ impl<'a> Multigrid<'a> {
     /// One cycle for `A x = b` on the top level: the V-cycle on a geometric hierarchy, the
     /// K-cycle on an algebraic one (see [`Multigrid::v_cycle`], [`Multigrid::k_cycle`]).
     pub fn cycle<A: TopOperator>(&mut self, fine: &A, x: &mut [f64], b: &[f64]) {
-        match self.levels.kind {
-            Kind::Geometric => self.v_cycle(fine, x, b),
-            Kind::Algebraic => self.k_cycle(fine, x, b),
+        if self.top <= self.levels.aggregated {
+            self.k_cycle(fine, x, b)
+        } else {
+            self.v_cycle(fine, x, b)
         }
     }
 
@@ -226,7 +227,7 @@ impl<'a> Multigrid<'a> {
             return false;
         }
         self.presmooth_top(fine, x, b, true);
-        let krylov = self.levels.kind == Kind::Algebraic;
+        let krylov = self.top <= self.levels.aggregated;
         self.cycle_below(fine, x, b, product, krylov)
     }
 
@@ -547,13 +548,19 @@ impl<'a> Multigrid<'a> {
         if krylov {
             self.krylov_correction(top - 1);
         } else {
-            for k in (1..top).rev() {
+            // Down to the coarsest mesh level, whose correction is the direct solve, or
+            // the K-cycle's on the aggregation levels below it.
+            let base = self.levels.aggregated;
+            for k in (base + 1..top).rev() {
                 self.presmooth_and_restrict(k);
             }
-            // Bottom: the direct solve.
-            self.solve_coarsest_in_place(Some(0));
+            if base == 0 {
+                self.solve_coarsest_in_place(Some(0));
+            } else {
+                self.krylov_correction(base);
+            }
             // Up: prolongate the correction, smooth.
-            for k in 1..top {
+            for k in base + 1..top {
                 self.prolongate_and_postsmooth(k, None);
             }
         }

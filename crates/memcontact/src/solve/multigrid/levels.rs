@@ -39,6 +39,13 @@ pub struct Levels {
     pub transfers: Vec<Transfer>,
     /// What the smoother reads from every level's pattern, coarsest first.
     pub(crate) sweep_rows: Vec<SweepRows>,
+    /// The number of aggregation transfers at the bottom of the hierarchy: levels
+    /// `0..=aggregated` are solved by the K-cycle ([`super::cycle::Multigrid::k_cycle`]),
+    /// the levels above by the V-cycle. All of them on an algebraic hierarchy, none on the
+    /// levels of a mesh hierarchy whose coarsest mesh is small; on one whose coarsest mesh
+    /// is large (an imported mesh refined uniformly), the aggregation levels below it
+    /// ([`Levels::with_aggregation_below`]).
+    pub aggregated: usize,
 }
 
 impl Levels {
@@ -121,6 +128,7 @@ impl Levels {
         patterns.reverse();
         Ok(Levels {
             kind: Kind::Geometric,
+            aggregated: 0,
             sizes,
             dofs,
             sweep_rows: patterns.iter().map(|p| SweepRows::of(p)).collect(),
@@ -135,12 +143,64 @@ impl Levels {
         let (transfers, sizes, patterns) = super::aggregation::hierarchy(a, coarsest);
         Levels {
             kind: Kind::Algebraic,
+            aggregated: sizes.len() - 1,
             sizes,
             dofs: Vec::new(),
             sweep_rows: patterns.iter().map(|p| SweepRows::of(p)).collect(),
             patterns,
             transfers,
         }
+    }
+
+    /// These mesh levels with aggregation levels below the coarsest mesh when it has more
+    /// than [`super::aggregation::COARSEST`] unknowns (an imported mesh refined uniformly),
+    /// so that the coarsest level is not factorised whole: its Galerkin operator, from
+    /// `a` (the finest level's operator, on the finest pattern) through the mesh levels,
+    /// is aggregated as an algebraic hierarchy is. Otherwise unchanged.
+    pub fn with_aggregation_below(self, a: &Csr) -> Levels {
+        use super::aggregation::{hierarchy, COARSEST};
+        if self.kind != Kind::Geometric || self.aggregated > 0 || self.sizes[0] <= COARSEST {
+            return self;
+        }
+        // The operator of every mesh level, finest to coarsest; the coarsest is kept.
+        let mut coarse: Option<Csr> = None;
+        for (k, t) in self.transfers.iter().enumerate().rev() {
+            let mut c = Csr::zeros(self.patterns[k].clone());
+            t.galerkin_values(coarse.as_ref().unwrap_or(a), &mut c, None);
+            coarse = Some(c);
+        }
+        let Some(bottom) = coarse else { return self };
+        let (below, sizes, patterns) = hierarchy(&bottom, COARSEST);
+        if below.is_empty() {
+            return self;
+        }
+        let m = below.len();
+        // The aggregation levels' list without its finest (the coarsest mesh level, which
+        // the mesh levels have), then the mesh levels'.
+        fn join<T>(mut low: Vec<T>, high: Vec<T>) -> Vec<T> {
+            low.pop();
+            low.extend(high);
+            low
+        }
+        let sweep_below: Vec<SweepRows> = patterns[..m].iter().map(|p| SweepRows::of(p)).collect();
+        let mut sweep_rows = sweep_below;
+        sweep_rows.extend(self.sweep_rows);
+        let mut transfers = below;
+        transfers.extend(self.transfers);
+        Levels {
+            kind: Kind::Geometric,
+            aggregated: m,
+            sizes: join(sizes, self.sizes),
+            dofs: self.dofs,
+            patterns: join(patterns, self.patterns),
+            transfers,
+            sweep_rows,
+        }
+    }
+
+    /// The unknowns of mesh level `k` (not an aggregation level, nor the finest).
+    pub fn dofs_of(&self, k: usize) -> &DofMap {
+        &self.dofs[k - self.aggregated]
     }
 
     /// Number of levels.

@@ -240,6 +240,7 @@ pub fn solve_with(
         Coarsening::Geometric(h) => {
             built = timer.time("setup", || {
                 Levels::new(h, &model.dofs, model.s.pattern.clone())
+                    .map(|l| l.with_aggregation_below(&setup_matrix(model)))
             })?;
             &built
         }
@@ -305,9 +306,10 @@ pub fn solve_with(
         let tol = if k == top {
             settings.tolerance
         } else {
-            let nested = match levels.kind {
-                Kind::Geometric => options.nested_tolerance,
-                Kind::Algebraic => options.nested_tolerance_algebraic,
+            let nested = if k < levels.aggregated {
+                options.nested_tolerance_algebraic
+            } else {
+                options.nested_tolerance
             };
             nested.max(settings.tolerance)
         };
@@ -392,7 +394,7 @@ pub(super) fn coarse_model(fine: &Model, t: &Transfer, levels: &Levels, k: usize
         y
     };
     let mut s = galerkin(&fine.s);
-    if levels.kind == Kind::Algebraic {
+    if k < levels.aggregated {
         let factor = aggregation::stiffness_scale(t.n_fine(), t.n_coarse);
         par_rows(&mut s.val, |_, x| *x *= factor);
     }
@@ -427,9 +429,10 @@ pub(super) fn coarse_model(fine: &Model, t: &Transfer, levels: &Levels, k: usize
             epsilon: low.epsilon,
         }
     });
-    let dofs = match levels.kind {
-        Kind::Geometric => levels.dofs[k].clone(),
-        Kind::Algebraic => crate::mesh::DofMap::all(t.n_coarse),
+    let dofs = if k < levels.aggregated {
+        crate::mesh::DofMap::all(t.n_coarse)
+    } else {
+        levels.dofs_of(k).clone()
     };
     Model {
         d: restrict(&fine.d),
