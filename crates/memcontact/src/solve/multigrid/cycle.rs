@@ -16,7 +16,9 @@
 //!   from zero (every cycle of the flexible CG, every coarse level) and the residual after
 //!   it are one pass over the matrix ([`gauss_seidel_from_zero`]).
 //! * Coarsest level: sparse Cholesky ([`Cholesky`], symbolic analysis once), zero rows
-//!   replaced by the identity.
+//!   replaced by the identity. Below a large coarsest mesh the hierarchy ends with
+//!   aggregation levels ([`Levels::with_aggregation_below`]): the V-cycle's correction on
+//!   the coarsest mesh is then the K-cycle's on them.
 
 use super::levels::Levels;
 use super::operator::{apply, values_into, zero_held, TopOperator};
