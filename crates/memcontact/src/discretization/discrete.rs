@@ -147,7 +147,7 @@ impl Discretization {
                 &d.model.dofs,
                 d.model.s.pattern.clone(),
             )?
-            .with_aggregation_below(&crate::solve::multigrid::tnnmg::setup_matrix(&d.model));
+            .with_aggregation_below(|| crate::solve::multigrid::tnnmg::setup_matrix(&d.model));
             d.built = Some(Arc::new(levels));
             let seconds = t0.elapsed().as_secs_f64();
             observer.phase_finished("levels", seconds);

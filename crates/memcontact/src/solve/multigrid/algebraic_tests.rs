@@ -307,7 +307,7 @@ fn large_coarsest_meshes_get_aggregation_levels_below() {
     assert!(mesh_levels.sizes[0] > COARSEST, "{:?}", mesh_levels.sizes);
     let levels = mesh_levels
         .clone()
-        .with_aggregation_below(&setup_matrix(&m));
+        .with_aggregation_below(|| setup_matrix(&m));
     let below = levels.aggregated;
     assert!(below >= 1, "{:?}", levels.sizes);
     assert_eq!(levels.len(), below + mesh_levels.len());
@@ -363,7 +363,7 @@ fn large_coarsest_meshes_get_aggregation_levels_below() {
     let m = model(h.finest(), Some(&300.0), Foundation::Lumped);
     let levels = Levels::new(&h, &m.dofs, m.s.pattern.clone()).unwrap();
     let (len, sizes) = (levels.len(), levels.sizes.clone());
-    let levels = levels.with_aggregation_below(&setup_matrix(&m));
+    let levels = levels.with_aggregation_below(|| setup_matrix(&m));
     assert_eq!(
         (levels.aggregated, levels.len(), levels.sizes),
         (0, len, sizes)

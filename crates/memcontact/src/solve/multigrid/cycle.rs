@@ -201,8 +201,9 @@ impl<'a> Multigrid<'a> {
         steps
     }
 
-    /// One cycle for `A x = b` on the top level: the V-cycle on a geometric hierarchy, the
-    /// K-cycle on an algebraic one (see [`Multigrid::v_cycle`], [`Multigrid::k_cycle`]).
+    /// One cycle for `A x = b` on the top level: the V-cycle on mesh levels (with the
+    /// K-cycle's correction on aggregation levels below a large coarsest mesh), the K-cycle
+    /// on an algebraic hierarchy (see [`Multigrid::v_cycle`], [`Multigrid::k_cycle`]).
     pub fn cycle<A: TopOperator>(&mut self, fine: &A, x: &mut [f64], b: &[f64]) {
         if self.top <= self.levels.aggregated {
             self.k_cycle(fine, x, b)

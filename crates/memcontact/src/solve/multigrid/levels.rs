@@ -155,18 +155,19 @@ impl Levels {
     /// These mesh levels with aggregation levels below the coarsest mesh when it has more
     /// than [`super::aggregation::COARSEST`] unknowns (an imported mesh refined uniformly),
     /// so that the coarsest level is not factorised whole: its Galerkin operator, from
-    /// `a` (the finest level's operator, on the finest pattern) through the mesh levels,
-    /// is aggregated as an algebraic hierarchy is. Otherwise unchanged.
-    pub fn with_aggregation_below(self, a: &Csr) -> Levels {
+    /// the finest level's operator `a()` (on the finest pattern, formed only then) through
+    /// the mesh levels, is aggregated as an algebraic hierarchy is. Otherwise unchanged.
+    pub fn with_aggregation_below(self, a: impl FnOnce() -> Csr) -> Levels {
         use super::aggregation::{hierarchy, COARSEST};
         if self.kind != Kind::Geometric || self.aggregated > 0 || self.sizes[0] <= COARSEST {
             return self;
         }
         // The operator of every mesh level, finest to coarsest; the coarsest is kept.
+        let a = a();
         let mut coarse: Option<Csr> = None;
         for (k, t) in self.transfers.iter().enumerate().rev() {
             let mut c = Csr::zeros(self.patterns[k].clone());
-            t.galerkin_values(coarse.as_ref().unwrap_or(a), &mut c, None);
+            t.galerkin_values(coarse.as_ref().unwrap_or(&a), &mut c, None);
             coarse = Some(c);
         }
         let Some(bottom) = coarse else { return self };

@@ -240,7 +240,7 @@ pub fn solve_with(
         Coarsening::Geometric(h) => {
             built = timer.time("setup", || {
                 Levels::new(h, &model.dofs, model.s.pattern.clone())
-                    .map(|l| l.with_aggregation_below(&setup_matrix(model)))
+                    .map(|l| l.with_aggregation_below(|| setup_matrix(model)))
             })?;
             &built
         }
