@@ -117,16 +117,25 @@ fn agrees_with(
     reference: &[f64],
     what: &str,
 ) -> TnnmgReport {
-    let (sol, rep) = solve_with(
-        model,
-        Coarsening::Algebraic,
-        &settings(),
-        options,
-        None,
-        &mut Silent,
-    )
-    .unwrap();
-    assert_eq!(sol.coarsening, Some(Kind::Algebraic));
+    agrees_on(model, Coarsening::Algebraic, options, reference, what).1
+}
+
+/// TNNMG on `coarsening` with `options` against `reference` (its levels of the kind
+/// asked, KKT ≤ 1e-11, relative difference < 1e-8), with its energy history monotone.
+fn agrees_on(
+    model: &Model,
+    coarsening: Coarsening,
+    options: &TnnmgOptions,
+    reference: &[f64],
+    what: &str,
+) -> (crate::solve::Solution, TnnmgReport) {
+    let (sol, rep) =
+        solve_with(model, coarsening, &settings(), options, None, &mut Silent).unwrap();
+    let kind = match coarsening {
+        Coarsening::Algebraic => Kind::Algebraic,
+        _ => Kind::Geometric,
+    };
+    assert_eq!(sol.coarsening, Some(kind), "{what}");
     assert!(
         sol.certificate.kkt() <= 1e-11,
         "{what}: {:?}",
@@ -142,7 +151,7 @@ fn agrees_with(
             w[1].energy
         );
     }
-    rep
+    (sol, rep)
 }
 
 #[test]
@@ -325,29 +334,7 @@ fn large_coarsest_meshes_get_aggregation_levels_below() {
             nested,
             ..TnnmgOptions::default()
         };
-        let (sol, rep) = solve_with(
-            &m,
-            Coarsening::Geometric(&h),
-            &settings(),
-            &options,
-            None,
-            &mut Silent,
-        )
-        .unwrap();
-        assert_eq!(sol.coarsening, Some(Kind::Geometric));
-        assert!(
-            sol.certificate.kkt() <= 1e-11,
-            "{what}: {:?}",
-            sol.certificate
-        );
-        let d = rel_diff(&sol.u, &reference.u);
-        assert!(d < 1e-8, "{what}: differs from active set by {d:e}");
-        for w in sol.history.windows(2) {
-            assert!(
-                w[1].energy <= w[0].energy + 1e-13 * w[0].energy.abs(),
-                "{what}"
-            );
-        }
+        let (sol, rep) = agrees_on(&m, Coarsening::Geometric(&h), &options, &reference.u, &what);
         let solved = if nested { levels.len() } else { 1 };
         assert_eq!(rep.levels.len(), solved, "{what}: levels reported");
         // From zero the hard start costs a few iterations more, as on any levels.
