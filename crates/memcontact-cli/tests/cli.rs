@@ -459,3 +459,60 @@ fn a_case_benchmark_prints_the_solver_phases_when_asked() {
     assert!(names.contains(&"certificate"), "{names:?}");
     assert!(phases.iter().all(|(_, s)| s.is_finite() && *s >= 0.0));
 }
+
+/// A refined mesh whose coarsest level is large (a disc of about 6 500 vertices refined
+/// once, as `refine = 1` makes of an imported mesh): `auto` runs multigrid on the mesh
+/// levels, with aggregation levels below the coarsest mesh, says so in `summary.json`, and
+/// its answer is the active-set method's (an independent formulation, Problem 2f with
+/// sparse Cholesky) in every vertex of `nodes.csv`.
+#[test]
+fn a_refined_mesh_with_a_large_coarsest_level_is_solved_on_its_levels() {
+    let case = examples().join("disk.toml");
+    let solve = |name: &str, extra: &[&str]| {
+        let out = tmp(name);
+        let mut args = vec![
+            "solve",
+            case.to_str().unwrap(),
+            "--set",
+            "mesh.size=0.03",
+            "--set",
+            "mesh.refine=1",
+            "-o",
+            out.to_str().unwrap(),
+            "-q",
+        ];
+        args.extend_from_slice(extra);
+        let o = run(&args);
+        assert!(o.status.success(), "{}", text(&o));
+        let u: Vec<f64> = std::fs::read_to_string(out.join("nodes.csv"))
+            .unwrap()
+            .lines()
+            .skip(1)
+            .map(|l| l.split(',').nth(2).unwrap().parse().unwrap())
+            .collect();
+        (summary(&out), u)
+    };
+    let (s, u) = solve("refined-levels", &[]);
+    assert_eq!(s["solver"], "multigrid");
+    assert_eq!(s["hierarchy"], "geometric");
+    assert_eq!(s["solver_choice"], "geometric_hierarchy");
+    assert!(
+        s["unknowns"].as_u64().unwrap() > 20_000,
+        "{}",
+        s["unknowns"]
+    );
+    assert!(
+        s["iterations"].as_u64().unwrap() <= 4,
+        "{}",
+        s["iterations"]
+    );
+    let (r, reference) = solve("refined-active-set", &["--set", "solver.method=active-set"]);
+    assert_eq!(r["solver"], "active-set");
+    assert_eq!(u.len(), reference.len());
+    let scale = reference.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    let diff = u
+        .iter()
+        .zip(&reference)
+        .fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
+    assert!(diff <= 1e-8 * scale, "differs from active set by {diff:e}");
+}
