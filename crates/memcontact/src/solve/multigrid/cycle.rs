@@ -205,7 +205,7 @@ impl<'a> Multigrid<'a> {
     /// K-cycle's correction on aggregation levels below a large coarsest mesh), the K-cycle
     /// on an algebraic hierarchy (see [`Multigrid::v_cycle`], [`Multigrid::k_cycle`]).
     pub fn cycle<A: TopOperator>(&mut self, fine: &A, x: &mut [f64], b: &[f64]) {
-        if self.top <= self.levels.aggregated {
+        if self.k_cycle_on_top() {
             self.k_cycle(fine, x, b)
         } else {
             self.v_cycle(fine, x, b)
@@ -230,8 +230,15 @@ impl<'a> Multigrid<'a> {
             return false;
         }
         self.presmooth_top(fine, x, b, true);
-        let krylov = self.top <= self.levels.aggregated;
+        let krylov = self.k_cycle_on_top();
         self.cycle_below(fine, x, b, product, krylov)
+    }
+
+    /// Whether the top level and all below it are aggregation levels (an algebraic
+    /// hierarchy, or nested iteration on the aggregation levels below a large coarsest
+    /// mesh): the K-cycle's, not the V-cycle's, descent from the top.
+    fn k_cycle_on_top(&self) -> bool {
+        self.top <= self.levels.aggregated
     }
 
     /// Whether `fine`'s pattern is the top level's own, so that the fused kernels may use

@@ -183,19 +183,15 @@ impl Levels {
             low.extend(high);
             low
         }
-        let sweep_below: Vec<SweepRows> = patterns[..m].iter().map(|p| SweepRows::of(p)).collect();
-        let mut sweep_rows = sweep_below;
-        sweep_rows.extend(self.sweep_rows);
-        let mut transfers = below;
-        transfers.extend(self.transfers);
+        let sweep_below = patterns[..m].iter().map(|p| SweepRows::of(p)).collect();
         Levels {
             kind: Kind::Geometric,
             aggregated: m,
             sizes: join(sizes, self.sizes),
             dofs: self.dofs,
             patterns: join(patterns, self.patterns),
-            transfers,
-            sweep_rows,
+            transfers: [below, self.transfers].concat(),
+            sweep_rows: [sweep_below, self.sweep_rows].concat(),
         }
     }
 
