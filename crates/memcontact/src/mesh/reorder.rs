@@ -282,52 +282,49 @@ fn triangle_order(triangles: &[[u32; 3]], vertices: &Permutation) -> Vec<u32> {
     order_by_key(&keys)
 }
 
-/// Bits of the key sorted per pass of [`order_by_key`].
-const RADIX_BITS: u32 = 11;
-
-/// The indices `0..keys.len()` ordered by `keys[i]`, ties by index: a least-significant-
-/// digit radix sort (stable counting passes of [`RADIX_BITS`] from the identity order), in
-/// time linear in the number of keys, and skipping the digits that all keys share.
+/// The indices `0..keys.len()` ordered by `keys[i]`, ties by index. The indices are first
+/// grouped by the leading bits of their keys, about one group per index, by the stable
+/// counting sort [`group_by_key`] (on all threads); each group, in index order, is then
+/// sorted by its whole keys, stably. Linear time for keys spread over their range, and the
+/// same order for any number of threads.
 fn order_by_key(keys: &[u32]) -> Vec<u32> {
     let n = keys.len();
-    // Key and index in one word, so that every pass reads its input in order.
-    let mut items: Vec<u64> = keys
-        .iter()
-        .enumerate()
-        .map(|(i, &k)| (u64::from(k) << 32) | i as u64)
-        .collect();
-    let mut next = vec![0u64; n];
-    let buckets = 1usize << RADIX_BITS;
-    let mut count = vec![0usize; buckets];
-    let mut shift = 32;
-    while shift < u64::BITS {
-        let digit = |x: u64| (x >> shift) as usize & (buckets - 1);
-        count.iter_mut().for_each(|c| *c = 0);
-        for &x in &items {
-            count[digit(x)] += 1;
-        }
-        if count.contains(&n) {
-            shift += RADIX_BITS;
-            continue;
-        }
-        let mut start = 0;
-        for c in count.iter_mut() {
-            (*c, start) = (start, start + *c);
-        }
-        for &x in &items {
-            let d = digit(x);
-            next[count[d]] = x;
-            count[d] += 1;
-        }
-        std::mem::swap(&mut items, &mut next);
-        shift += RADIX_BITS;
+    if n == 0 {
+        return Vec::new();
     }
-    items.into_iter().map(|x| x as u32).collect()
+    let (lo, hi) = keys
+        .par_iter()
+        .with_min_len(8192)
+        .fold(|| (u32::MAX, 0), |(lo, hi), &k| (lo.min(k), hi.max(k)))
+        .reduce(|| (u32::MAX, 0), |a, b| (a.0.min(b.0), a.1.max(b.1)));
+    // Groups of the keys' leading bits: at most 2n of them (none when all keys are equal).
+    let bits = u32::BITS - (hi - lo).leading_zeros();
+    let group_bits = (usize::BITS - n.leading_zeros()).min(bits);
+    let shift = bits - group_bits;
+    let (ptr, mut order) = crate::sparse::group_by_key(1 << group_bits, n, |i| {
+        [Some(((keys[i] - lo) >> shift, i as u32))]
+    });
+    if shift > 0 {
+        // Blocks of groups, each sorting its own groups.
+        const GROUPS: usize = 4096;
+        let mut blocks = Vec::with_capacity(ptr.len().div_ceil(GROUPS));
+        let mut rest = &mut order[..];
+        for first in (0..ptr.len() - 1).step_by(GROUPS) {
+            let last = (first + GROUPS).min(ptr.len() - 1);
+            let (block, tail) = rest.split_at_mut(ptr[last] - ptr[first]);
+            blocks.push((first, last, block));
+            rest = tail;
+        }
+        blocks.into_par_iter().for_each(|(first, last, block)| {
+            let base = ptr[first];
+            for g in first..last {
+                block[ptr[g] - base..ptr[g + 1] - base].sort_by_key(|&i| keys[i as usize]);
+            }
+        });
+    }
+    order
 }
 
-/// The mean distance `|i − j|` between the numbers of the two ends of an edge, in units of
-/// `√n`: about 0.7 for a structured grid numbered row by row, of order `√n` for a
-/// scattered numbering.
 #[cfg(any(test, feature = "bench"))]
 pub fn edge_span(mesh: &Mesh) -> f64 {
     span_of(mesh.n_vertices(), &mesh.triangles)
@@ -460,6 +457,10 @@ mod tests {
             (5000, u32::MAX, 0),
             (5000, 0x3f, 0),
             (70_000, 0xffff, 0x7000_0000),
+            // On all threads: keys spread over the full range, and keys of about one per
+            // index (the grouping alone orders them).
+            (300_000, u32::MAX, 0),
+            (300_000, 0x3_ffff, 0),
         ] {
             let keys: Vec<u32> = (0..n).map(|_| base | (next() as u32 & mask)).collect();
             let mut expected: Vec<u32> = (0..n as u32).collect();
