@@ -140,14 +140,12 @@ impl Discretization {
         if geometric {
             let t0 = Instant::now();
             observer.phase_started("levels");
-            let levels = Levels::from_relations(
+            let levels = crate::solve::multigrid::tnnmg::mesh_levels(
+                &d.model,
                 &d.hierarchy.refinements,
                 &counts,
                 d.hierarchy.levels.last(),
-                &d.model.dofs,
-                d.model.s.pattern.clone(),
-            )?
-            .with_aggregation_below(|| crate::solve::multigrid::tnnmg::setup_matrix(&d.model));
+            )?;
             d.built = Some(Arc::new(levels));
             let seconds = t0.elapsed().as_secs_f64();
             observer.phase_finished("levels", seconds);

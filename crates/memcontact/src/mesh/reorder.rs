@@ -284,7 +284,7 @@ fn triangle_order(triangles: &[[u32; 3]], vertices: &Permutation) -> Vec<u32> {
 
 /// The indices `0..keys.len()` ordered by `keys[i]`, ties by index. The indices are first
 /// grouped by the leading bits of their keys, about one group per index, by the stable
-/// counting sort [`group_by_key`] (on all threads); each group, in index order, is then
+/// counting sort [`crate::sparse::group_by_key`] (on all threads); each group, in index order, is then
 /// sorted by its whole keys, stably. Linear time for keys spread over their range, and the
 /// same order for any number of threads.
 fn order_by_key(keys: &[u32]) -> Vec<u32> {
@@ -297,7 +297,7 @@ fn order_by_key(keys: &[u32]) -> Vec<u32> {
         .with_min_len(8192)
         .fold(|| (u32::MAX, 0), |(lo, hi), &k| (lo.min(k), hi.max(k)))
         .reduce(|| (u32::MAX, 0), |a, b| (a.0.min(b.0), a.1.max(b.1)));
-    // Groups of the keys' leading bits: at most 2n of them (none when all keys are equal).
+    // Groups of the keys' leading bits: at most 2n of them (one when all keys are equal).
     let bits = u32::BITS - (hi - lo).leading_zeros();
     let group_bits = (usize::BITS - n.leading_zeros()).min(bits);
     let shift = bits - group_bits;
@@ -325,6 +325,9 @@ fn order_by_key(keys: &[u32]) -> Vec<u32> {
     order
 }
 
+/// The mean distance `|i − j|` between the numbers of the two ends of an edge, in units of
+/// `√n`: about 0.7 for a structured grid numbered row by row, of order `√n` for a
+/// scattered numbering.
 #[cfg(any(test, feature = "bench"))]
 pub fn edge_span(mesh: &Mesh) -> f64 {
     span_of(mesh.n_vertices(), &mesh.triangles)

@@ -73,8 +73,7 @@ pub fn levels_for(model: &Model, hierarchy: Option<&Hierarchy>) -> Result<Option
         return Ok(None);
     }
     Ok(Some(match hierarchy {
-        Some(h) if h.depth() >= 2 => Levels::new(h, &model.dofs, model.s.pattern.clone())?
-            .with_aggregation_below(|| crate::solve::multigrid::tnnmg::setup_matrix(model)),
+        Some(h) if h.depth() >= 2 => crate::solve::multigrid::tnnmg::mesh_levels_of(model, h)?,
         _ => Levels::algebraic(
             &crate::solve::multigrid::tnnmg::setup_matrix(model),
             crate::solve::multigrid::aggregation::COARSEST,

@@ -5,7 +5,7 @@ use super::aggregation;
 use super::cycle::{FcgWork, Multigrid};
 use super::levels::Levels;
 use super::smoother::*;
-use super::tnnmg::{coarse_model, setup_matrix, Coarsening};
+use super::tnnmg::{coarse_model, mesh_levels_of, setup_matrix, Coarsening};
 use crate::error::Result;
 use crate::model::Model;
 use crate::solve::line_search::{apply_step, exact_step, line_data, line_data_at};
@@ -39,7 +39,7 @@ pub fn kernel_timings(
     let mut levels = None;
     time("levels setup", &mut || {
         levels = match coarsening {
-            Coarsening::Geometric(h) => Levels::new(h, &model.dofs, model.s.pattern.clone()).ok(),
+            Coarsening::Geometric(h) => mesh_levels_of(model, h).ok(),
             Coarsening::Built(l) => Some(l.clone()),
             Coarsening::Algebraic => Some(Levels::algebraic(
                 &setup_matrix(model),

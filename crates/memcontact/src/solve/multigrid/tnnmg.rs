@@ -214,6 +214,33 @@ pub(crate) fn setup_matrix(model: &Model) -> Csr {
     }
 }
 
+/// The multigrid levels of `model` on the mesh hierarchy of the refinement relations
+/// `refinements` (vertex counts coarsest first, the finest mesh `last`; see
+/// [`Levels::from_relations`]), with aggregation levels below a coarsest mesh too large to
+/// factorise ([`Levels::with_aggregation_below`], from [`setup_matrix`]). Every solve of a
+/// model on mesh levels builds them here.
+pub(crate) fn mesh_levels(
+    model: &Model,
+    refinements: &[crate::mesh::refine::Refinement],
+    vertex_counts: &[usize],
+    last: Option<&crate::mesh::Mesh>,
+) -> Result<Levels> {
+    Ok(Levels::from_relations(
+        refinements,
+        vertex_counts,
+        last,
+        &model.dofs,
+        model.s.pattern.clone(),
+    )?
+    .with_aggregation_below(|| setup_matrix(model)))
+}
+
+/// [`mesh_levels`] of `model` on the whole hierarchy `h`.
+pub(crate) fn mesh_levels_of(model: &Model, h: &Hierarchy) -> Result<Levels> {
+    let counts: Vec<usize> = h.levels.iter().map(|m| m.n_vertices()).collect();
+    mesh_levels(model, &h.refinements, &counts, h.levels.last())
+}
+
 /// Solves Problem 2b by TNNMG ([`crate::Method::Multigrid`]) with explicit options, also
 /// returning the per-level report (one entry per level solved: all of them with nested
 /// iteration). With a `start` the iteration begins there on the finest level, without
@@ -238,10 +265,7 @@ pub fn solve_with(
             l
         }
         Coarsening::Geometric(h) => {
-            built = timer.time("setup", || {
-                Levels::new(h, &model.dofs, model.s.pattern.clone())
-                    .map(|l| l.with_aggregation_below(|| setup_matrix(model)))
-            })?;
+            built = timer.time("setup", || mesh_levels_of(model, h))?;
             &built
         }
         Coarsening::Algebraic => {
