@@ -114,7 +114,7 @@ impl Discretization {
             return Err(crate::error::Error::Cancelled);
         }
         let (mut hierarchy, t_reorder) = reorder(hierarchy, observer)?;
-        let counts: Vec<usize> = hierarchy.levels.iter().map(Mesh::n_vertices).collect();
+        let counts = hierarchy.vertex_counts();
         let depth = hierarchy.depth();
         for m in &mut hierarchy.levels[..depth - 1] {
             m.points = Vec::new();

@@ -53,6 +53,12 @@ impl Hierarchy {
     pub fn depth(&self) -> usize {
         self.levels.len()
     }
+
+    /// The number of vertices of every level, coarsest first (what multigrid's levels read
+    /// of the coarser meshes, which may then be released).
+    pub fn vertex_counts(&self) -> Vec<usize> {
+        self.levels.iter().map(Mesh::n_vertices).collect()
+    }
 }
 
 impl Hierarchy {

@@ -53,7 +53,7 @@ impl Levels {
     /// pattern is `pattern`) and builds the transfers and Galerkin patterns. A hierarchy
     /// that does not fit is an error.
     pub fn new(hierarchy: &Hierarchy, finest: &DofMap, pattern: Arc<Pattern>) -> Result<Levels> {
-        let counts: Vec<usize> = hierarchy.levels.iter().map(Mesh::n_vertices).collect();
+        let counts = hierarchy.vertex_counts();
         Levels::from_relations(
             &hierarchy.refinements,
             &counts,

@@ -237,7 +237,7 @@ pub(crate) fn mesh_levels(
 
 /// [`mesh_levels`] of `model` on the whole hierarchy `h`.
 pub(crate) fn mesh_levels_of(model: &Model, h: &Hierarchy) -> Result<Levels> {
-    let counts: Vec<usize> = h.levels.iter().map(|m| m.n_vertices()).collect();
+    let counts = h.vertex_counts();
     mesh_levels(model, &h.refinements, &counts, h.levels.last())
 }
 
