@@ -323,8 +323,10 @@ pub(super) fn read_elements_v2(c: &mut Cursor, binary: bool, raw: &mut Raw) -> P
         let (tag_text, start) = c
             .token()
             .ok_or("unexpected end of file in $Elements: expected an element")?;
-        let line = c.line(start);
+        // The line number is counted only for the error: counting it for every element
+        // would make reading quadratic in the file's size.
         let tag: i64 = tag_text.parse().map_err(|_| {
+            let line = c.line(start);
             format!("line {line} ($Elements): expected an element tag, found `{tag_text}`")
         })?;
         let ty: i32 = c.parse("an element type")?;
