@@ -144,15 +144,26 @@ pub fn free_boundary(mesh: &Mesh, contact: &[bool], rings: usize) -> Result<Vec<
 /// boundary is refined at most as fast as the bulk and the energy error keeps its rate.
 /// Returns sorted indices.
 pub fn largest(mesh: &Mesh, set: &[u32], besides: &[u32], count: usize) -> Vec<u32> {
-    let mut rest: Vec<u32> = set
-        .iter()
-        .copied()
-        .filter(|k| besides.binary_search(k).is_err())
-        .collect();
+    // `set` minus `besides`, one merge of the two sorted lists.
+    let mut rest = Vec::with_capacity(set.len());
+    let mut others = besides.iter().peekable();
+    for &k in set {
+        while others.next_if(|&&o| o < k).is_some() {}
+        if others.peek() != Some(&&k) {
+            rest.push(k);
+        }
+    }
     if rest.len() > count {
-        let key = |&k: &u32| (std::cmp::Reverse(OrdArea(mesh.area(k as usize))), k);
-        rest.sort_unstable_by_key(key);
-        rest.truncate(count);
+        // Each area computed once; the `count` first in the order (larger area, then lower
+        // index), which is a total order: the same set as a full sort's first `count`.
+        let mut keyed: Vec<(std::cmp::Reverse<OrdArea>, u32)> = rest
+            .iter()
+            .map(|&k| (std::cmp::Reverse(OrdArea(mesh.area(k as usize))), k))
+            .collect();
+        if count > 0 {
+            keyed.select_nth_unstable(count - 1);
+        }
+        rest = keyed[..count].iter().map(|&(_, k)| k).collect();
         rest.sort_unstable();
     }
     rest
@@ -378,6 +389,54 @@ mod tests {
         }
         let e = free_boundary(&m, &contact[1..], 0).unwrap_err().to_string();
         assert!(e.contains("contact flags for"), "{e}");
+    }
+
+    #[test]
+    fn largest_takes_the_largest_areas_outside_the_other_set() {
+        // Interior vertices moved in the left half (areas vary); the right half keeps
+        // equal areas, so ties are broken by index.
+        let mut m = grid(12);
+        let jitter = uniform(7, 2 * m.n_vertices());
+        for (i, p) in m.points.iter_mut().enumerate() {
+            if p[0] < 0.0 && p[0] > -1.0 && p[1].abs() < 1.0 {
+                p[0] += 0.04 * (jitter[2 * i] - 0.5);
+                p[1] += 0.04 * (jitter[2 * i + 1] - 0.5);
+            }
+        }
+        let n = m.n_triangles() as u32;
+        let pick = uniform(11, n as usize);
+        let set: Vec<u32> = (0..n).filter(|&k| pick[k as usize] < 0.6).collect();
+        let besides: Vec<u32> = (0..n).filter(|&k| k % 3 == 0).collect();
+        // By definition: a full sort of the rest by (larger area, lower index).
+        let naive = |count: usize| {
+            let mut rest: Vec<u32> = set
+                .iter()
+                .copied()
+                .filter(|k| !besides.contains(k))
+                .collect();
+            rest.sort_by(|&a, &b| {
+                let (aa, ab) = (m.area(a as usize), m.area(b as usize));
+                ab.total_cmp(&aa).then(a.cmp(&b))
+            });
+            rest.truncate(count);
+            rest.sort_unstable();
+            rest
+        };
+        let rest = naive(usize::MAX);
+        assert!(rest.len() > 100);
+        for count in [
+            0,
+            1,
+            7,
+            rest.len() / 2,
+            rest.len() - 1,
+            rest.len(),
+            rest.len() + 5,
+        ] {
+            assert_eq!(largest(&m, &set, &besides, count), naive(count), "{count}");
+        }
+        assert_eq!(largest(&m, &set, &[], usize::MAX), set);
+        assert!(largest(&m, &[], &besides, 10).is_empty());
     }
 
     #[test]

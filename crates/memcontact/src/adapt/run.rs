@@ -129,6 +129,15 @@ pub fn run_adapt(
             discretization.warnings = warnings.clone();
             check_case_on_mesh(case, discretization.mesh(), false)?;
         }
+        // The multigrid levels: the previous step's, with this step's mesh on top.
+        if discretization.solves_on_mesh_levels(&case.settings) {
+            let counts = discretization.hierarchy.vertex_counts();
+            let previous = kept.as_mut().and_then(|(o, _)| {
+                let levels = o.discretization.take_levels()?;
+                Some((levels, &o.discretization.model.dofs))
+            });
+            discretization.build_levels(&counts, previous, observer)?;
+        }
         let start_unknowns = start.as_ref().map(|values| {
             let mesh = discretization.mesh();
             let values = mesh.vertex_values_from_user(values);
@@ -199,8 +208,14 @@ pub fn run_adapt(
         {
             break (AdaptStop::MaxVertices, None);
         }
+        // Without refinements the check reads the vertices and triangles alone: the edges
+        // are not counted (that would cost a pass over the mesh's adjacency every step).
+        let size = crate::limits::MeshSize::simply_connected(
+            b.mesh.n_vertices() as f64,
+            b.mesh.n_triangles() as f64,
+        );
         if let Err(e) = crate::limits::check_mesh_fits(
-            crate::limits::MeshSize::of(&b.mesh),
+            size,
             0,
             &format!("the adaptive loop's step {}", step + 1),
         ) {

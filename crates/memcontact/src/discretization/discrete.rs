@@ -5,7 +5,7 @@ use super::binding::BoundData;
 use super::meshing::build_mesh_checked;
 use crate::error::{Invalid, Result};
 use crate::mesh::refine::Hierarchy;
-use crate::mesh::{Mesh, MeshQuality};
+use crate::mesh::{DofMap, Mesh, MeshQuality};
 use crate::model::Model;
 use crate::problem::{MeshSource, MeshSpec, Problem};
 use crate::solve::multigrid::Levels;
@@ -134,27 +134,69 @@ impl Discretization {
         );
         // The levels multigrid will build from the mesh's hierarchy, built now (part of
         // the symbolic phase), so that the refinement relations can go.
-        let geometric = d.method_for(settings) == crate::solve::Method::Multigrid
-            && settings.hierarchy != crate::solve::HierarchyChoice::Algebraic
-            && depth > 1;
-        if geometric {
-            let t0 = Instant::now();
-            observer.phase_started("levels");
-            let levels = crate::solve::multigrid::tnnmg::mesh_levels(
-                &d.model,
-                &d.hierarchy.refinements,
-                &counts,
-                d.hierarchy.levels.last(),
-            )?;
-            d.built = Some(Arc::new(levels));
-            let seconds = t0.elapsed().as_secs_f64();
-            observer.phase_finished("levels", seconds);
-            if let Some(p) = d.phases.iter_mut().find(|p| p.name == "assembly") {
-                p.seconds += seconds;
-            }
+        if d.solves_on_mesh_levels(settings) {
+            d.build_levels(&counts, None, observer)?;
         }
         d.hierarchy.refinements = Vec::new();
         Ok(d)
+    }
+
+    /// Whether a solve with `settings` runs multigrid on the mesh levels: multigrid chosen,
+    /// the algebraic levels not asked for, and a hierarchy of more than one mesh.
+    pub(crate) fn solves_on_mesh_levels(&self, settings: &Settings) -> bool {
+        self.method_for(settings) == crate::solve::Method::Multigrid
+            && settings.hierarchy != crate::solve::HierarchyChoice::Algebraic
+            && self.hierarchy.depth() > 1
+    }
+
+    /// Builds the geometric multigrid levels the solves will use (the `levels` phase,
+    /// counted in `assembly`); `counts` are the vertex counts of the hierarchy's meshes.
+    /// With the `previous` step's levels of an adaptive loop and that step's unknowns,
+    /// whose mesh this hierarchy refined into its finest, only the new finest level is
+    /// added to them ([`Levels::extended`]) when they fit; otherwise every level is built.
+    pub(crate) fn build_levels(
+        &mut self,
+        counts: &[usize],
+        previous: Option<(Arc<Levels>, &DofMap)>,
+        observer: &mut dyn Observer,
+    ) -> Result<()> {
+        let t0 = Instant::now();
+        observer.phase_started("levels");
+        let h = &self.hierarchy;
+        let mut levels = None;
+        if let (Some((prev, top)), Some(refinement), Some(last)) =
+            (previous, h.refinements.last(), h.levels.last())
+        {
+            levels = Arc::unwrap_or_clone(prev).extended(
+                top,
+                refinement,
+                last,
+                &self.model.dofs,
+                self.model.s.pattern.clone(),
+            )?;
+        }
+        let levels = match levels {
+            Some(levels) => levels,
+            None => crate::solve::multigrid::tnnmg::mesh_levels(
+                &self.model,
+                &h.refinements,
+                counts,
+                h.levels.last(),
+            )?,
+        };
+        self.built = Some(Arc::new(levels));
+        let seconds = t0.elapsed().as_secs_f64();
+        observer.phase_finished("levels", seconds);
+        if let Some(p) = self.phases.iter_mut().find(|p| p.name == "assembly") {
+            p.seconds += seconds;
+        }
+        Ok(())
+    }
+
+    /// Takes the multigrid levels built beforehand, if any, out of this discretisation
+    /// (an adaptive loop's next step extends them).
+    pub(crate) fn take_levels(&mut self) -> Option<Arc<Levels>> {
+        self.built.take()
     }
 
     /// Releases what only a solve reads (S and the multigrid levels), once a discretisation

@@ -137,6 +137,51 @@ impl Levels {
         })
     }
 
+    /// These mesh levels with a finer level on top, the next step of an adaptive loop:
+    /// `refinement` leads from the current top level, whose unknowns were `top` (the
+    /// previous model's), to the mesh `last` with unknowns `finest` and operator pattern
+    /// `pattern`. Only the new level's transfer, Galerkin pattern and sweep data are
+    /// computed; the levels below are kept, the same as [`Levels::from_relations`] would
+    /// build them again. `None` when they would not be the same (levels with aggregation
+    /// below, or a top level whose unknowns or pattern differ from the ones the refinement
+    /// implies): the caller then builds all levels.
+    pub(crate) fn extended(
+        mut self,
+        top: &DofMap,
+        refinement: &Refinement,
+        last: &Mesh,
+        finest: &DofMap,
+        pattern: Arc<Pattern>,
+    ) -> Result<Option<Levels>> {
+        if self.kind != Kind::Geometric || self.aggregated > 0 {
+            return Ok(None);
+        }
+        if last.n_vertices() != finest.n_vertices() || pattern.n() != finest.len() {
+            return Err(Error::Mesh(format!(
+                "the new finest level has {} vertices, but the model was assembled on a mesh \
+                 of {} vertices",
+                last.n_vertices(),
+                finest.n_vertices()
+            )));
+        }
+        check_pattern(last, finest, &pattern)?;
+        let below = self.patterns.len() - 1;
+        let coarse = coarse_dofs(refinement, top.n_vertices(), finest)?;
+        if coarse.vertex != top.vertex || coarse.len() != self.sizes[below] {
+            return Ok(None);
+        }
+        let transfer = Transfer::new(refinement, &coarse, finest)?.with_columns_from(&pattern);
+        if transfer.galerkin_pattern(&pattern) != *self.patterns[below] {
+            return Ok(None);
+        }
+        self.sizes.push(finest.len());
+        self.dofs.push(coarse);
+        self.transfers.push(transfer);
+        self.sweep_rows.push(SweepRows::of(&pattern));
+        self.patterns.push(pattern);
+        Ok(Some(self))
+    }
+
     /// An algebraic hierarchy for the operator `a` (the finest level; its pattern is the
     /// finest pattern) by double pairwise aggregation, down to about `coarsest` unknowns.
     pub fn algebraic(a: &Csr, coarsest: usize) -> Levels {

@@ -644,29 +644,102 @@ fn forcing_is_quadratic_until_the_tolerance_is_near() {
     assert_eq!(forcing(5e-2, tol, 0.0, algebraic), 5e-2 * 5e-2);
 }
 
+/// The square on a 12 × 12 grid refined `steps` times by newest-vertex bisection of the
+/// triangles near one corner (an adaptive loop's hierarchy).
+fn corner_hierarchy(steps: usize) -> Hierarchy {
+    use crate::adapt::bisect::{bisect, label_longest_edge};
+    let mut h = Hierarchy::single(label_longest_edge(&square(12)));
+    for _ in 0..steps {
+        let mesh = h.finest();
+        let marked: Vec<u32> = (0..mesh.n_triangles() as u32)
+            .filter(|&k| {
+                let c = mesh.triangles[k as usize].map(|v| mesh.points[v as usize]);
+                c.iter().all(|p| p[0] + p[1] < 0.8)
+            })
+            .collect();
+        let b = bisect(mesh, &marked).unwrap();
+        h.levels.push(b.mesh);
+        h.refinements.push(b.refinement);
+    }
+    h
+}
+
+#[test]
+fn extended_levels_are_the_levels_built_whole() {
+    let h = corner_hierarchy(4);
+    let depth = h.depth();
+    let mut below = h.clone();
+    below.levels.pop();
+    below.refinements.pop();
+    let model = |m: &Mesh| bench_model(m, Some(1000.0), Foundation::Lumped);
+    let (previous, finest) = (model(below.finest()), model(h.finest()));
+    let old = Levels::new(&below, &previous.dofs, previous.s.pattern.clone()).unwrap();
+    let whole = Levels::new(&h, &finest.dofs, finest.s.pattern.clone()).unwrap();
+    let refinement = &h.refinements[depth - 2];
+    let extend = |top: &DofMap| {
+        old.clone()
+            .extended(
+                top,
+                refinement,
+                h.finest(),
+                &finest.dofs,
+                finest.s.pattern.clone(),
+            )
+            .unwrap()
+    };
+    let grown = extend(&previous.dofs).expect("the previous levels fit");
+    assert_eq!(grown.len(), depth);
+    assert_eq!(grown.sizes, whole.sizes);
+    assert!(std::sync::Arc::ptr_eq(
+        &grown.patterns[depth - 1],
+        &finest.s.pattern
+    ));
+    for k in 0..depth {
+        assert_eq!(grown.patterns[k], whole.patterns[k], "pattern {k}");
+        let (a, b) = (&grown.sweep_rows[k], &whole.sweep_rows[k]);
+        assert_eq!((&a.seams, &a.diag), (&b.seams, &b.diag), "sweep rows {k}");
+    }
+    for k in 0..depth - 1 {
+        assert_eq!(grown.dofs[k].vertex, whole.dofs[k].vertex, "dofs {k}");
+        let (a, b) = (&grown.transfers[k], &whole.transfers[k]);
+        assert_eq!(
+            (a.n_coarse, &a.parents),
+            (b.n_coarse, &b.parents),
+            "transfer {k}"
+        );
+        let n = a.n_fine();
+        assert!((0..n).all(|v| a.weights(v) == b.weights(v)), "weights {k}");
+        let x: Vec<f64> = (0..n)
+            .map(|i| ((i * 7919) % 1013) as f64 / 1013.0)
+            .collect();
+        let (mut ra, mut rb) = (vec![0.0; a.n_coarse], vec![1.0; b.n_coarse]);
+        a.restrict(&x, &mut ra);
+        b.restrict(&x, &mut rb);
+        assert_eq!(ra, rb, "restriction {k}");
+    }
+    // Levels whose top is not the level the refinement starts from are not extended.
+    assert!(extend(&DofMap::all(previous.dofs.n_vertices())).is_none());
+    // A mesh that is not the model's.
+    let e = old
+        .clone()
+        .extended(
+            &previous.dofs,
+            refinement,
+            below.finest(),
+            &finest.dofs,
+            finest.s.pattern.clone(),
+        )
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("new finest level has"), "{e}");
+}
+
 #[test]
 fn transfer_columns_read_from_the_fine_pattern_give_the_same_sums() {
     use crate::solve::newton::NewtonStates;
     let disk = crate::mesh::generate::disk([0.0, 0.0], 1.0, 0.3).unwrap();
-    // Local refinement: newest-vertex bisection of the triangles near one corner, twice
-    // (most coarse unknowns have no child but the one on them).
-    let local = {
-        use crate::adapt::bisect::{bisect, label_longest_edge};
-        let mut h = Hierarchy::single(label_longest_edge(&square(12)));
-        for _ in 0..2 {
-            let mesh = h.finest();
-            let marked: Vec<u32> = (0..mesh.n_triangles() as u32)
-                .filter(|&k| {
-                    let c = mesh.triangles[k as usize].map(|v| mesh.points[v as usize]);
-                    c.iter().all(|p| p[0] + p[1] < 0.8)
-                })
-                .collect();
-            let b = bisect(mesh, &marked).unwrap();
-            h.levels.push(b.mesh);
-            h.refinements.push(b.refinement);
-        }
-        h
-    };
+    // Local refinement: most coarse unknowns have no child but the one on them.
+    let local = corner_hierarchy(2);
     for (name, h, whole) in [
         ("square", square_hierarchy(4, 4), true),
         ("disc", Hierarchy::refined(disk, 3), true),
