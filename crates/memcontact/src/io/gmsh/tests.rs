@@ -450,6 +450,34 @@ fn byte_swapped_binary_is_read() {
 }
 
 #[test]
+fn large_ascii_files_are_read_in_one_pass() {
+    // 2 · 300² triangles in MSH 2.2 text: counting every element's line number from the
+    // start of the file, as the reader once did, would take hours here.
+    use crate::mesh::generate::{rectangle, Diagonal, RectangleSpec};
+    let spec = RectangleSpec {
+        x0: 0.0,
+        y0: 0.0,
+        x1: 1.0,
+        y1: 1.0,
+        nx: 300,
+        ny: 300,
+        diagonal: Diagonal::Alternate,
+    };
+    let mesh = rectangle(&spec).unwrap().levels.pop().unwrap();
+    for (name, version) in [
+        ("big22.msh", MshVersion::V22Ascii),
+        ("big41.msh", MshVersion::V41Ascii),
+    ] {
+        let p = temp(name);
+        write_msh(&p, &mesh, version).unwrap();
+        let (read, _) = read_msh(&p).unwrap();
+        assert_eq!(read.n_triangles(), 2 * 300 * 300, "{name}");
+        assert_eq!(read.n_vertices(), 301 * 301, "{name}");
+        assert_eq!(canonical(&read), canonical(&mesh), "{name}");
+    }
+}
+
+#[test]
 fn bad_files_are_clear_errors() {
     let err = |name: &str, text: &str| read_msh(&write_text(name, text)).unwrap_err().to_string();
     // truncated in the middle of $Elements
@@ -471,6 +499,14 @@ fn bad_files_are_clear_errors() {
     assert!(e.contains("version 3.0"), "{e}");
     let e = err("num.msh", &SQUARE_22.replace("20 1 0 0", "20 1 zero 0"));
     assert!(e.contains("line 13") && e.contains("zero"), "{e}");
+    // a bad element tag: the line named is the element's
+    let bad = SQUARE_22.replace("12 2 2 6 1 20 30 99", "1x 2 2 6 1 20 30 99");
+    let line = 1 + bad[..bad.find("1x 2 2").unwrap()].matches('\n').count();
+    let e = err("tag.msh", &bad);
+    assert!(
+        e.contains(&format!("line {line} ($Elements)")) && e.contains("`1x`"),
+        "{e}"
+    );
     // missing node
     let e = err(
         "miss.msh",
