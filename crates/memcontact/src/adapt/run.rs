@@ -229,7 +229,9 @@ pub fn run_adapt(
         hierarchy.refinements.push(refinement);
         step += 1;
     };
-    let (outcome, indicators) = kept.expect("step 0 is kept or is an error");
+    let (mut outcome, indicators) = kept.expect("step 0 is kept or is an error");
+    // Only a next step would extend the multigrid levels: they go before the writing.
+    outcome.discretization.release_levels();
     Ok(AdaptRun {
         rows,
         outcome,
