@@ -259,7 +259,19 @@ fn on_circle(c: &Circle, p: Point) -> bool {
 /// out of range, a non-manifold or folded edge, a boundary region edge that is no edge of
 /// the mesh, more than `u32::MAX` vertices, or a triangle turned over by the projection
 /// onto the curve (a start mesh too coarse for its circle).
+#[cfg_attr(not(test), allow(dead_code))]
 pub fn bisect(mesh: &Mesh, marked: &[u32]) -> Result<Bisection> {
+    Ok(bisect_within(mesh, marked, usize::MAX)?.expect("no bound on the vertices"))
+}
+
+/// [`bisect`], or `None` as soon as the closure shows that the bisected mesh would have
+/// more than `max_vertices` vertices: the mesh is then not built (an adaptive loop that
+/// stops before such a mesh does not pay for it).
+pub fn bisect_within(
+    mesh: &Mesh,
+    marked: &[u32],
+    max_vertices: usize,
+) -> Result<Option<Bisection>> {
     let (nv, nt) = (mesh.n_vertices(), mesh.n_triangles());
     if let Some(i) = first_where(marked, |k| k as usize >= nt) {
         return Err(Error::Mesh(format!(
@@ -324,6 +336,9 @@ pub fn bisect(mesh: &Mesh, marked: &[u32]) -> Result<Bisection> {
             }
             new_edges.push(h as u32);
         }
+    }
+    if nv + new_edges.len() > max_vertices {
+        return Ok(None);
     }
     let ends = |h: u32| {
         let t = mesh.triangles[h as usize / 3];
@@ -393,11 +408,11 @@ pub fn bisect(mesh: &Mesh, marked: &[u32]) -> Result<Bisection> {
         boundary,
         numbering: None,
     };
-    Ok(Bisection {
+    Ok(Some(Bisection {
         mesh: fine,
         refinement: Refinement { parents },
         parent,
-    })
+    }))
 }
 
 /// The children of triangle `[a, b, c]` (refinement edge `ab`) given the new vertices on
@@ -770,6 +785,24 @@ mod tests {
                 m = b.mesh;
             }
         }
+    }
+
+    #[test]
+    fn a_bound_on_the_vertices_stops_before_the_mesh_is_built() {
+        let m = label_longest_edge(&l_shape(0.5));
+        let marked: Vec<u32> = (0..m.n_triangles() as u32).step_by(3).collect();
+        let full = bisect(&m, &marked).unwrap();
+        let n = full.mesh.n_vertices();
+        assert!(n > m.n_vertices());
+        let within = bisect_within(&m, &marked, n)
+            .unwrap()
+            .expect("fits exactly");
+        assert_eq!(within.mesh.triangles, full.mesh.triangles);
+        assert_eq!(within.mesh.points, full.mesh.points);
+        assert_eq!(within.refinement.parents, full.refinement.parents);
+        assert!(bisect_within(&m, &marked, n - 1).unwrap().is_none());
+        // Bad input is still an error, not a stop.
+        assert!(bisect_within(&m, &[u32::MAX], 0).is_err());
     }
 
     #[test]

@@ -201,13 +201,10 @@ pub fn run_adapt(
             let free = mark::largest(mesh, &mark::union(&refs), &bulk, bulk.len());
             marked = mark::union(&[&bulk, &free]);
         }
-        let b = bisect::bisect(mesh, &marked)?;
-        if spec
-            .max_vertices
-            .is_some_and(|max| b.mesh.n_vertices() > max)
-        {
+        let max = spec.max_vertices.unwrap_or(usize::MAX);
+        let Some(b) = bisect::bisect_within(mesh, &marked, max)? else {
             break (AdaptStop::MaxVertices, None);
-        }
+        };
         // Without refinements the check reads the vertices and triangles alone: the edges
         // are not counted (that would cost a pass over the mesh's adjacency every step).
         let size = crate::limits::MeshSize::simply_connected(
